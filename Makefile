@@ -1,0 +1,30 @@
+# The two commands a new user needs (both do the whole set-up first, once):
+#   make demo   the main job (for now: roll out a grid world, write pictures to out/)
+#   make test   the default test run (slow tests excluded; `make test-slow` runs them)
+VENV ?= .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.craftsuite-setup
+
+.PHONY: setup demo test test-slow bench clean
+
+$(STAMP): pyproject.toml constraints.txt scripts/setup.sh
+	VENV=$(VENV) bash scripts/setup.sh
+	touch $(STAMP)
+
+setup: $(STAMP)
+
+demo: $(STAMP)
+	$(PY) -m craftsuite demo --out out/demo
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+test-slow: $(STAMP)
+	$(PY) -m pytest -q -m slow
+
+bench: $(STAMP)
+	$(PY) benchmarks/automata.py
+	$(PY) benchmarks/grid_steps.py
+
+clean:
+	rm -rf out .pytest_cache

@@ -1,0 +1,17 @@
+"""CraftSuite: LTLf tasks as grid and MuJoCo worlds for neuro-symbolic transfer RL.
+
+Importing the package registers the gymnasium ids ``CraftSuite/<Task>-Grid<size>-v0``.
+"""
+
+from .automata import Automaton, compile_ltlf
+from .registration import make_grid, register_builtin, register_task, registered_ids, tasks
+from .spec import SpecError, TaskSpec, load_spec
+from .wrappers import AutomatonObservation
+
+__version__ = "0.1.0"
+__all__ = [
+    "Automaton", "AutomatonObservation", "SpecError", "TaskSpec", "compile_ltlf", "load_spec",
+    "make_grid", "register_task", "registered_ids", "tasks",
+]
+
+register_builtin()

@@ -1,0 +1,5 @@
+"""CraftSuite worlds."""
+
+from .grid import ACTION_NAMES, GridWorldEnv
+
+__all__ = ["GridWorldEnv", "ACTION_NAMES"]

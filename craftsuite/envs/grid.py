@@ -1,0 +1,251 @@
+"""Grid worlds: one environment class for every task spec and grid size."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+
+from ..labelling import Labeller
+from ..rendering.grid import EMPTY, WALL, draw_grid, grid_text
+from ..rules import Rules
+from ..spec import TaskSpec
+from ..registration import resolve_task
+
+# action -> (dx, dy); y grows downwards (row 0 is the top row)
+_MOVES = {0: (0, -1), 1: (1, 0), 2: (0, 1), 3: (-1, 0)}
+ACTION_NAMES = ("up", "right", "down", "left")
+
+
+class GridWorldEnv(gym.Env):
+    """A CraftSuite task on a square grid, with its LTLf objective tracked as a DFA.
+
+    ## Description
+    The agent walks on a ``size`` x ``size`` grid. Items (wood, key, gold, ...) are picked
+    up by stepping on their tile, places (factory, home, chest, dragon) act when the agent
+    enters them; what they do comes from the task spec in ``tasks/`` (see
+    ``craftsuite.spec``). Each step is labelled with the task's atomic propositions and the
+    objective's automaton advances on that label. The layout is drawn anew from the seed
+    given to ``reset``.
+
+    ## Action Space
+    ``Discrete(4)``: 0 up, 1 right, 2 down, 3 left. Moving into the border or an obstacle
+    leaves the agent where it is.
+
+    ## Observation Space
+    ``Box(0, 1, (C*size*size + n_inventory,), float32)``: one binary plane per channel
+    (agent, obstacle, then one per object kind in spec order), row-major, followed by the
+    inventory counts divided by their largest possible value. ``observation_layout``
+    describes the slices; reshape the first part to ``(C, size, size)`` for a CNN. With
+    ``product=True`` (``gymnasium.make`` keyword) the automaton state's one-hot follows.
+
+    ## Rewards
+    From the spec: the step reward (-0.1) every step, each item's reward on pickup (+1 by
+    default, 0 for iron), and the completion reward (+100) when the automaton accepts.
+
+    ## Starting State
+    Objects, then the agent, on distinct random free cells ("corner" places on the
+    top-left cell); empty inventory; the automaton in its initial state.
+
+    ## Episode End
+    Terminated when the automaton accepts (``info["is_success"]``) or falls into its
+    rejecting sink (``info["violation"]``: the objective can no longer be met; no
+    completion reward). Truncated at the spec's ``grid.max_steps`` (TimeLimit).
+
+    ## Info
+    ``labels`` (names of the true propositions), ``label_mask`` (their bitmask, bit i =
+    ``automaton.propositions[i]``), ``automaton_state`` (after the step),
+    ``automaton_transition`` ``(w, sigma, w')``, ``is_success``, ``violation``.
+
+    ## Registered Configurations
+    ``CraftSuite/<Task>-Grid<size>-v0`` for every spec in ``tasks/`` and each of its grid
+    sizes: BlindCraftsman, DungeonQuest, DiamondMine (7 and 10), BlindCraftsmanObstacles
+    (10). ``craftsuite tasks`` lists them.
+    """
+
+    metadata = {"render_modes": ["rgb_array", "ansi"], "render_fps": 8}
+
+    def __init__(self, task: str | TaskSpec = "BlindCraftsman", size: int = 7,
+                 render_mode: str | None = None):
+        self.task = resolve_task(task)
+        if not isinstance(size, int) or size < 2:
+            raise ValueError(f"size must be an integer >= 2, got {size!r}")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode {render_mode!r} is not supported; use one of {self.metadata['render_modes']}"
+            )
+        self.size = size
+        self.render_mode = render_mode
+        spec = self.task
+        self.automaton = spec.automaton
+        self.rules = Rules(spec)
+        self.labeller = Labeller(spec, self.automaton.propositions)
+        self._objects = spec.objects
+        self._obstacles = sorted({y * size + x for x, y in spec.grid.obstacles})
+        n_cells = size * size
+        free = n_cells - len(self._obstacles) - 1
+        n_objects = sum(o.count for o in self._objects)
+        if n_objects > free:
+            raise ValueError(f"{spec.name}: {n_objects} objects do not fit a {size}x{size} grid")
+        if any(not (0 <= x < size and 0 <= y < size) for x, y in spec.grid.obstacles):
+            raise ValueError(f"{spec.name}: obstacles {spec.grid.obstacles} lie outside a {size}x{size} grid")
+
+        self._n_channels = 2 + len(self._objects)
+        self._inv_offset = self._n_channels * n_cells
+        n_obs = self._inv_offset + len(self.rules.inventory_names)
+        self.observation_space = gym.spaces.Box(0.0, 1.0, (n_obs,), dtype=np.float32)
+        self.action_space = gym.spaces.Discrete(4)
+        self._inv_scale = self.rules.scale
+        self._step_reward = spec.step_reward
+        self._completion = spec.completion_reward
+        self._rows = self.automaton.delta.tolist()
+        self._accepting = self.automaton.accepting.tolist()
+        self._rejecting = self.automaton.rejecting.tolist()
+        self._label_names: dict[int, tuple[str, ...]] = {}
+        self._cells: list[int] = []
+        self._obs = np.zeros(n_obs, dtype=np.float32)
+        self._agent = 0
+        self.automaton_state = self.automaton.initial
+        self.inventory_counts = self.rules.new_inventory()
+
+    # -- public views --------------------------------------------------------------------------
+    @property
+    def observation_layout(self) -> dict:
+        """Where things are in the observation vector."""
+        return {
+            "planes": (self._n_channels, self.size, self.size),
+            "plane_names": ("agent", "obstacle") + tuple(o.name for o in self._objects),
+            "inventory": slice(self._inv_offset, self._inv_offset + len(self.inventory_counts)),
+            "inventory_names": self.rules.inventory_names,
+            "inventory_scale": tuple(self._inv_scale),
+        }
+
+    @property
+    def inventory(self) -> dict[str, int]:
+        return dict(zip(self.rules.inventory_names, self.inventory_counts))
+
+    @property
+    def agent_position(self) -> tuple[int, int]:
+        y, x = divmod(self._agent, self.size)
+        return x, y
+
+    def object_positions(self) -> dict[str, list[tuple[int, int]]]:
+        """Cells ``(x, y)`` of the objects still on the map, by object name."""
+        out: dict[str, list[tuple[int, int]]] = {o.name: [] for o in self._objects}
+        for cell, kind in enumerate(self._cells):
+            if kind >= 0:
+                y, x = divmod(cell, self.size)
+                out[self._objects[kind].name].append((x, y))
+        return out
+
+    # -- gymnasium API -----------------------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        n_cells = self.size * self.size
+        cells = [EMPTY] * n_cells
+        for c in self._obstacles:
+            cells[c] = WALL
+        corner = [k for k, o in enumerate(self._objects) if getattr(o, "placement", "") == "corner"]
+        for k in corner:
+            cells[0] = k
+        free = [c for c in range(n_cells) if cells[c] == EMPTY]
+        order = self.np_random.permutation(len(free)).tolist()
+        i = 0
+        for k, obj in enumerate(self._objects):
+            if k in corner:
+                continue
+            for _ in range(obj.count):
+                cells[free[order[i]]] = k
+                i += 1
+        self._agent = free[order[i]]
+        self._cells = cells
+
+        obs = self._obs
+        obs[:] = 0.0
+        obs[self._agent] = 1.0
+        for c in self._obstacles:
+            obs[n_cells + c] = 1.0
+        for c, k in enumerate(cells):
+            if k >= 0:
+                obs[(2 + k) * n_cells + c] = 1.0
+        self.inventory_counts = self.rules.new_inventory()
+        self._level_mask = self.labeller.levels(self.inventory_counts)
+        self.automaton_state = self.automaton.initial
+        w = self.automaton_state
+        info = {"labels": (), "label_mask": 0, "automaton_state": w,
+                "automaton_transition": None, "is_success": False, "violation": False}
+        return obs.copy(), info
+
+    def step(self, action):
+        try:
+            dx, dy = _MOVES[action]
+        except (KeyError, TypeError):
+            raise ValueError(
+                f"invalid action {action!r} for {self.task.name}: expected an integer in [0, 4) "
+                f"({', '.join(f'{i} {n}' for i, n in enumerate(ACTION_NAMES))})"
+            ) from None
+        if not self._cells:
+            raise RuntimeError("call reset() before step()")
+        size = self.size
+        y, x = divmod(self._agent, size)
+        nx, ny = x + dx, y + dy
+        moved = False
+        obs = self._obs
+        if 0 <= nx < size and 0 <= ny < size:
+            cell = ny * size + nx
+            if self._cells[cell] != WALL:
+                obs[self._agent] = 0.0
+                obs[cell] = 1.0
+                self._agent = cell
+                moved = True
+
+        reward = self._step_reward
+        mask = self._level_mask
+        kind = self._cells[self._agent]
+        if kind >= 0:
+            inv = self.inventory_counts
+            outcome = self.rules.touch(inv, kind, moved)
+            arrived = kind if moved and kind >= self.rules.n_items else -1
+            if outcome is not None:
+                reward += outcome.reward
+                if outcome.consumed:
+                    self._cells[self._agent] = EMPTY
+                    obs[(2 + kind) * size * size + self._agent] = 0.0
+                off, scale = self._inv_offset, self._inv_scale
+                for s, count in enumerate(inv):
+                    obs[off + s] = count / scale[s]
+                self._level_mask = self.labeller.levels(inv)
+                mask = self.labeller(inv, outcome.gained, arrived)
+            elif arrived >= 0:
+                mask = self.labeller(inv, 0, arrived)
+
+        w = self.automaton_state
+        w2 = self._rows[w][mask]
+        self.automaton_state = w2
+        success = self._accepting[w2]
+        violation = self._rejecting[w2]
+        if success:
+            reward += self._completion
+        labels = self._label_names.get(mask)
+        if labels is None:
+            labels = self._label_names[mask] = self.labeller.names(mask)
+        info = {"labels": labels, "label_mask": mask, "automaton_state": w2,
+                "automaton_transition": (w, mask, w2), "is_success": success,
+                "violation": violation}
+        return obs.copy(), reward, success or violation, False, info
+
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode= to make()")
+            return None
+        if not self._cells:
+            raise RuntimeError("call reset() before render()")
+        if self.render_mode == "ansi":
+            text = grid_text(self.size, self._cells, self._agent, self._objects)
+            held = ", ".join(f"{k} {v}" for k, v in self.inventory.items() if v) or "nothing"
+            return f"{text}\ninventory: {held}; automaton state {self.automaton_state}\n"
+        w = self.automaton_state
+        flag = "accepted" if self._accepting[w] else "violated" if self._rejecting[w] else ""
+        panel = {"inventory": self.inventory, "automaton_state": w,
+                 "n_states": self.automaton.n_states, "flag": flag}
+        return draw_grid(self.size, self._cells, self._agent, self._objects,
+                         self.rules.is_place, panel)

@@ -1,0 +1,452 @@
+"""Task specs: a task's objective, objects and rules as data (TOML files in ``tasks/``).
+
+A spec says everything a world needs and nothing about how a world looks: which items lie
+on the map and how many, which places act on arrival, which recipes turn inventory into
+other inventory, what each proposition of the LTLf objective means, the rewards, and the
+grid sizes. The grid and MuJoCo worlds both read the same spec; neither restates it.
+
+Format (see ``tasks/blind_craftsman.toml`` for a full example)::
+
+    name = "BlindCraftsman"          # CamelCase; ids are CraftSuite/<name>-Grid<size>-v0
+    formula = "G(wood -> F factory) & F(tools3 & home)"
+    extends = "other_spec"           # optional: start from tasks/other_spec.toml
+
+    [propositions]                   # bit order = order written here
+    wood = { obtained = "wood" }     # event: inventory count of wood went up this step
+    factory = { arrived = "factory" }# event: the agent entered a factory this step
+    tools3 = { at_least = { tools = 3 } }   # level: holding >= 3 tools
+    gold1 = { reached = { gold = 1 } }      # event: gold count went up to exactly 1
+
+    [items.wood]                     # picked up by stepping on it
+    count = 3                        # how many on the map
+    reward = 1.0                     # per pickup (default 1.0)
+    capacity = 2                     # carry at most this many (default: no limit)
+    requires = { pickaxe = 1 }       # cannot be picked up without (default: nothing)
+    excludes = ["gold"]              # cannot be picked up while holding any of these
+
+    [places.factory]                 # stays on the map, acts on arrival
+    count = 1
+    placement = "corner"             # "random" (default) or "corner" (top-left cell)
+
+    [[recipes]]                      # at = a place (on arrival) or omitted (anywhere,
+    at = "factory"                   # checked after every pickup)
+    consume = { wood = 1 }
+    produce = { tools = 1 }
+    repeat = true                    # apply as often as the inventory allows
+
+    [rewards]
+    step = -0.1
+    completion = 100.0
+
+    [grid]
+    sizes = [7, 10]
+    max_steps = 500
+    obstacles = [[3, 5], [3, 4]]     # impassable cells as [x, y]
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+from .automata import Automaton, LTLfSyntaxError, compile_ltlf, parse
+from .automata.ltlf import atoms
+from .paths import tasks_dir
+
+__all__ = [
+    "SpecError", "TaskSpec", "Item", "Place", "Recipe", "Proposition", "GridConfig",
+    "load_spec", "builtin_specs",
+]
+
+
+class SpecError(ValueError):
+    """A task spec that cannot be used; the message names the file, the field and the problem."""
+
+
+@dataclass(frozen=True)
+class Item:
+    name: str
+    count: int
+    reward: float = 1.0
+    capacity: int | None = None
+    requires: dict[str, int] = field(default_factory=dict)
+    excludes: tuple[str, ...] = ()
+    color: str = "#888888"
+    symbol: str = "?"
+
+
+@dataclass(frozen=True)
+class Place:
+    name: str
+    count: int = 1
+    placement: str = "random"
+    color: str = "#888888"
+    symbol: str = "?"
+
+
+@dataclass(frozen=True)
+class Recipe:
+    consume: dict[str, int]
+    produce: dict[str, int]
+    at: str | None = None
+    repeat: bool = False
+
+
+@dataclass(frozen=True)
+class Proposition:
+    """What makes one atomic proposition true after a step.
+
+    kind: ``obtained`` (event: ``subject``'s count went up), ``arrived`` (event: entered
+    a ``subject`` place), ``at_least`` (level: count of ``subject`` >= ``value``) or
+    ``reached`` (event: count of ``subject`` went up to exactly ``value``).
+    """
+
+    name: str
+    kind: str
+    subject: str
+    value: int = 0
+
+
+@dataclass(frozen=True)
+class GridConfig:
+    sizes: tuple[int, ...] = (7, 10)
+    max_steps: int = 500
+    obstacles: tuple[tuple[int, int], ...] = ()
+
+
+@dataclass(frozen=True)
+class TaskSpec:
+    name: str
+    formula: str
+    propositions: tuple[Proposition, ...]
+    items: tuple[Item, ...]
+    places: tuple[Place, ...]
+    recipes: tuple[Recipe, ...]
+    step_reward: float
+    completion_reward: float
+    grid: GridConfig
+    description: str = ""
+    path: Path | None = None
+
+    @property
+    def proposition_names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.propositions)
+
+    @property
+    def objects(self) -> tuple[Item | Place, ...]:
+        """Everything that is placed on the map, items first: index = object kind."""
+        return self.items + self.places
+
+    @property
+    def inventory(self) -> tuple[str, ...]:
+        """Inventory slots: every item, then everything recipes produce, in spec order."""
+        names = [i.name for i in self.items]
+        for r in self.recipes:
+            names += [n for n in r.produce if n not in names]
+        return tuple(names)
+
+    @cached_property
+    def automaton(self) -> Automaton:
+        return compile_ltlf(self.formula, self.proposition_names)
+
+
+# Readable defaults for objects a spec gives no colour; the paper's Figure 1c colours first.
+_PALETTE = ["#8b5a2b", "#d9822b", "#3d7dd8", "#7b4fb5", "#2ca58d", "#d64550", "#e0c341",
+            "#5c6b73", "#9bc53d", "#f28ab2"]
+_NAME = re.compile(r"[a-z_][a-z0-9_]*\Z")
+_TASK_NAME = re.compile(r"[A-Z][A-Za-z0-9]*\Z")
+_COLOR = re.compile(r"#[0-9a-fA-F]{6}\Z")
+_TOP_KEYS = {"name", "formula", "description", "extends", "propositions", "items", "places",
+             "recipes", "rewards", "grid"}
+
+
+class _Reader:
+    """Validating accessors that know where in which file they are."""
+
+    def __init__(self, path: Path | str):
+        self.path = path
+
+    def fail(self, where: str, problem: str):
+        raise SpecError(f"{self.path}: {where}: {problem}")
+
+    def table(self, data: Any, where: str) -> dict:
+        if not isinstance(data, dict):
+            self.fail(where, f"must be a table, got {type(data).__name__}")
+        return data
+
+    def keys(self, data: dict, allowed: set[str], where: str):
+        unknown = set(data) - allowed
+        if unknown:
+            self.fail(where, f"unknown key(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
+
+    def int(self, data: dict, key: str, where: str, default=None, minimum: int = 0) -> int:
+        value = data.get(key, default)
+        if value is None:
+            self.fail(f"{where}.{key}", "is required")
+        if not isinstance(value, int) or isinstance(value, bool):
+            self.fail(f"{where}.{key}", f"must be an integer, got {value!r}")
+        if value < minimum:
+            self.fail(f"{where}.{key}", f"must be >= {minimum}, got {value}")
+        return value
+
+    def float(self, data: dict, key: str, where: str, default: float) -> float:
+        value = data.get(key, default)
+        if not isinstance(value, (int, float)) or isinstance(value, bool) or value != value:
+            self.fail(f"{where}.{key}", f"must be a number, got {value!r}")
+        return float(value)
+
+    def str(self, data: dict, key: str, where: str, default=None) -> str:
+        value = data.get(key, default)
+        if not isinstance(value, str):
+            self.fail(f"{where}.{key}", f"must be a string, got {value!r}")
+        return value
+
+    def counts(self, data: Any, where: str, known: set[str]) -> dict[str, int]:
+        data = self.table(data, where)
+        for name, n in data.items():
+            if name not in known:
+                self.fail(where, f"unknown inventory name {name!r}; known: {sorted(known)}")
+            if not isinstance(n, int) or isinstance(n, bool) or n < 1:
+                self.fail(f"{where}.{name}", f"must be a positive integer, got {n!r}")
+        return dict(data)
+
+
+def _merge(base: dict, override: dict) -> dict:
+    out = dict(base)
+    for k, v in override.items():
+        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+def _read_toml(path: Path) -> dict:
+    if not path.is_file():
+        raise SpecError(f"{path}: no such task spec file")
+    try:
+        with path.open("rb") as f:
+            return tomllib.load(f)
+    except tomllib.TOMLDecodeError as err:
+        raise SpecError(f"{path}: not valid TOML: {err}") from None
+
+
+def _raw(path: Path, seen: tuple[Path, ...] = ()) -> dict:
+    data = _read_toml(path)
+    base = data.pop("extends", None)
+    if base is None:
+        return data
+    if not isinstance(base, str):
+        raise SpecError(f"{path}: extends: must be a spec file name, got {base!r}")
+    base_path = (path.parent / base).with_suffix(".toml")
+    if base_path.resolve() in seen:
+        raise SpecError(f"{path}: extends: {base!r} extends itself (cycle)")
+    return _merge(_raw(base_path, seen + (path.resolve(),)), data)
+
+
+def load_spec(source: str | Path | dict, *, name_hint: str = "<dict>") -> TaskSpec:
+    """Load and validate a task spec from a TOML file (or an already-parsed dict).
+
+    Raises:
+        SpecError: naming the file, the field and the problem.
+    """
+    if isinstance(source, dict):
+        path, data = name_hint, dict(source)
+    else:
+        path = Path(source)
+        data = _raw(path)
+    return _build(_Reader(path), data, path if isinstance(path, Path) else None)
+
+
+def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
+    r.keys(data, _TOP_KEYS, "top level")
+    name = r.str(data, "name", "top level")
+    if not _TASK_NAME.match(name):
+        r.fail("name", f"must be CamelCase letters and digits (e.g. 'BlindCraftsman'), got {name!r}")
+
+    palette = iter(_PALETTE * 4)
+    symbols: dict[str, str] = {}
+
+    def looks(table: dict, where: str, obj_name: str) -> tuple[str, str]:
+        color = r.str(table, "color", where, default=next(palette))
+        if not _COLOR.match(color):
+            r.fail(f"{where}.color", f"must look like '#rrggbb', got {color!r}")
+        symbol = r.str(table, "symbol", where, default=obj_name[0])
+        if len(symbol) != 1 or symbol in ".#@":
+            r.fail(f"{where}.symbol", f"must be one character other than '.', '#', '@', got {symbol!r}")
+        if symbol in symbols:
+            r.fail(f"{where}.symbol", f"{symbol!r} is already used by {symbols[symbol]!r}; set another")
+        symbols[symbol] = obj_name
+        return color, symbol
+
+    # Objects first (items, places), then inventory names, then what refers to them.
+    raw_items = r.table(data.get("items", {}), "items")
+    raw_places = r.table(data.get("places", {}), "places")
+    for obj in (*raw_items, *raw_places):
+        if not _NAME.match(obj):
+            r.fail(f"items/places.{obj}", "names must be lower-case identifiers")
+    both = set(raw_items) & set(raw_places)
+    if both:
+        r.fail("places", f"{sorted(both)} declared both as item and place")
+    if not raw_items and not raw_places:
+        r.fail("items", "a task needs at least one item or place")
+
+    raw_recipes = data.get("recipes", [])
+    if not isinstance(raw_recipes, list):
+        r.fail("recipes", "must be an array of tables ([[recipes]])")
+    produced = set()
+    for i, rec in enumerate(raw_recipes):
+        rec = r.table(rec, f"recipes[{i}]")
+        for n in r.table(rec.get("produce", {}), f"recipes[{i}].produce"):
+            if not _NAME.match(n):
+                r.fail(f"recipes[{i}].produce", f"{n!r} is not a lower-case identifier")
+            produced.add(n)
+    inventory = set(raw_items) | produced
+
+    items = []
+    for obj, table in raw_items.items():
+        where = f"items.{obj}"
+        table = r.table(table, where)
+        r.keys(table, {"count", "reward", "capacity", "requires", "excludes", "color", "symbol"}, where)
+        excludes = table.get("excludes", [])
+        if not isinstance(excludes, list) or any(e not in inventory for e in excludes):
+            r.fail(f"{where}.excludes", f"must list inventory names from {sorted(inventory)}, got {excludes!r}")
+        capacity = table.get("capacity")
+        if capacity is not None:
+            capacity = r.int(table, "capacity", where, minimum=1)
+        color, symbol = looks(table, where, obj)
+        items.append(Item(
+            name=obj,
+            count=r.int(table, "count", where),
+            reward=r.float(table, "reward", where, 1.0),
+            capacity=capacity,
+            requires=r.counts(table.get("requires", {}), f"{where}.requires", inventory),
+            excludes=tuple(excludes),
+            color=color, symbol=symbol,
+        ))
+
+    places = []
+    for obj, table in raw_places.items():
+        where = f"places.{obj}"
+        table = r.table(table, where)
+        r.keys(table, {"count", "placement", "color", "symbol"}, where)
+        placement = r.str(table, "placement", where, default="random")
+        if placement not in ("random", "corner"):
+            r.fail(f"{where}.placement", f"must be 'random' or 'corner', got {placement!r}")
+        count = r.int(table, "count", where, default=1)
+        if placement == "corner" and count != 1:
+            r.fail(f"{where}.count", "a place with placement 'corner' must have count 1")
+        color, symbol = looks(table, where, obj)
+        places.append(Place(name=obj, count=count, placement=placement, color=color, symbol=symbol))
+    corners = [p.name for p in places if p.placement == "corner"]
+    if len(corners) > 1:
+        r.fail("places", f"only one place can take the corner, got {corners}")
+
+    recipes = []
+    for i, rec in enumerate(raw_recipes):
+        where = f"recipes[{i}]"
+        r.keys(rec, {"at", "consume", "produce", "repeat"}, where)
+        at = rec.get("at")
+        if at is not None and at not in raw_places:
+            r.fail(f"{where}.at", f"unknown place {at!r}; places: {sorted(raw_places)}")
+        repeat = rec.get("repeat", False)
+        if not isinstance(repeat, bool):
+            r.fail(f"{where}.repeat", f"must be true or false, got {repeat!r}")
+        consume = r.counts(rec.get("consume", {}), f"{where}.consume", inventory)
+        produce = r.counts(rec.get("produce", {}), f"{where}.produce", inventory)
+        if not consume or not produce:
+            r.fail(where, "a recipe needs both 'consume' and 'produce'")
+        recipes.append(Recipe(consume=consume, produce=produce, at=at, repeat=repeat))
+
+    if "propositions" not in data:
+        r.fail("propositions", "is required")
+    raw_props = r.table(data["propositions"], "propositions")
+    props = []
+    for prop, table in raw_props.items():
+        where = f"propositions.{prop}"
+        if not _NAME.match(prop):
+            r.fail(where, "proposition names must be lower-case identifiers (e.g. 'tools3', 'gold_1')")
+        table = r.table(table, where)
+        if len(table) != 1:
+            r.fail(where, "needs exactly one of 'obtained', 'arrived', 'at_least', 'reached'")
+        (kind, arg), = table.items()
+        if kind == "obtained":
+            if arg not in inventory:
+                r.fail(f"{where}.obtained", f"unknown inventory name {arg!r}; known: {sorted(inventory)}")
+            props.append(Proposition(prop, kind, arg))
+        elif kind == "arrived":
+            if arg not in raw_places:
+                r.fail(f"{where}.arrived", f"unknown place {arg!r}; places: {sorted(raw_places)}")
+            props.append(Proposition(prop, kind, arg))
+        elif kind in ("at_least", "reached"):
+            counts = r.counts(arg, f"{where}.{kind}", inventory)
+            if len(counts) != 1:
+                r.fail(f"{where}.{kind}", "must name exactly one inventory count, e.g. { tools = 3 }")
+            (subject, value), = counts.items()
+            props.append(Proposition(prop, kind, subject, value))
+        else:
+            r.fail(where, f"unknown kind {kind!r}; use 'obtained', 'arrived', 'at_least' or 'reached'")
+
+    formula = r.str(data, "formula", "top level")
+    try:
+        ast = parse(formula)
+    except LTLfSyntaxError as err:
+        r.fail("formula", str(err))
+    unknown = atoms(ast) - {p.name for p in props}
+    if unknown:
+        r.fail("formula", f"uses unknown proposition(s) {sorted(unknown)}; declared in "
+                          f"[propositions]: {[p.name for p in props]}")
+
+    rewards = r.table(data.get("rewards", {}), "rewards")
+    r.keys(rewards, {"step", "completion"}, "rewards")
+
+    raw_grid = r.table(data.get("grid", {}), "grid")
+    r.keys(raw_grid, {"sizes", "max_steps", "obstacles"}, "grid")
+    sizes = raw_grid.get("sizes", [7, 10])
+    if not isinstance(sizes, list) or not sizes or any(
+            not isinstance(s, int) or isinstance(s, bool) or s < 2 for s in sizes):
+        r.fail("grid.sizes", f"must be a list of integers >= 2, got {sizes!r}")
+    obstacles = raw_grid.get("obstacles", [])
+    if not isinstance(obstacles, list) or any(
+            not (isinstance(c, list) and len(c) == 2 and all(isinstance(v, int) for v in c))
+            for c in obstacles):
+        r.fail("grid.obstacles", f"must be a list of [x, y] cells, got {obstacles!r}")
+    grid = GridConfig(
+        sizes=tuple(sizes),
+        max_steps=r.int(raw_grid, "max_steps", "grid", default=500, minimum=1),
+        obstacles=tuple(tuple(c) for c in obstacles),
+    )
+    n_objects = sum(i.count for i in items) + sum(p.count for p in places)
+    for size in grid.sizes:
+        outside = [c for c in grid.obstacles if not (0 <= c[0] < size and 0 <= c[1] < size)]
+        if outside:
+            r.fail("grid.obstacles", f"cells {outside} lie outside the {size}x{size} grid")
+        free = size * size - len(set(grid.obstacles)) - 1  # one cell for the agent
+        if n_objects > free:
+            r.fail("grid.sizes", f"{n_objects} objects do not fit a {size}x{size} grid "
+                                 f"({free} free cells besides the agent)")
+        if corners and (0, 0) in set(grid.obstacles):
+            r.fail("grid.obstacles", "the corner cell (0, 0) is taken by a 'corner' place")
+
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        r.fail("description", "must be a string")
+    return TaskSpec(
+        name=name, formula=formula, propositions=tuple(props), items=tuple(items),
+        places=tuple(places), recipes=tuple(recipes),
+        step_reward=r.float(rewards, "step", "rewards", -0.1),
+        completion_reward=r.float(rewards, "completion", "rewards", 100.0),
+        grid=grid, description=description.strip(), path=path,
+    )
+
+
+def builtin_specs() -> dict[str, TaskSpec]:
+    """Every spec shipped in ``tasks/``, by task name."""
+    specs = {}
+    for file in sorted(tasks_dir().glob("*.toml")):
+        spec = load_spec(file)
+        if spec.name in specs:
+            raise SpecError(f"{file}: name: {spec.name!r} is also the name of {specs[spec.name].path}")
+        specs[spec.name] = spec
+    return specs

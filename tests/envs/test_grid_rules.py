@@ -1,0 +1,203 @@
+"""Rules and labelling through scripted play on the grid worlds."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import craftsuite
+from craftsuite.labelling import Labeller
+from craftsuite.rules import Rules
+from craftsuite.scripted import GridScriptedPolicy, run_episode
+from craftsuite.spec import builtin_specs
+
+IDS = craftsuite.registered_ids()
+
+
+def kind_of(env, name):
+    return [o.name for o in env.unwrapped.task.objects].index(name)
+
+
+def visit(env, policy, name, max_steps=300):
+    """Walk to the nearest object called ``name``; return the step results on the way."""
+    kind = kind_of(env, name)
+    steps = []
+    start = env.unwrapped._cells.count(kind)
+    for _ in range(max_steps):
+        result = env.step(policy.toward(kind))
+        steps.append(result)
+        info = result[4]
+        here = env.unwrapped._cells[env.unwrapped._agent]
+        touched = env.unwrapped._cells.count(kind) < start or (
+            here == kind and env.unwrapped.rules.is_place(kind))
+        if touched or result[2] or result[3]:
+            return steps, info
+    raise AssertionError(f"did not reach {name}")
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_scripted_policy_completes_every_task(env_id):
+    env = gym.make(env_id)
+    policy = GridScriptedPolicy(env)
+    for seed in range(10):
+        total, steps, info = run_episode(env, policy, seed=seed)
+        assert info["is_success"], (seed, steps)
+        a = env.unwrapped.automaton
+        assert a.accepting[info["automaton_state"]]
+        assert total > 100 + env.unwrapped.task.step_reward * steps  # +100 earned, items on top
+
+
+def test_completion_reward_exactly_on_the_accepting_step():
+    env = gym.make("CraftSuite/BlindCraftsman-Grid7-v0")
+    policy = GridScriptedPolicy(env)
+    env.reset(seed=4)
+    while True:
+        obs, reward, term, trunc, info = env.step(policy())
+        if term:
+            break
+        assert reward < 50
+    assert info["is_success"] and reward == pytest.approx(100 - 0.1)
+    assert "home" in info["labels"] and "tools3" in info["labels"]
+
+
+def test_blind_craftsman_capacity_and_factory():
+    env = gym.make("CraftSuite/BlindCraftsman-Grid10-v0")
+    env.reset(seed=0)
+    policy = GridScriptedPolicy(env)
+    u = env.unwrapped
+    _, info = visit(env, policy, "wood")
+    assert u.inventory["wood"] == 1 and info["labels"] == ("wood",)
+    visit(env, policy, "wood")
+    assert u.inventory["wood"] == 2
+    # a full agent cannot pick up the third wood: it stays on the map
+    kind = kind_of(env, "wood")
+    third = u._cells.index(kind)
+    u._agent = third + 1 if third % u.size < u.size - 1 else third - 1
+    if u._cells[u._agent] >= 0:
+        pytest.skip("neighbour cell is occupied in this layout")
+    env.step(3 if u._agent > third else 1)
+    assert u._agent == third and u.inventory["wood"] == 2 and u._cells[third] == kind
+    steps, info = visit(env, policy, "factory")
+    assert u.inventory == {"wood": 0, "tools": 2}
+    assert "factory" in info["labels"]
+    obs = steps[-1][0]
+    layout = u.observation_layout
+    tools = layout["inventory_names"].index("tools")
+    assert obs[layout["inventory"]][tools] == pytest.approx(2 / layout["inventory_scale"][tools])
+
+
+def test_diamond_mine_wood_then_gold_is_a_violation():
+    env = gym.make("CraftSuite/DiamondMine-Grid10-v0")
+    env.reset(seed=2)
+    policy = GridScriptedPolicy(env)
+    visit(env, policy, "wood")
+    steps, info = visit(env, policy, "gold")
+    obs, reward, term, trunc, info = steps[-1]
+    assert term and info["violation"] and not info["is_success"]
+    assert env.unwrapped.automaton.rejecting[info["automaton_state"]]
+    assert reward < 50  # no completion reward
+
+
+@pytest.mark.parametrize("size", [7, 10])
+def test_diamond_mine_diamond_route(size):
+    """Wood and all 30 iron craft a pickaxe; the diamond then counts; home completes."""
+    env = gym.make(f"CraftSuite/DiamondMine-Grid{size}-v0")
+    env.reset(seed=1)
+    policy = GridScriptedPolicy(env)
+    u = env.unwrapped
+    visit(env, policy, "wood")
+    while u._cells.count(kind_of(env, "iron")):
+        visit(env, policy, "iron")
+    assert u.inventory["pickaxe"] == 1 and u.inventory["wood"] == 0
+    _, info = visit(env, policy, "diamond")
+    assert "diamond" in info["labels"]
+    steps, info = visit(env, policy, "home")
+    assert info["is_success"] and steps[-1][1] == pytest.approx(100 - 0.1)
+
+
+def test_diamond_needs_the_pickaxe():
+    rules = Rules(builtin_specs()["DiamondMine"])
+    inv = rules.new_inventory()
+    diamond = [o.name for o in rules.spec.objects].index("diamond")
+    assert rules.touch(inv, diamond, arrived=True) is None
+    inv[rules.inventory_names.index("pickaxe")] = 1
+    assert rules.touch(inv, diamond, arrived=True).consumed
+    gold = [o.name for o in rules.spec.objects].index("gold")
+    assert rules.touch(inv, gold, arrived=True) is None  # excluded after the diamond
+
+
+def test_dungeon_quest_unarmed_dragon_is_a_violation():
+    env = gym.make("CraftSuite/DungeonQuest-Grid10-v0")
+    env.reset(seed=0)
+    policy = GridScriptedPolicy(env)
+    steps, info = visit(env, policy, "dragon")
+    assert steps[-1][2] and info["violation"] and info["labels"] == ("dragon",)
+
+
+def test_dungeon_quest_chest_turns_key_into_sword():
+    env = gym.make("CraftSuite/DungeonQuest-Grid7-v0")
+    env.reset(seed=0)
+    policy = GridScriptedPolicy(env)
+    visit(env, policy, "chest")
+    assert env.unwrapped.inventory["sword"] == 0  # no key, nothing happens
+    visit(env, policy, "key")
+    _, info = visit(env, policy, "chest")
+    assert env.unwrapped.inventory == {"key": 0, "shield": 0, "sword": 1}
+    assert info["labels"] == ("sword",)
+
+
+def test_labeller_events_and_levels():
+    spec = builtin_specs()["DiamondMine"]
+    lab = Labeller(spec)
+    rules = Rules(spec)
+    inv = rules.new_inventory()
+    gold = rules.inventory_names.index("gold")
+    inv[gold] = 3
+    assert lab.names(lab(inv, gained=1 << gold)) == ("gold3",)
+    assert lab(inv, gained=0) == 0  # 'reached' is an event, not a level
+    bc = builtin_specs()["BlindCraftsman"]
+    lab = Labeller(bc)
+    inv = [0, 3]
+    assert lab.names(lab(inv)) == ("tools3",)  # 'at_least' is a level
+    home = [o.name for o in bc.objects].index("home")
+    assert lab.names(lab(inv, arrived=home)) == ("tools3", "home")
+
+
+@pytest.mark.parametrize("action", [4, -1, 1.5, "up", None, np.array([1]), float("nan")])
+def test_bad_actions_are_named(action):
+    env = gym.make("CraftSuite/BlindCraftsman-Grid7-v0", disable_env_checker=True)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="invalid action .* expected an integer in \\[0, 4\\)"):
+        env.step(action)
+
+
+def test_numpy_integer_actions_work():
+    env = gym.make("CraftSuite/BlindCraftsman-Grid7-v0")
+    env.reset(seed=0)
+    env.step(np.int64(1))
+
+
+def test_step_before_reset():
+    env = craftsuite.make_grid("BlindCraftsman", 7)
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step(0)
+
+
+def test_bad_ids_and_tasks():
+    with pytest.raises(gym.error.NameNotFound):
+        gym.make("CraftSuite/BlindCraftsmen-Grid7-v0")
+    with pytest.raises(KeyError, match="unknown task 'Nope'.*BlindCraftsman"):
+        craftsuite.make_grid("Nope", 7)
+    with pytest.raises(ValueError, match="render_mode 'human'"):
+        craftsuite.make_grid("BlindCraftsman", 7, render_mode="human")
+
+
+def test_module_prefix_without_import(tmp_path):
+    import subprocess
+    import sys
+    code = ("import gymnasium as gym; e = gym.make('craftsuite:CraftSuite/DungeonQuest-Grid7-v0'); "
+            "print(e.reset(seed=0)[0].shape)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip().startswith("(")

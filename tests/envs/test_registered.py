@@ -1,0 +1,135 @@
+"""Every registered CraftSuite id, checked the way Minigrid checks its envs."""
+
+from __future__ import annotations
+
+import pickle
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env as gym_check_env
+from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+import craftsuite
+
+IDS = craftsuite.registered_ids()
+
+
+def rollout(env, seed, n=60, action_seed=0):
+    obs, info = env.reset(seed=seed)
+    actions = np.random.default_rng(action_seed).integers(0, env.action_space.n, n)
+    trace = [(obs, None, info["automaton_state"])]
+    for a in actions:
+        obs, r, term, trunc, info = env.step(int(a))
+        trace.append((obs, r, info["automaton_transition"]))
+        if term or trunc:
+            obs, info = env.reset()
+            trace.append((obs, None, info["automaton_state"]))
+    return trace
+
+
+def same(a, b):
+    return len(a) == len(b) and all(
+        np.array_equal(x[0], y[0]) and x[1] == y[1] and x[2] == y[2] for x, y in zip(a, b))
+
+
+def test_ids_cover_the_paper_tasks():
+    expected = {f"CraftSuite/{t}-Grid{s}-v0" for t in ("BlindCraftsman", "DungeonQuest", "DiamondMine")
+                for s in (7, 10)} | {"CraftSuite/BlindCraftsmanObstacles-Grid10-v0"}
+    assert expected <= set(IDS)
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_gymnasium_check_env(env_id):
+    env = gym.make(env_id, disable_env_checker=True).unwrapped
+    gym_check_env(env, skip_render_check=False)
+    product = gym.make(env_id, product=True, disable_env_checker=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # check_env notes that the env is wrapped
+        gym_check_env(product)
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_sb3_check_env(env_id):
+    for product in (False, True):
+        sb3_check_env(gym.make(env_id, product=product), warn=True)
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_same_seed_same_rollout(env_id):
+    a = rollout(gym.make(env_id, product=True), seed=123)
+    b = rollout(gym.make(env_id, product=True), seed=123)
+    assert same(a, b)
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_different_seeds_different_layouts(env_id):
+    env = gym.make(env_id)
+    layouts = set()
+    for seed in range(5):
+        env.reset(seed=seed)
+        layouts.add((env.unwrapped.agent_position, repr(env.unwrapped.object_positions())))
+    assert len(layouts) == 5
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_render_modes(env_id):
+    env = gym.make(env_id, render_mode="rgb_array")
+    env.reset(seed=0)
+    frame = env.render()
+    size = env.unwrapped.size
+    assert frame.dtype == np.uint8 and frame.ndim == 3 and frame.shape[1] == size * 32
+    assert len(np.unique(frame.reshape(-1, 3), axis=0)) > 5  # not blank
+    text = gym.make(env_id, render_mode="ansi")
+    text.reset(seed=0)
+    out = text.render()
+    assert out.count("@") == 1 and len(out.splitlines()) == size + 1
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_pickling_mid_episode(env_id):
+    env = gym.make(env_id, product=True)
+    rollout(env, seed=5, n=7)
+    clone = pickle.loads(pickle.dumps(env))
+    actions = np.random.default_rng(9).integers(0, 4, 30).tolist()
+    for a in actions:
+        x, y = env.step(a), clone.step(a)
+        assert np.array_equal(x[0], y[0]) and x[1:4] == y[1:4]
+        if x[2] or x[3]:
+            break
+
+
+@pytest.mark.parametrize("env_id", IDS)
+@pytest.mark.parametrize("mode", ["sync", "async"])
+def test_make_vec(env_id, mode):
+    envs = gym.make_vec(env_id, num_envs=2, vectorization_mode=mode, product=True)
+    try:
+        obs, infos = envs.reset(seed=[1, 2])
+        assert obs.shape == (2,) + envs.single_observation_space.shape
+        assert not np.array_equal(obs[0], obs[1])
+        for _ in range(20):
+            obs, rewards, term, trunc, infos = envs.step(envs.action_space.sample())
+        assert rewards.shape == (2,)
+        assert "automaton_state" in infos
+    finally:
+        envs.close()
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_product_observation_tail_is_automaton_one_hot(env_id):
+    env = gym.make(env_id, product=True)
+    n = env.unwrapped.automaton.n_states
+    base = env.unwrapped.observation_space.shape[0]
+    assert env.observation_space.shape == (base + n,)
+    obs, info = env.reset(seed=3)
+    assert obs[base:].argmax() == info["automaton_state"] and obs[base:].sum() == 1
+    prev = info["automaton_state"]
+    for a in np.random.default_rng(0).integers(0, 4, 100).tolist():
+        obs, r, term, trunc, info = env.step(a)
+        w, sigma, w2 = info["automaton_transition"]
+        assert w == prev and w2 == info["automaton_state"] == obs[base:].argmax()
+        assert w2 == env.unwrapped.automaton.step(w, sigma)
+        prev = w2
+        if term or trunc:
+            break

@@ -1,0 +1,119 @@
+"""Task specs: the built-in ones load; bad ones fail at load time naming file, field, problem."""
+
+from __future__ import annotations
+
+import re
+import textwrap
+
+import gymnasium as gym
+import pytest
+
+import craftsuite
+from craftsuite.spec import SpecError, builtin_specs, load_spec
+
+GOOD = """
+name = "Treasure"
+formula = "F(coin) & G(!trap)"
+
+[propositions]
+coin = { obtained = "coin" }
+trap = { arrived = "trap" }
+
+[items.coin]
+count = 2
+
+[places.trap]
+count = 1
+
+[grid]
+sizes = [5]
+max_steps = 50
+"""
+
+
+def write(tmp_path, text, name="treasure.toml"):
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def test_builtin_specs():
+    specs = builtin_specs()
+    assert set(specs) == {"BlindCraftsman", "BlindCraftsmanObstacles", "DungeonQuest", "DiamondMine"}
+    bc = specs["BlindCraftsman"]
+    assert bc.proposition_names == ("wood", "factory", "tools3", "home")
+    assert bc.inventory == ("wood", "tools")
+    assert bc.items[0].capacity == 2
+    dm = specs["DiamondMine"]
+    assert len(dm.propositions) == 13
+    assert {i.name: i.count for i in dm.items}["iron"] == 30
+    assert {i.name: i.reward for i in dm.items}["iron"] == 0.0
+
+
+def test_extends_merges_the_base_spec():
+    specs = builtin_specs()
+    obstacles, base = specs["BlindCraftsmanObstacles"], specs["BlindCraftsman"]
+    assert obstacles.formula == base.formula and obstacles.items == base.items
+    assert obstacles.grid.sizes == (10,)
+    assert (3, 5) in obstacles.grid.obstacles
+    assert obstacles.grid.max_steps == base.grid.max_steps
+
+
+def test_good_spec_loads(tmp_path):
+    spec = load_spec(write(tmp_path, GOOD))
+    assert spec.name == "Treasure" and spec.automaton.n_states >= 2
+
+
+BAD = [
+    # (edit to GOOD, field named, problem named)
+    (('F(coin) & G(!trap)', 'F(coin) & G(!lava)'), "formula", "unknown proposition(s) ['lava']"),
+    (('F(coin) & G(!trap)', 'F(coin & '), "formula", "expected"),
+    (('coin = { obtained = "coin" }', 'coin = { obtained = "gem" }'), "propositions.coin.obtained", "unknown inventory name 'gem'"),
+    (('trap = { arrived = "trap" }', 'trap = { arrived = "coin" }'), "propositions.trap.arrived", "unknown place 'coin'"),
+    (('trap = { arrived = "trap" }', 'trap = { smells = "trap" }'), "propositions.trap", "unknown kind 'smells'"),
+    (("count = 2", "count = -2"), "items.coin.count", "must be >= 0"),
+    (("count = 2", "count = 30"), "grid.sizes", "do not fit a 5x5 grid"),
+    (("count = 2", "count = 2\nrequires = { gem = 1 }"), "items.coin.requires", "unknown inventory name 'gem'"),
+    (("count = 2", "count = 2\nwings = 3"), "items.coin", "unknown key(s) ['wings']"),
+    (('name = "Treasure"', 'name = "treasure hunt"'), "name", "CamelCase"),
+    (("max_steps = 50", "max_steps = 50\nobstacles = [[9, 9]]"), "grid.obstacles", "outside the 5x5 grid"),
+    (("[places.trap]", "[places.trap]\nplacement = \"middle\""), "places.trap.placement", "'random' or 'corner'"),
+]
+
+
+@pytest.mark.parametrize("edit, field, problem", BAD, ids=[b[1] + ":" + b[2][:20] for b in BAD])
+def test_bad_spec_names_file_field_and_problem(tmp_path, edit, field, problem):
+    old, new = edit
+    assert old in GOOD
+    path = write(tmp_path, GOOD.replace(old, new, 1))
+    with pytest.raises(SpecError) as err:
+        load_spec(path)
+    message = str(err.value)
+    assert message.startswith(str(path)), message
+    assert f": {field}:" in message, message
+    assert problem in message, message
+
+
+def test_bad_toml_and_missing_file(tmp_path):
+    with pytest.raises(SpecError, match=re.escape("not valid TOML")):
+        load_spec(write(tmp_path, "name = \n"))
+    with pytest.raises(SpecError, match="no such task spec file"):
+        load_spec(tmp_path / "nope.toml")
+
+
+def test_extends_cycle(tmp_path):
+    write(tmp_path, 'extends = "b"\nname = "A"', "a.toml")
+    write(tmp_path, 'extends = "a"\nname = "B"', "b.toml")
+    with pytest.raises(SpecError, match="cycle"):
+        load_spec(tmp_path / "a.toml")
+
+
+def test_user_spec_registers_and_runs(tmp_path):
+    ids = craftsuite.register_task(write(tmp_path, GOOD))
+    assert ids == ["CraftSuite/Treasure-Grid5-v0"]
+    env = gym.make(ids[0], product=True)
+    obs, info = env.reset(seed=1)
+    assert obs.shape == env.observation_space.shape
+    assert env.unwrapped.automaton.propositions == ("coin", "trap")
+    assert env.spec.max_episode_steps == 50
+    env.close()

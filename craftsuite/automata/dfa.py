@@ -101,9 +101,16 @@ class Automaton:
         return bool(self.accepting[self.run(masks)])
 
     # -- reading ---------------------------------------------------------------------------
-    def guard(self, source: int, target: int) -> str:
-        """A short Boolean expression over the propositions for the labels from -> to."""
-        return boolean_cover(self.delta[source] == target, self.propositions)
+    def guard(self, source: int, target: int, sink_free: bool = False) -> str:
+        """A short Boolean expression over the propositions for the labels from -> to.
+
+        ``sink_free``: treat labels that lead to the rejecting sink as don't-cares, which
+        shortens guards a lot; right where the sink is not shown (any label on no edge
+        leads there).
+        """
+        row = self.delta[source]
+        dont_care = self.rejecting[row] if sink_free and not self.rejecting[target] else None
+        return boolean_cover(row == target, self.propositions, dont_care)
 
     def describe(self) -> str:
         """A text table of states and guarded transitions."""
@@ -155,15 +162,17 @@ def minimize(delta: np.ndarray, accepting: np.ndarray, initial: int = 0):
     return new_id[small[order]].astype(dtype), small_accepting[order].copy()
 
 
-def boolean_cover(onset: np.ndarray, names) -> str:
+def boolean_cover(onset: np.ndarray, names, dont_care: np.ndarray | None = None) -> str:
     """A small sum-of-products for a Boolean function given as its truth table.
 
-    ``onset[mask]`` is the function on the assignment whose bit i is ``names[i]``. Cubes
-    come from a decision-tree split, are expanded to primes greedily and redundant ones
-    dropped (the EXPAND and IRREDUNDANT steps of Espresso): short, readable guards.
+    ``onset[mask]`` is the function on the assignment whose bit i is ``names[i]``;
+    ``dont_care[mask]`` marks assignments the expression may cover or not. Cubes come from
+    a decision-tree split, are expanded to primes greedily and redundant ones dropped (the
+    EXPAND and IRREDUNDANT steps of Espresso): short, readable guards.
     """
     n = len(names)
-    if onset.all():
+    allowed = onset if dont_care is None else onset | dont_care
+    if allowed.all():
         return "true"
     if not onset.any():
         return "false"
@@ -172,17 +181,16 @@ def boolean_cover(onset: np.ndarray, names) -> str:
 
     def split(care: int, value: int, var: int):
         inside = (masks & care) == value
-        sel = onset[inside]
-        if not sel.any():
+        if not onset[inside].any():
             return
-        if sel.all():
+        if allowed[inside].all():
             cubes.append((care, value))
             return
         while var < n:
             bit = 1 << var
-            lo = onset[inside & (masks & bit == 0)]
-            hi = onset[inside & (masks & bit != 0)]
-            if not np.array_equal(lo, hi):
+            lo = inside & (masks & bit == 0)
+            hi = inside & (masks & bit != 0)
+            if not (np.array_equal(onset[lo], onset[hi]) and np.array_equal(allowed[lo], allowed[hi])):
                 split(care | bit, value, var + 1)
                 split(care | bit, value | bit, var + 1)
                 return
@@ -191,7 +199,7 @@ def boolean_cover(onset: np.ndarray, names) -> str:
     split(0, 0, 0)
 
     def covered(care, value):
-        return onset[(masks & care) == value].all()
+        return allowed[(masks & care) == value].all()
 
     primes = []
     for care, value in cubes:
@@ -205,7 +213,7 @@ def boolean_cover(onset: np.ndarray, names) -> str:
     kept = list(primes)
     for cube in sorted(primes, key=lambda c: -bin(c[0]).count("1")):
         rest = [c for c in kept if c != cube]
-        if rest and _union(rest, masks)[(masks & cube[0]) == cube[1]].all():
+        if rest and _union(rest, masks)[((masks & cube[0]) == cube[1]) & onset].all():
             kept = rest
 
     def text(care, value):

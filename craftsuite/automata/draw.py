@@ -37,6 +37,9 @@ def to_dot(
         '  node [shape=circle, fontname="Helvetica", style=filled, fillcolor="#eef3fb"];',
         '  edge [fontname="Helvetica", fontsize=10];',
     ]
+    if not show_sink and automaton.rejecting.any():
+        note = "labels on no edge lead to the rejecting sink (not drawn)"
+        title = f"{title}\n{note}" if title else note
     if title:
         lines.append(f"  labelloc=t; label={_quote(title)};")
     lines.append('  start [shape=point, width=0.08, label=""];')
@@ -51,7 +54,7 @@ def to_dot(
         lines.append(f"  q{s} [{', '.join(attrs)}];")
     lines.append(f"  start -> q{automaton.initial};")
     for s, t in automaton.edges(include_sink=show_sink):
-        label = automaton.guard(s, t)
+        label = automaton.guard(s, t, sink_free=not show_sink)
         if (s, t) in edge_notes:
             label += f"\n{edge_notes[(s, t)]}"
         style = ", style=dotted" if (s, t) in dotted else ""

@@ -195,14 +195,21 @@ def test_precedence_matches_flloat():
     )
 
 
-def test_guards_partition_the_labels():
-    spec = builtin_specs()["DungeonQuest"]
-    a = spec.automaton
+@pytest.mark.parametrize("task", ["DungeonQuest", "DiamondMine"])
+@pytest.mark.parametrize("sink_free", [False, True])
+def test_guards_are_exact(task, sink_free):
+    """A guard holds on exactly the labels of its edge (sink_free: labels to the sink are free)."""
+    a = builtin_specs()[task].automaton
     names = a.propositions
+    masks = np.arange(1 << len(names))
+    bits = {p: (masks >> i & 1).astype(bool) for i, p in enumerate(names)}
     for s in range(a.n_states):
-        for t in np.unique(a.delta[s]):
-            guard = a.guard(s, int(t))
-            expr = guard.replace("!", " not ").replace("&", " and ").replace("|", " or ")
-            for m in range(1 << len(names)):
-                env = {p: bool(m >> i & 1) for i, p in enumerate(names)} | {"true": True, "false": False}
-                assert eval(expr, {}, env) == (a.delta[s, m] == t), (s, t, guard, m)
+        for t in np.unique(a.delta[s]).tolist():
+            guard = a.guard(s, t, sink_free=sink_free)
+            expr = guard.replace("!", " ~").replace("true", "ALL")
+            value = eval(expr, {"ALL": np.ones(len(masks), bool)}, bits)
+            to_t = a.delta[s] == t
+            free = a.rejecting[a.delta[s]] if sink_free and not a.rejecting[t] else np.zeros_like(to_t)
+            assert (value[to_t]).all() and not (value & ~to_t & ~free).any(), (s, t, guard)
+    if task == "DiamondMine":
+        assert a.guard(0, int(a.delta[0, a.mask(["gold1"])]), sink_free=True) == "gold1"

@@ -3,10 +3,14 @@
 Importing the package registers the gymnasium ids ``CraftSuite/<Task>-Grid<size>-v0``.
 """
 
-from .automata import Automaton, compile_ltlf
-from .registration import make_grid, register_builtin, register_task, registered_ids, tasks
-from .spec import SpecError, TaskSpec, load_spec
-from .wrappers import AutomatonObservation
+from .rendering.gl import configure_gl
+
+configure_gl()  # before anything imports mujoco
+
+from .automata import Automaton, compile_ltlf  # noqa: E402
+from .registration import make_grid, register_builtin, register_task, registered_ids, tasks  # noqa: E402
+from .spec import SpecError, TaskSpec, load_spec  # noqa: E402
+from .wrappers import AutomatonObservation  # noqa: E402
 
 __version__ = "0.1.0"
 __all__ = [

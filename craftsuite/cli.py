@@ -89,6 +89,34 @@ def _demo(args) -> int:
     return 0
 
 
+def _video(args) -> int:
+    import gymnasium as gym
+    from tqdm import tqdm
+
+    from . import registration  # noqa: F401  (registers the ids)
+    from .policies import load_policy
+    from .rendering.video import VideoWriter
+
+    env = gym.make(args.env_id, render_mode="rgb_array", product=args.product)
+    policy = load_policy(args.policy, env, seed=args.seed)
+    fps = args.fps or env.metadata.get("render_fps", 20)
+    successes = 0
+    with VideoWriter(args.out, fps) as video:
+        for episode in tqdm(range(args.episodes), desc=f"{args.env_id} ({args.policy})", unit="episode"):
+            obs, _ = env.reset(seed=args.seed + episode)
+            video.write(env.render())
+            done = False
+            while not done:
+                obs, _, term, trunc, info = env.step(policy(obs))
+                video.write(env.render())
+                done = term or trunc
+            successes += bool(info["is_success"])
+    env.close()
+    print(f"wrote {args.out}: {video.frames} frames at {fps} fps ({video.codec}); "
+          f"{successes}/{args.episodes} episodes completed the objective")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="craftsuite", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -109,7 +137,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--episodes", type=int, default=20, help="episodes per id (default: 20)")
     p.add_argument("--seed", type=int, default=0, help="first seed (default: 0)")
     p.set_defaults(run=_demo)
+
+    p = sub.add_parser("video", help="record rollouts of a policy as an MP4 (grid and MuJoCo ids)")
+    p.add_argument("env_id", help="a registered id, e.g. CraftSuite/BlindCraftsman-Cont-v0")
+    p.add_argument("--policy", default="scripted",
+                   help="'random', 'scripted' (default) or a stable-baselines3 checkpoint (.zip)")
+    p.add_argument("--episodes", type=int, default=1, help="episodes to record (default: 1)")
+    p.add_argument("--out", default="rollout.mp4", help="output .mp4 (default: rollout.mp4)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the first episode (default: 0)")
+    p.add_argument("--fps", type=float, help="frames per second (default: the env's render_fps)")
+    p.add_argument("--product", action="store_true",
+                   help="make the env with product=True (for checkpoints trained on the product MDP)")
+    p.set_defaults(run=_video)
     return parser
+
+
+def gym_error():
+    import gymnasium as gym
+
+    return gym.error.Error
 
 
 def main(argv=None) -> int:
@@ -118,7 +164,7 @@ def main(argv=None) -> int:
         return args.run(args)
     except BrokenPipeError:  # output piped into `head` and the like
         return 0
-    except (KeyError, ValueError, RuntimeError, FileNotFoundError) as err:
+    except (KeyError, ValueError, RuntimeError, FileNotFoundError, gym_error()) as err:
         print(f"craftsuite {args.command}: error: {err.args[0] if isinstance(err, KeyError) else err}",
               file=sys.stderr)
         return 2

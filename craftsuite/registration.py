@@ -46,22 +46,36 @@ def make_grid(task: str | TaskSpec, size: int, product: bool = False,
 make_grid.metadata = {"render_modes": ["rgb_array", "ansi"], "render_fps": 8}
 
 
+def cont_id(task: str) -> str:
+    return f"{NAMESPACE}/{task}-Cont-v0"
+
+
+def make_continuous(task: str | TaskSpec, product: bool = False, render_mode: str | None = None,
+                    width: int = 240, height: int = 240) -> gym.Env:
+    """Entry point of the MuJoCo ids; ``product=True`` adds the automaton one-hot."""
+    from .envs.continuous import ContinuousWorldEnv
+    from .wrappers import AutomatonObservation
+
+    env = ContinuousWorldEnv(task, render_mode=render_mode, width=width, height=height)
+    return AutomatonObservation(env) if product else env
+
+
+make_continuous.metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+
+
 def _register(spec: TaskSpec, builtin: bool) -> list[str]:
-    ids = []
-    for size in spec.grid.sizes:
-        env_id = grid_id(spec.name, size)
+    # built-in tasks by name (readable specs); user tasks carry their spec, so that worker
+    # processes of vector envs need not re-register them
+    task = spec.name if builtin else spec
+    worlds = [(grid_id(spec.name, size), "make_grid", {"size": size}, spec.grid.max_steps)
+              for size in spec.grid.sizes]
+    worlds.append((cont_id(spec.name), "make_continuous", {}, spec.continuous.max_steps))
+    for env_id, entry, kwargs, max_steps in worlds:
         if env_id in gym.registry:
             del gym.registry[env_id]  # re-registering a task replaces its ids
-        gym.register(
-            id=env_id,
-            entry_point="craftsuite.registration:make_grid",
-            # built-in tasks by name (readable specs); user tasks carry their spec, so that
-            # worker processes of vector envs need not re-register them
-            kwargs={"task": spec.name if builtin else spec, "size": size},
-            max_episode_steps=spec.grid.max_steps,
-        )
-        ids.append(env_id)
-    return ids
+        gym.register(id=env_id, entry_point=f"craftsuite.registration:{entry}",
+                     kwargs={"task": task, **kwargs}, max_episode_steps=max_steps)
+    return [w[0] for w in worlds]
 
 
 def register_task(spec: str | Path | TaskSpec) -> list[str]:

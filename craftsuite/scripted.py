@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from collections import deque
 
+import numpy as np
+
 from .labelling import Labeller
 from .rendering.grid import WALL
 from .rules import Rules
@@ -37,6 +39,10 @@ class ObjectivePlanner:
     def harmless(self, w: int, inv: tuple[int, ...], kind: int) -> bool:
         """Stepping on ``kind`` now leaves the automaton state unchanged."""
         return self.touch(w, inv, kind)[0] == w
+
+    def next_kind_in(self, env) -> int | None:
+        """The next kind to touch in a world (its ``unwrapped``)."""
+        return self.next_kind(env.automaton_state, env.inventory_counts, env.remaining_counts())
 
     def next_kind(self, w: int, inv, remaining) -> int | None:
         """The object kind to touch next on a shortest route to acceptance (None: no route)."""
@@ -77,15 +83,7 @@ class GridScriptedPolicy:
         self.planner = ObjectivePlanner(self.env.task)
 
     def __call__(self, observation=None) -> int:
-        env = self.env
-        inv, w, cells = tuple(env.inventory_counts), env.automaton_state, env._cells
-        remaining = [0] * len(env.task.objects)
-        for kind in cells:
-            if kind >= 0:
-                remaining[kind] += 1
-        for k in range(env.rules.n_items, len(remaining)):
-            remaining[k] = max(remaining[k], 1)  # places are never used up
-        return self.toward(self.planner.next_kind(w, inv, remaining))
+        return self.toward(self.planner.next_kind_in(self.env))
 
     def toward(self, target: int | None) -> int:
         """A step towards the nearest object of kind ``target``, through harmless cells."""
@@ -134,6 +132,124 @@ def _bfs_first_step(size, cells, start, goals, blocked) -> int | None:
     return None
 
 
+class ContinuousScriptedPolicy:
+    """Acts in a ``ContinuousWorldEnv``: ``policy(obs) -> thrust``.
+
+    Paths come from a breadth-first search on a 0.25 m occupancy grid: walls and
+    obstacles (grown by the agent's size), and the pickup zones of objects that would
+    change the automaton state (grown by a safety margin), are blocked. The agent steers
+    for a cell a few steps down the path with a velocity controller.
+    """
+
+    CELL = 0.25
+    LOOKAHEAD = 3
+
+    def __init__(self, env):
+        from .envs.scene import AGENT_HALF
+
+        self.env = env.unwrapped
+        self.planner = ObjectivePlanner(self.env.task)
+        e = self.env
+        self.n = int(np.ceil(e.arena / self.CELL))
+        centres = (np.arange(self.n) + 0.5) * (e.arena / self.n) - e.half
+        self.cx, self.cy = np.meshgrid(centres, centres, indexing="xy")  # [row=y index, col=x]
+        grow = AGENT_HALF + 0.05
+        static = (np.abs(self.cx) > e.half - grow) | (np.abs(self.cy) > e.half - grow)
+        for x, y, h in e.scene.obstacles:
+            static |= (np.abs(self.cx - x) < h + grow) & (np.abs(self.cy - y) < h + grow)
+        self.static = static
+
+    def cell_of(self, p) -> tuple[int, int]:
+        e = self.env
+        ix = int(np.clip((p[0] + e.half) / e.arena * self.n, 0, self.n - 1))
+        iy = int(np.clip((p[1] + e.half) / e.arena * self.n, 0, self.n - 1))
+        return iy, ix
+
+    def __call__(self, observation=None) -> np.ndarray:
+        return self.toward(self.planner.next_kind_in(self.env))
+
+    def toward(self, target: int | None) -> np.ndarray:
+        """Thrust towards the nearest object of kind ``target``, around unsafe zones."""
+        from .envs.continuous import TOP_SPEED
+
+        e = self.env
+        if target is None:
+            return np.zeros(2, dtype=np.float32)
+        pos, vel = e.data.qpos[:2].copy(), e.data.qvel[:2].copy()
+        w, inv = e.automaton_state, tuple(e.inventory_counts)
+        kinds = np.array(e._kinds)
+        present = e._present
+        # a place acts on entering: instances we stand in do not count until we leave them
+        goal_objects = np.flatnonzero((kinds == target) & present & ~e._inside)
+        if len(goal_objects) == 0:
+            near = np.flatnonzero((kinds == target) & present)
+            if len(near) == 0:
+                return np.zeros(2, dtype=np.float32)
+            away = pos - e._positions[near[0]]
+            return self._steer(away / (np.linalg.norm(away) + 1e-9) * TOP_SPEED, vel)
+        unsafe = [i for i in np.flatnonzero(present)
+                  if kinds[i] != target and not self.planner.harmless(w, inv, int(kinds[i]))]
+        blocked = self.static.copy()
+        for i in unsafe:
+            ox, oy = e._positions[i]
+            blocked |= (self.cx - ox) ** 2 + (self.cy - oy) ** 2 < (e.radius + 0.3) ** 2
+        goal = np.zeros_like(blocked)
+        for i in goal_objects:
+            gx, gy = e._positions[i]
+            goal |= (self.cx - gx) ** 2 + (self.cy - gy) ** 2 < (0.6 * e.radius) ** 2
+        path = _grid_path(blocked, goal, self.cell_of(pos)) or _grid_path(self.static, goal, self.cell_of(pos))
+        if path is None or len(path) <= self.LOOKAHEAD:
+            dists = np.linalg.norm(e._positions[goal_objects] - pos, axis=1)
+            aim = e._positions[goal_objects[dists.argmin()]]
+        else:
+            iy, ix = path[self.LOOKAHEAD]
+            aim = np.array([self.cx[iy, ix], self.cy[iy, ix]])
+        offset = aim - pos
+        dist = np.linalg.norm(offset)
+        desired = offset / (dist + 1e-9) * TOP_SPEED * min(1.0, dist / 0.3 + 0.3)
+        return self._steer(desired, vel)
+
+    @staticmethod
+    def _steer(desired, vel) -> np.ndarray:
+        from .envs.continuous import TOP_SPEED
+
+        thrust = desired / TOP_SPEED + 0.5 * (desired - vel) / TOP_SPEED
+        return np.clip(thrust, -1, 1).astype(np.float32)
+
+
+def _grid_path(blocked: np.ndarray, goal: np.ndarray, start: tuple[int, int]):
+    """Cells of a shortest 8-connected path from ``start`` into ``goal``, or None."""
+    if not goal.any():
+        return None
+    rows, cols = blocked.shape
+    parent = {start: None}
+    queue = deque([start])
+    while queue:
+        cell = queue.popleft()
+        if goal[cell]:
+            path = []
+            while cell is not None:
+                path.append(cell)
+                cell = parent[cell]
+            return path[::-1]
+        y, x = cell
+        for dy, dx in ((0, 1), (1, 0), (0, -1), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1)):
+            ny, nx = y + dy, x + dx
+            if 0 <= ny < rows and 0 <= nx < cols and (ny, nx) not in parent and not blocked[ny, nx]:
+                if dy and dx and (blocked[y, nx] or blocked[ny, x]):
+                    continue  # no corner cutting past walls
+                parent[(ny, nx)] = cell
+                queue.append((ny, nx))
+    return None
+
+
+def scripted_policy(env):
+    """The scripted policy for a CraftSuite world, grid or MuJoCo."""
+    from .envs.continuous import ContinuousWorldEnv
+
+    return ContinuousScriptedPolicy(env) if isinstance(env.unwrapped, ContinuousWorldEnv) else GridScriptedPolicy(env)
+
+
 def run_episode(env, policy, seed: int | None = None, max_steps: int = 10_000):
     """Roll out ``policy`` until the episode ends: (total reward, steps, last info)."""
     obs, info = env.reset(seed=seed)
@@ -146,4 +262,5 @@ def run_episode(env, policy, seed: int | None = None, max_steps: int = 10_000):
     return total, steps, info
 
 
-__all__ = ["ObjectivePlanner", "GridScriptedPolicy", "run_episode"]
+__all__ = ["ObjectivePlanner", "GridScriptedPolicy", "ContinuousScriptedPolicy", "scripted_policy",
+           "run_episode"]

@@ -41,7 +41,13 @@ Format (see ``tasks/blind_craftsman.toml`` for a full example)::
     [grid]
     sizes = [7, 10]
     max_steps = 500
-    obstacles = [[3, 5], [3, 4]]     # impassable cells as [x, y]
+    obstacles = [[3, 5], [3, 4]]     # impassable cells as [x, y] of the largest grid size
+
+    [continuous]                     # the MuJoCo world (all keys optional)
+    arena = 7.0                      # side of the square arena
+    pickup_radius = 0.4              # an object is touched within this distance
+    boundary_reward = -0.1           # per step of pushing against the boundary
+    max_steps = 1000
 """
 
 from __future__ import annotations
@@ -58,7 +64,7 @@ from .automata.ltlf import atoms
 from .paths import tasks_dir
 
 __all__ = [
-    "SpecError", "TaskSpec", "Item", "Place", "Recipe", "Proposition", "GridConfig",
+    "SpecError", "TaskSpec", "Item", "Place", "Recipe", "Proposition", "GridConfig", "ContinuousConfig",
     "load_spec", "builtin_specs",
 ]
 
@@ -119,6 +125,16 @@ class GridConfig:
 
 
 @dataclass(frozen=True)
+class ContinuousConfig:
+    """The MuJoCo world of a task; obstacles come from ``GridConfig`` (scaled to the arena)."""
+
+    arena: float = 7.0
+    pickup_radius: float = 0.4
+    boundary_reward: float = -0.1
+    max_steps: int = 1000
+
+
+@dataclass(frozen=True)
 class TaskSpec:
     name: str
     formula: str
@@ -129,6 +145,7 @@ class TaskSpec:
     step_reward: float
     completion_reward: float
     grid: GridConfig
+    continuous: ContinuousConfig = ContinuousConfig()
     description: str = ""
     path: Path | None = None
 
@@ -161,7 +178,7 @@ _NAME = re.compile(r"[a-z_][a-z0-9_]*\Z")
 _TASK_NAME = re.compile(r"[A-Z][A-Za-z0-9]*\Z")
 _COLOR = re.compile(r"#[0-9a-fA-F]{6}\Z")
 _TOP_KEYS = {"name", "formula", "description", "extends", "propositions", "items", "places",
-             "recipes", "rewards", "grid"}
+             "recipes", "rewards", "grid", "continuous"}
 
 
 class _Reader:
@@ -429,6 +446,23 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
         if corners and (0, 0) in set(grid.obstacles):
             r.fail("grid.obstacles", "the corner cell (0, 0) is taken by a 'corner' place")
 
+    raw_cont = r.table(data.get("continuous", {}), "continuous")
+    r.keys(raw_cont, {"arena", "pickup_radius", "boundary_reward", "max_steps"}, "continuous")
+    default = ContinuousConfig()
+    continuous = ContinuousConfig(
+        arena=r.float(raw_cont, "arena", "continuous", default.arena),
+        pickup_radius=r.float(raw_cont, "pickup_radius", "continuous", default.pickup_radius),
+        boundary_reward=r.float(raw_cont, "boundary_reward", "continuous", default.boundary_reward),
+        max_steps=r.int(raw_cont, "max_steps", "continuous", default=default.max_steps, minimum=1),
+    )
+    if continuous.arena <= 0 or continuous.pickup_radius <= 0:
+        r.fail("continuous", "arena and pickup_radius must be positive")
+    spacing = 2 * continuous.pickup_radius
+    per_side = int((continuous.arena - spacing) // spacing)
+    if n_objects + 1 > per_side * per_side:
+        r.fail("continuous", f"{n_objects} objects and the agent cannot get non-overlapping pickup "
+                             f"zones in a {continuous.arena} arena (at most {per_side * per_side - 1})")
+
     description = data.get("description", "")
     if not isinstance(description, str):
         r.fail("description", "must be a string")
@@ -437,7 +471,7 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
         places=tuple(places), recipes=tuple(recipes),
         step_reward=r.float(rewards, "step", "rewards", -0.1),
         completion_reward=r.float(rewards, "completion", "rewards", 100.0),
-        grid=grid, description=description.strip(), path=path,
+        grid=grid, continuous=continuous, description=description.strip(), path=path,
     )
 
 

@@ -3,3 +3,30 @@ import tempfile
 
 # Tests must not touch the user's automaton cache: one fresh directory per test session.
 os.environ.setdefault("CRAFTSUITE_CACHE_DIR", tempfile.mkdtemp(prefix="craftsuite-test-cache-"))
+
+
+import pytest  # noqa: E402
+
+
+class _GL:
+    def __init__(self, ok: bool, reason: str = ""):
+        self.ok, self.reason = ok, reason
+
+    def __bool__(self):
+        return self.ok
+
+
+@pytest.fixture(scope="session")
+def gl_available():
+    """Whether MuJoCo can render off-screen here; falsy with the reason when it cannot."""
+    import craftsuite  # noqa: F401  (chooses MUJOCO_GL before mujoco is imported)
+    import mujoco
+
+    try:
+        model = mujoco.MjModel.from_xml_string("<mujoco><worldbody/></mujoco>")
+        with mujoco.Renderer(model, 8, 8) as renderer:
+            renderer.render()
+    except Exception as err:  # no GL backend could start
+        import os
+        return _GL(False, f"no off-screen GL backend (MUJOCO_GL={os.environ.get('MUJOCO_GL')}): {err}")
+    return _GL(True)

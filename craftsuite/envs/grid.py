@@ -128,6 +128,14 @@ class GridWorldEnv(gym.Env):
         y, x = divmod(self._agent, self.size)
         return x, y
 
+    def remaining_counts(self) -> list[int]:
+        """Objects of each kind still on the map (places are never used up)."""
+        counts = [0] * len(self._objects)
+        for kind in self._cells:
+            if kind >= 0:
+                counts[kind] += 1
+        return counts
+
     def object_positions(self) -> dict[str, list[tuple[int, int]]]:
         """Cells ``(x, y)`` of the objects still on the map, by object name."""
         out: dict[str, list[tuple[int, int]]] = {o.name: [] for o in self._objects}

@@ -1,0 +1,373 @@
+"""MuJoCo worlds: a point-mass agent in a square arena, the same tasks and rules as the grids."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import mujoco
+import numpy as np
+
+from ..labelling import Labeller
+from ..registration import resolve_task
+from ..rendering.gl import gl_error_hint
+from ..rendering.panel import status_panel
+from ..rules import Rules
+from ..spec import TaskSpec
+from .scene import AGENT_HALF, build_scene
+
+FRAME_SKIP = 2  # physics steps of 0.025 s per action: control period 0.05 s
+TOP_SPEED = 2.0  # m/s at full thrust (gear 10 / damping 5 in assets/arena.xml)
+_PLACEMENT_TRIES = 200
+_FAR = 1e6  # where consumed objects are parked: never within reach
+
+
+class ContinuousWorldEnv(gym.Env):
+    """A CraftSuite task in a MuJoCo arena with a point-mass agent.
+
+    ## Description
+    The agent, a 0.3 m cube on two slide joints, moves in a square arena (7 x 7 m by
+    default) walled on all sides; obstacle variants add solid walls. An object is touched
+    while the agent's centre is within ``pickup_radius`` (0.4 m) of it: items are picked
+    up (and vanish) when the task's rules allow, places act on entering their zone. Rules,
+    labels and the automaton are the same code as the grid worlds use.
+
+    ## Action Space
+    ``Box(-1, 1, (2,), float32)``: thrust along x and y. Out-of-range values are clipped;
+    NaN, infinite or wrongly shaped actions raise ``ValueError``. Each action is held for
+    0.05 s (2 physics steps of 0.025 s); full thrust reaches the top speed of 2 m/s
+    (0.1 m per step) with a 0.2 s time constant, so crossing the arena takes about 70
+    steps and a good Blind Craftsman episode a few hundred.
+
+    ## Observation Space
+    ``Box(-1, 1, (4 + 3 * n_objects + n_inventory,), float32)``: agent position divided
+    by half the arena and velocity divided by the top speed; per object slot (spec order,
+    fixed count) its position relative to the agent divided by the arena side and a
+    present flag (0 once consumed, its position then 0); inventory counts divided by their
+    largest possible value. ``observation_layout`` gives the slices. With ``product=True``
+    the automaton state's one-hot follows.
+
+    ## Rewards
+    The spec's step reward (-0.1), item rewards on pickup, the completion reward (+100) on
+    acceptance, and ``boundary_reward`` (-0.1) on every step the agent pushes against the
+    boundary wall.
+
+    ## Starting State
+    Objects and the agent at random positions, at least two pickup radii apart (so no
+    zones overlap, nor the start), clear of walls and obstacles.
+
+    ## Episode End
+    Terminated on acceptance (``is_success``) or on reaching the rejecting sink
+    (``violation``); truncated at ``continuous.max_steps`` (1000) by TimeLimit.
+
+    ## Registered Configurations
+    ``CraftSuite/<Task>-Cont-v0`` for every task spec: BlindCraftsman,
+    BlindCraftsmanObstacles, DungeonQuest, DiamondMine.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+
+    def __init__(self, task: str | TaskSpec = "BlindCraftsman", render_mode: str | None = None,
+                 width: int = 240, height: int = 240):
+        self.task = spec = resolve_task(task)
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode {render_mode!r} is not supported; use one of {self.metadata['render_modes']}"
+            )
+        self.render_mode = render_mode
+        self.width, self.height = width, height
+        cfg = spec.continuous
+        self.arena = cfg.arena
+        self.half = cfg.arena / 2
+        self.radius = cfg.pickup_radius
+        self.scene = scene = build_scene(spec)
+        self.model = mujoco.MjModel.from_xml_string(scene.xml)
+        self.data = mujoco.MjData(self.model)
+        self._body_ids = np.array([self.model.body(n).id for n in scene.object_bodies])
+        self._geom_ids = np.array([self.model.geom(n).id for n in scene.object_bodies])
+        self._rgba = self.model.geom_rgba[self._geom_ids].copy()
+        self._kinds = list(scene.object_kinds)
+        self.automaton = spec.automaton
+        self.rules = Rules(spec)
+        self.labeller = Labeller(spec, self.automaton.propositions)
+        n_obj = len(self._kinds)
+        self._is_item = np.array([k < self.rules.n_items for k in self._kinds])
+        self._inv_offset = 4 + 3 * n_obj
+        n_obs = self._inv_offset + len(self.rules.inventory_names)
+        self.observation_space = gym.spaces.Box(-1.0, 1.0, (n_obs,), dtype=np.float32)
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
+        self._rows = self.automaton.delta.tolist()
+        self._accepting = self.automaton.accepting.tolist()
+        self._rejecting = self.automaton.rejecting.tolist()
+        self._step_reward = spec.step_reward
+        self._boundary_reward = cfg.boundary_reward
+        self._completion = spec.completion_reward
+        self._wall_limit = self.half - AGENT_HALF - 0.02  # agent touching the boundary wall
+        self._obs = np.zeros(n_obs, dtype=np.float32)
+        self._positions = np.zeros((n_obj, 2))
+        self._present = np.zeros(n_obj, dtype=bool)
+        self._inside = np.zeros(n_obj, dtype=bool)
+        self._any_inside = False
+        self._radius2 = self.radius ** 2
+        self._offset_scale = np.zeros((n_obj, 1))
+        self._obs_objects = self._object_view()
+        self._label_names: dict[int, tuple[str, ...]] = {}
+        self._renderer = None
+        self._started = False
+        self.automaton_state = self.automaton.initial
+        self.inventory_counts = self.rules.new_inventory()
+
+    def _object_view(self) -> np.ndarray:
+        """(dx, dy, present) rows of the observation buffer, as a writable view."""
+        n_obj = len(self._kinds)
+        return self._obs[4:4 + 3 * n_obj].reshape(n_obj, 3)
+
+    # -- public views --------------------------------------------------------------------------
+    @property
+    def observation_layout(self) -> dict:
+        n_obj = len(self._kinds)
+        return {
+            "agent_position": slice(0, 2), "agent_velocity": slice(2, 4),
+            "objects": slice(4, 4 + 3 * n_obj),  # (dx, dy, present) per slot
+            "object_names": tuple(self.task.objects[k].name for k in self._kinds),
+            "inventory": slice(self._inv_offset, self._inv_offset + len(self.inventory_counts)),
+            "inventory_names": self.rules.inventory_names,
+        }
+
+    @property
+    def inventory(self) -> dict[str, int]:
+        return dict(zip(self.rules.inventory_names, self.inventory_counts))
+
+    @property
+    def agent_position(self) -> np.ndarray:
+        return self.data.qpos[:2].copy()
+
+    def remaining_counts(self) -> list[int]:
+        """Objects of each kind still in the arena (places are never used up)."""
+        counts = [0] * len(self.task.objects)
+        for i, kind in enumerate(self._kinds):
+            counts[kind] += bool(self._present[i])
+        return counts
+
+    def object_positions(self) -> dict[str, list[tuple[float, float]]]:
+        """Positions of the objects still in the arena, by object name."""
+        out: dict[str, list[tuple[float, float]]] = {o.name: [] for o in self.task.objects}
+        for i, kind in enumerate(self._kinds):
+            if self._present[i]:
+                out[self.task.objects[kind].name].append(tuple(self._positions[i].round(4)))
+        return out
+
+    # -- episodes ----------------------------------------------------------------------------------
+    def _clear(self, p: np.ndarray, margin: float) -> bool:
+        if np.any(np.abs(p) > self.half - margin):
+            return False
+        for x, y, h in self.scene.obstacles:
+            if max(abs(p[0] - x), abs(p[1] - y)) < h + margin:
+                return False
+        return True
+
+    def _sample_positions(self, n: int) -> np.ndarray:
+        """n points, pairwise >= 2 pickup radii apart, clear of walls and obstacles.
+
+        Uniform dart throwing (batches of candidates, checked with numpy) for sparse
+        scenes; scenes too crowded for it (Diamond Mine's 43 objects fill over half the
+        arena with pickup zones) take random cells of a jittered lattice.
+        """
+        rng, spacing = self.np_random, 2 * self.radius + 1e-3
+        margin = max(self.radius, AGENT_HALF) + 0.05
+        span = self.arena - 2 * margin
+        if n > 0.35 * (span / spacing) ** 2:
+            return self._jittered_grid(n, spacing, margin)
+        points = np.empty((0, 2))
+        for _ in range(n):
+            for _ in range(_PLACEMENT_TRIES // 20):
+                cand = rng.uniform(-self.half + margin, self.half - margin, (20, 2))
+                ok = [self._clear(c, margin) for c in cand] if self.scene.obstacles else np.ones(20, bool)
+                if len(points):
+                    gaps = np.linalg.norm(cand[:, None, :] - points[None, :, :], axis=2).min(axis=1)
+                    ok = ok & (gaps >= spacing)
+                hits = np.flatnonzero(ok)
+                if len(hits):
+                    points = np.vstack([points, cand[hits[0]]])
+                    break
+            else:
+                return self._jittered_grid(n, spacing, margin)
+        return points
+
+    def _jittered_grid(self, n: int, spacing: float, margin: float) -> np.ndarray:
+        """Crowded scenes (Diamond Mine's 43 objects): random cells of a lattice, jittered."""
+        span = self.arena - 2 * margin
+        per_side = int(span // spacing) + 1
+        step = span / (per_side - 1)
+        jitter = max(0.0, (step - spacing) / 2)
+        axis = np.linspace(-self.half + margin, self.half - margin, per_side)
+        cells = np.array([(x, y) for x in axis for y in axis])
+        cells = cells[[self._clear(c, margin) for c in cells]]
+        if len(cells) < n:
+            raise RuntimeError(f"{self.task.name}: {n} positions do not fit the arena")
+        chosen = cells[self.np_random.permutation(len(cells))[:n]]
+        return chosen + self.np_random.uniform(-jitter, jitter, chosen.shape)
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        model, data = self.model, self.data
+        mujoco.mj_resetData(model, data)
+        n_obj = len(self._kinds)
+        points = self._sample_positions(n_obj + 1)
+        self._positions = points[:n_obj].copy()
+        data.qpos[:2] = points[n_obj]
+        model.body_pos[self._body_ids, :2] = self._positions
+        model.body_pos[self._body_ids, 2] = 0.0
+        model.geom_rgba[self._geom_ids] = self._rgba
+        self._present[:] = True
+        self._inside[:] = False
+        self._any_inside = False
+        self._offset_scale[:] = 1.0 / self.arena
+        mujoco.mj_forward(model, data)
+        self.inventory_counts = self.rules.new_inventory()
+        self._level_mask = self.labeller.levels(self.inventory_counts)
+        self.automaton_state = self.automaton.initial
+        self._started = True
+        obs = self._obs
+        obs[:] = 0.0
+        self._obs_objects[:, 2] = 1.0
+        self._write_observation(self._positions - data.qpos[:2])
+        info = {"labels": (), "label_mask": 0, "automaton_state": self.automaton_state,
+                "automaton_transition": None, "is_success": False, "violation": False}
+        return obs.copy(), info
+
+    def _write_observation(self, offsets: np.ndarray):
+        """Agent state and object offsets (``offsets`` = object positions - agent position)."""
+        obs, data = self._obs, self.data
+        obs[0] = data.qpos[0] / self.half
+        obs[1] = data.qpos[1] / self.half
+        obs[2] = min(1.0, max(-1.0, data.qvel[0] / TOP_SPEED))
+        obs[3] = min(1.0, max(-1.0, data.qvel[1] / TOP_SPEED))
+        # consumed objects sit far away with scale 0: their offsets read 0
+        np.multiply(offsets, self._offset_scale, out=self._obs_objects[:, :2])
+
+    def step(self, action):
+        try:
+            x, y = action
+            x, y = float(x), float(y)
+        except (TypeError, ValueError):
+            shape = getattr(action, "shape", None)
+            raise ValueError(
+                f"invalid action {action!r}" + (f" of shape {shape}" if shape is not None else "")
+                + ": expected 2 numbers (thrust along x and y) in [-1, 1]"
+            ) from None
+        if not (abs(x) < float("inf") and abs(y) < float("inf")):  # also False for NaN
+            raise ValueError(f"invalid action [{x}, {y}]: NaN or infinite thrust")
+        if not self._started:
+            raise RuntimeError("call reset() before step()")
+        x, y = min(1.0, max(-1.0, x)), min(1.0, max(-1.0, y))
+        model, data = self.model, self.data
+        data.ctrl[0] = x
+        data.ctrl[1] = y
+        for _ in range(FRAME_SKIP):
+            mujoco.mj_step(model, data)
+
+        reward = self._step_reward
+        px, py = data.qpos[0], data.qpos[1]
+        lim = self._wall_limit
+        if (abs(px) >= lim and x * px > 0) or (abs(py) >= lim and y * py > 0):
+            reward += self._boundary_reward
+
+        offsets = self._positions - data.qpos[:2]
+        dist2 = np.einsum("ij,ij->i", offsets, offsets)
+        mask = self._level_mask
+        if dist2.min() < self._radius2 or self._any_inside:
+            inside = dist2 < self._radius2
+            mask, reward = self._touch(inside, mask, reward)
+            self._inside = inside
+            self._any_inside = bool(inside.any())
+        self._write_observation(offsets)
+
+        w = self.automaton_state
+        w2 = self._rows[w][mask]
+        self.automaton_state = w2
+        success, violation = self._accepting[w2], self._rejecting[w2]
+        if success:
+            reward += self._completion
+        labels = self._label_names.get(mask)
+        if labels is None:
+            labels = self._label_names[mask] = self.labeller.names(mask)
+        info = {"labels": labels, "label_mask": mask, "automaton_state": w2,
+                "automaton_transition": (w, mask, w2), "is_success": success,
+                "violation": violation}
+        return self._obs.copy(), reward, success or violation, False, info
+
+    def _touch(self, inside: np.ndarray, mask: int, reward: float) -> tuple[int, float]:
+        """Apply the rules to every object whose zone the agent is in; return (label, reward)."""
+        inv = self.inventory_counts
+        gained, arrived, touched = 0, -1, False
+        for i in np.flatnonzero(inside).tolist():
+            kind = self._kinds[i]
+            entered = not self._inside[i]
+            outcome = self.rules.touch(inv, kind, entered)
+            if entered and not self._is_item[i]:
+                arrived = kind
+            if outcome is None:
+                continue
+            touched = True
+            reward += outcome.reward
+            gained |= outcome.gained
+            if outcome.consumed:
+                self._remove(i)
+                inside[i] = False
+        if touched:
+            off, scale = self._inv_offset, self.rules.scale
+            for s, count in enumerate(inv):
+                self._obs[off + s] = count / scale[s]
+            self._level_mask = self.labeller.levels(inv)
+        if touched or arrived >= 0:
+            mask = self.labeller(inv, gained, arrived)
+        return mask, reward
+
+    def _remove(self, i: int):
+        self._present[i] = False
+        self._positions[i] = _FAR
+        self._offset_scale[i] = 0.0
+        self._obs_objects[i, 2] = 0.0
+        self.model.geom_rgba[self._geom_ids[i], 3] = 0.0
+        self.model.body_pos[self._body_ids[i], 2] = -1.0
+
+    # -- rendering -----------------------------------------------------------------------------------
+    def world_to_pixel(self, x: float, y: float) -> tuple[int, int]:
+        """(column, row) of an arena point in the camera image (top-down, orthographic)."""
+        extent = self.model.cam_fovy[self.model.camera("top").id]
+        col = (x / extent + 0.5) * self.width
+        row = (0.5 - y / extent) * self.height
+        return int(col), int(row)
+
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode= to make()")
+            return None
+        if not self._started:
+            raise RuntimeError("call reset() before render()")
+        if self._renderer is None:
+            try:
+                self._renderer = mujoco.Renderer(self.model, self.height, self.width)
+            except Exception as err:  # the GL backend could not start
+                raise RuntimeError(gl_error_hint(err)) from err
+        self._renderer.update_scene(self.data, camera="top")
+        frame = self._renderer.render()
+        w = self.automaton_state
+        flag = "accepted" if self._accepting[w] else "violated" if self._rejecting[w] else ""
+        panel = status_panel(self.width, self.inventory, w, self.automaton.n_states, flag)
+        return np.concatenate([frame, panel], axis=0)
+
+    def close(self):
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+        super().close()
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state["_renderer"] = None  # GL contexts do not travel; render() makes a new one
+        del state["_obs_objects"]  # a view into _obs: pickling would detach it
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._obs_objects = self._object_view()

@@ -1,0 +1,242 @@
+"""The MuJoCo worlds: pickups by distance, physics, scripted completion, rendering, video."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import cv2
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import craftsuite
+from craftsuite.cli import main as cli
+from craftsuite.envs.continuous import TOP_SPEED, ContinuousWorldEnv
+from craftsuite.scripted import ContinuousScriptedPolicy, run_episode
+
+CONT = [i for i in craftsuite.registered_ids() if "-Cont-" in i]
+
+
+def make(task="BlindCraftsman", **kw):
+    return ContinuousWorldEnv(task, **kw)
+
+
+def place_agent(env, xy):
+    env.data.qpos[:2] = xy
+    env.data.qvel[:2] = 0
+    import mujoco
+    mujoco.mj_forward(env.model, env.data)
+
+
+@pytest.mark.parametrize("env_id", CONT)
+def test_scripted_policy_completes_within_the_time_limit(env_id):
+    env = gym.make(env_id)
+    policy = ContinuousScriptedPolicy(env)
+    successes = 0
+    for seed in range(10):
+        accepting_before_end = False
+        obs, info = env.reset(seed=seed)
+        done = False
+        while not done:
+            obs, reward, term, trunc, info = env.step(policy(obs))
+            done = term or trunc
+            accepting = env.unwrapped.automaton.accepting[info["automaton_state"]]
+            accepting_before_end |= accepting and not done
+        assert not accepting_before_end  # acceptance ends the episode on the spot
+        assert info["is_success"] == env.unwrapped.automaton.accepting[info["automaton_state"]]
+        successes += info["is_success"]
+    assert successes >= 9
+
+
+def test_acceptance_exactly_when_blind_craftsman_is_done():
+    env = gym.make("CraftSuite/BlindCraftsman-Cont-v0")
+    policy = ContinuousScriptedPolicy(env)
+    env.reset(seed=3)
+    u = env.unwrapped
+    while True:
+        obs, reward, term, trunc, info = env.step(policy())
+        home = [p for p in u.task.places if p.name == "home"]
+        if term:
+            break
+        assert not (u.inventory["tools"] >= 3 and "home" in info["labels"])
+    assert info["is_success"] and u.inventory["tools"] >= 3 and "home" in info["labels"]
+    assert reward == pytest.approx(100 - 0.1, abs=0.11)  # + possibly a boundary push
+    assert home
+
+
+def test_pickup_radius_is_0_4():
+    env = make("DungeonQuest")
+    env.reset(seed=0)
+    key = env._kinds.index([o.name for o in env.task.objects].index("key"))
+    kx, ky = env._positions[key]
+    direction = -np.sign([kx, ky]) * np.array([1.0, 0.0])  # move towards the arena centre
+    if not direction.any():
+        direction = np.array([1.0, 0.0])
+    place_agent(env, np.array([kx, ky]) + direction * 0.45)
+    env.step(np.zeros(2))
+    assert env.inventory["key"] == 0 and env._present[key]
+    place_agent(env, np.array([kx, ky]) + direction * 0.35)
+    obs, reward, term, trunc, info = env.step(np.zeros(2))
+    assert env.inventory["key"] == 1 and not env._present[key]
+    assert info["labels"] == ("key",) and reward == pytest.approx(0.9)
+    layout = env.observation_layout
+    slot = obs[layout["objects"]].reshape(-1, 3)[key]
+    assert slot.tolist() == [0.0, 0.0, 0.0]  # consumed: gone from the observation
+    assert env.model.geom_rgba[env._geom_ids[key], 3] == 0.0  # and from view
+
+
+def test_places_act_on_arrival_only():
+    env = make("DungeonQuest")
+    env.reset(seed=0)
+    env.inventory_counts[env.rules.inventory_names.index("key")] = 1
+    chest = env._kinds.index([o.name for o in env.task.objects].index("chest"))
+    place_agent(env, env._positions[chest] + [0.1, 0.0])
+    env.step(np.zeros(2))
+    assert env.inventory["sword"] == 1 and env.inventory["key"] == 0
+    env.inventory_counts[env.rules.inventory_names.index("key")] = 1
+    env.step(np.zeros(2))  # still inside: no second arrival
+    assert env.inventory["sword"] == 1 and env.inventory["key"] == 1
+
+
+def test_top_speed_and_control_period():
+    env = make()
+    env.reset(seed=0)
+    place_agent(env, np.array([-3.0, 0.0]))
+    env._positions[:] = 1e6  # nothing to touch on the way
+    for _ in range(40):
+        env.step(np.array([1.0, 0.0]))
+    assert env.data.qvel[0] == pytest.approx(TOP_SPEED, rel=0.02)
+    assert env.data.time == pytest.approx(40 * 0.05)
+
+
+def test_boundary_push_costs_and_walls_hold():
+    env = make()
+    env.reset(seed=0)
+    env._positions[:] = 1e6
+    place_agent(env, np.array([env.half - 0.5, 0.0]))
+    rewards = [env.step(np.array([1.0, 0.0]))[1] for _ in range(30)]
+    assert env.data.qpos[0] < env.half
+    assert rewards[-1] == pytest.approx(-0.2)
+    assert rewards[0] == pytest.approx(-0.1)
+
+
+def test_obstacles_are_solid():
+    env = make("BlindCraftsmanObstacles")
+    env.reset(seed=0)
+    env._positions[:] = 1e6
+    x, y, h = env.scene.obstacles[0]
+    place_agent(env, np.array([x - h - 0.6, y]))
+    for _ in range(60):
+        env.step(np.array([1.0, 0.0]))
+    assert env.data.qpos[0] < x - h
+
+
+def test_reset_writes_positions_without_recompiling():
+    env = make()
+    model = env.model
+    env.reset(seed=1)
+    first = env._positions.copy()
+    env.reset(seed=2)
+    assert env.model is model and not np.allclose(first, env._positions)
+    assert np.allclose(model.body_pos[env._body_ids, :2], env._positions)
+
+
+@pytest.mark.parametrize("task", ["BlindCraftsman", "DiamondMine", "BlindCraftsmanObstacles"])
+def test_zones_do_not_overlap(task):
+    env = make(task)
+    for seed in range(20):
+        env.reset(seed=seed)
+        points = np.vstack([env._positions, env.data.qpos[:2]])
+        gaps = np.linalg.norm(points[:, None] - points[None], axis=2) + np.eye(len(points)) * 99
+        assert gaps.min() >= 2 * env.radius
+        for x, y, h in env.scene.obstacles:
+            assert (np.maximum(abs(points[:, 0] - x), abs(points[:, 1] - y)) > h).all()
+
+
+@pytest.mark.parametrize("action, message", [
+    (np.array([np.nan, 0.0]), "NaN or infinite"),
+    (np.array([np.inf, 0.0]), "NaN or infinite"),
+    (np.zeros(3), "expected 2 numbers"),
+    (np.zeros((2, 1)), "expected 2 numbers"),
+    ("up", "expected 2 numbers"),
+])
+def test_bad_actions_are_named(action, message):
+    env = make()
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=message):
+        env.step(action)
+
+
+def test_out_of_range_actions_are_clipped():
+    a, b = make(), make()
+    a.reset(seed=0)
+    b.reset(seed=0)
+    for _ in range(5):
+        oa = a.step(np.array([7.0, -3.0]))[0]
+        ob = b.step(np.array([1.0, -1.0]))[0]
+    assert np.array_equal(oa, ob)
+
+
+def test_frame_shows_the_agent_where_it_is(gl_available):
+    if not gl_available:
+        pytest.skip(gl_available.reason)
+    env = make(render_mode="rgb_array")
+    env.reset(seed=0)
+    frame = env.render()
+    assert frame.shape == (280, 240, 3) and frame.std() > 10
+    col, row = env.world_to_pixel(*env.data.qpos[:2])
+    patch = frame[row - 2:row + 3, col - 2:col + 3].astype(int)
+    assert patch.max() < 60  # the agent is a near-black cube
+    far = env.world_to_pixel(*(-np.sign(env.data.qpos[:2]) * 2.0))
+    assert frame[far[1], far[0]].min() > 100  # the floor elsewhere is light
+    env.close()
+
+
+def test_renderer_closes_cleanly_at_exit(gl_available):
+    if not gl_available:
+        pytest.skip(gl_available.reason)
+    code = ("import gymnasium as gym, craftsuite; e = gym.make('CraftSuite/DungeonQuest-Cont-v0', "
+            "render_mode='rgb_array'); e.reset(seed=0); e.render(); "
+            "f = gym.make('CraftSuite/BlindCraftsman-Cont-v0', render_mode='rgb_array'); "
+            "f.reset(seed=0); f.render(); f.close()")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 0 and out.stderr.strip() == "", out.stderr
+
+
+@pytest.mark.parametrize("env_id", ["CraftSuite/DungeonQuest-Cont-v0", "CraftSuite/DungeonQuest-Grid7-v0"])
+def test_video_command_writes_a_readable_mp4(tmp_path, env_id, gl_available, capsys):
+    if "Cont" in env_id and not gl_available:
+        pytest.skip(gl_available.reason)
+    out = tmp_path / "rollout.mp4"
+    assert cli(["video", env_id, "--policy", "scripted", "--episodes", "2", "--out", str(out)]) == 0
+    env = gym.make(env_id)
+    policy = craftsuite.scripted.scripted_policy(env)
+    expected = sum(run_episode(env, policy, seed=s)[1] + 1 for s in range(2))  # + reset frames
+    video = cv2.VideoCapture(str(out))
+    frames = 0
+    while video.read()[0]:
+        frames += 1
+    assert frames == expected
+    assert f"{expected} frames" in capsys.readouterr().out
+
+
+def test_video_rejects_a_corrupt_checkpoint(tmp_path, capsys):
+    bad = tmp_path / "model.zip"
+    bad.write_bytes(b"not a zip")
+    assert cli(["video", "CraftSuite/DungeonQuest-Grid7-v0", "--policy", str(bad),
+                "--out", str(tmp_path / "x.mp4")]) == 2
+    assert "not a stable-baselines3 checkpoint" in capsys.readouterr().err
+
+
+def test_record_video_wrapper(tmp_path, gl_available):
+    if not gl_available:
+        pytest.skip(gl_available.reason)
+    env = gym.make("CraftSuite/BlindCraftsman-Cont-v0", render_mode="rgb_array")
+    env = gym.wrappers.RecordVideo(env, str(tmp_path / "videos"), episode_trigger=lambda e: True,
+                                   disable_logger=True)
+    env.reset(seed=0)
+    for _ in range(10):
+        env.step(env.action_space.sample())
+    env.close()
+    assert list((tmp_path / "videos").glob("*.mp4"))

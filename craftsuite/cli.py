@@ -45,7 +45,7 @@ def _demo(args) -> int:
 
     from .automata import write_image
     from .registration import registered_ids, tasks
-    from .scripted import GridScriptedPolicy
+    from .scripted import scripted_policy
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -56,7 +56,7 @@ def _demo(args) -> int:
     rows = []
     for env_id in tqdm(ids, desc="scripted rollouts", unit="env"):
         env = gym.make(env_id, render_mode="rgb_array")
-        policy = GridScriptedPolicy(env)
+        policy = scripted_policy(env)
         successes, lengths = 0, []
         for episode in range(args.episodes):
             env.reset(seed=args.seed + episode)
@@ -64,7 +64,7 @@ def _demo(args) -> int:
                 first = env.render()
             steps, done = 0, False
             while not done:
-                _, _, term, trunc, info = env.step(policy())
+                _, _, term, trunc, info = env.step(policy(None))
                 steps += 1
                 done = term or trunc
             if episode == 0:
@@ -131,10 +131,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--show-sink", action="store_true", help="also draw the rejecting sink")
     p.set_defaults(run=_automaton)
 
-    p = sub.add_parser("demo", help="roll out the scripted policy on every grid id; write pictures")
+    p = sub.add_parser("demo", help="roll out the scripted policy on every id; write pictures")
     p.add_argument("--out", default="out/demo", help="output directory (default: out/demo)")
     p.add_argument("--task", help="only this task (default: all)")
-    p.add_argument("--episodes", type=int, default=20, help="episodes per id (default: 20)")
+    p.add_argument("--episodes", type=int, default=10, help="episodes per id (default: 10)")
     p.add_argument("--seed", type=int, default=0, help="first seed (default: 0)")
     p.set_defaults(run=_demo)
 

@@ -25,6 +25,7 @@ test-slow: $(STAMP)
 bench: $(STAMP)
 	$(PY) benchmarks/automata.py
 	$(PY) benchmarks/grid_steps.py
+	$(PY) benchmarks/cont_steps.py
 
 clean:
 	rm -rf out .pytest_cache

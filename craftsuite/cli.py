@@ -86,34 +86,22 @@ def _demo(args) -> int:
     for env_id, ok, n, steps, pic in rows:
         print(f"| {env_id} | {ok}/{n} | {steps:.1f} | {out / pic} |")
     print(f"\nautomata drawn in {out}/<Task>-automaton.png")
+    cont = [i for i in ids if "-Cont-" in i]
+    if cont:
+        from .rollouts import record_video
+
+        rec = record_video(cont[0], "scripted", 1, str(out / f"{cont[0].split('/')[1]}.mp4"), args.seed)
+        print(f"rollout video: {rec.path} ({rec.frames} frames, {rec.codec})")
     return 0
 
 
 def _video(args) -> int:
-    import gymnasium as gym
-    from tqdm import tqdm
-
     from . import registration  # noqa: F401  (registers the ids)
-    from .policies import load_policy
-    from .rendering.video import VideoWriter
+    from .rollouts import record_video
 
-    env = gym.make(args.env_id, render_mode="rgb_array", product=args.product)
-    policy = load_policy(args.policy, env, seed=args.seed)
-    fps = args.fps or env.metadata.get("render_fps", 20)
-    successes = 0
-    with VideoWriter(args.out, fps) as video:
-        for episode in tqdm(range(args.episodes), desc=f"{args.env_id} ({args.policy})", unit="episode"):
-            obs, _ = env.reset(seed=args.seed + episode)
-            video.write(env.render())
-            done = False
-            while not done:
-                obs, _, term, trunc, info = env.step(policy(obs))
-                video.write(env.render())
-                done = term or trunc
-            successes += bool(info["is_success"])
-    env.close()
-    print(f"wrote {args.out}: {video.frames} frames at {fps} fps ({video.codec}); "
-          f"{successes}/{args.episodes} episodes completed the objective")
+    rec = record_video(args.env_id, args.policy, args.episodes, args.out, args.seed, args.fps, args.product)
+    print(f"wrote {rec.path}: {rec.frames} frames at {rec.fps} fps ({rec.codec}); "
+          f"{rec.successes}/{rec.episodes} episodes completed the objective")
     return 0
 
 

@@ -156,13 +156,14 @@ class ContinuousWorldEnv(gym.Env):
         return out
 
     # -- episodes ----------------------------------------------------------------------------------
-    def _clear(self, p: np.ndarray, margin: float) -> bool:
-        if np.any(np.abs(p) > self.half - margin):
-            return False
-        for x, y, h in self.scene.obstacles:
-            if max(abs(p[0] - x), abs(p[1] - y)) < h + margin:
-                return False
-        return True
+    def _clear(self, points: np.ndarray, margin: float) -> np.ndarray:
+        """Which of the (n, 2) points keep ``margin`` from the walls and every obstacle."""
+        ok = (np.abs(points) <= self.half - margin).all(axis=1)
+        if self.scene.obstacles:
+            box = np.array(self.scene.obstacles)  # (k, 3): x, y, half side
+            gap = np.maximum(np.abs(points[:, None, 0] - box[:, 0]), np.abs(points[:, None, 1] - box[:, 1]))
+            ok &= (gap >= box[:, 2] + margin).all(axis=1)
+        return ok
 
     def _sample_positions(self, n: int) -> np.ndarray:
         """n points, pairwise >= 2 pickup radii apart, clear of walls and obstacles.
@@ -180,7 +181,7 @@ class ContinuousWorldEnv(gym.Env):
         for _ in range(n):
             for _ in range(_PLACEMENT_TRIES // 20):
                 cand = rng.uniform(-self.half + margin, self.half - margin, (20, 2))
-                ok = [self._clear(c, margin) for c in cand] if self.scene.obstacles else np.ones(20, bool)
+                ok = self._clear(cand, margin)
                 if len(points):
                     gaps = np.linalg.norm(cand[:, None, :] - points[None, :, :], axis=2).min(axis=1)
                     ok = ok & (gaps >= spacing)
@@ -200,7 +201,7 @@ class ContinuousWorldEnv(gym.Env):
         jitter = max(0.0, (step - spacing) / 2)
         axis = np.linspace(-self.half + margin, self.half - margin, per_side)
         cells = np.array([(x, y) for x in axis for y in axis])
-        cells = cells[[self._clear(c, margin) for c in cells]]
+        cells = cells[self._clear(cells, margin)]
         if len(cells) < n:
             raise RuntimeError(f"{self.task.name}: {n} positions do not fit the arena")
         chosen = cells[self.np_random.permutation(len(cells))[:n]]

@@ -20,16 +20,7 @@ import numpy as np
 import craftsuite  # chooses MUJOCO_GL before mujoco is imported
 import mujoco
 from craftsuite.envs.continuous import FRAME_SKIP
-
-
-def env_steps(env, actions) -> float:
-    env.reset(seed=0)
-    t = time.perf_counter()
-    for a in actions:
-        _, _, term, trunc, _ = env.step(a)
-        if term or trunc:
-            env.reset()
-    return len(actions) / (time.perf_counter() - t)
+from _timing import reset_ms, steps_per_second
 
 
 def raw_steps(model, n) -> float:
@@ -67,12 +58,9 @@ def main():
         product = gym.make(env_id, product=True, render_mode="rgb_array")
         world = product.unwrapped
         raw = raw_steps(world.model, args.steps)
-        w = env_steps(world, actions)
-        p = max(env_steps(product, actions) for _ in range(2))
-        t = time.perf_counter()
-        for seed in range(500):
-            product.reset(seed=seed)
-        reset_ms = (time.perf_counter() - t) / 500 * 1000
+        w = steps_per_second(world, actions)
+        p = max(steps_per_second(product, actions) for _ in range(2))
+        reset = reset_ms(product)
         fps = "-"
         if not args.no_render:
             product.render()
@@ -81,7 +69,7 @@ def main():
                 product.render()
             fps = f"{100 / (time.perf_counter() - t):.0f}"
         product.close()
-        print(f"| {env_id} | {raw:,.0f} | {w:,.0f} | {p:,.0f} | {reset_ms:.3f} | {fps} |", flush=True)
+        print(f"| {env_id} | {raw:,.0f} | {w:,.0f} | {p:,.0f} | {reset:.3f} | {fps} |", flush=True)
     print(f"\ndm_control point_mass (easy) via dm_env: {dm_control_point_mass(args.steps):,.0f} steps/s")
 
 

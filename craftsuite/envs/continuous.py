@@ -6,11 +6,11 @@ import gymnasium as gym
 import mujoco
 import numpy as np
 
-from ..labelling import Labeller
 from ..registration import resolve_task
 from ..rendering.gl import gl_error_hint
 from ..rendering.panel import status_panel
 from ..rules import Rules
+from ..tracking import ObjectiveTracker
 from ..spec import TaskSpec
 from .scene import AGENT_HALF, build_scene
 
@@ -85,21 +85,18 @@ class ContinuousWorldEnv(gym.Env):
         self._geom_ids = np.array([self.model.geom(n).id for n in scene.object_bodies])
         self._rgba = self.model.geom_rgba[self._geom_ids].copy()
         self._kinds = list(scene.object_kinds)
-        self.automaton = spec.automaton
         self.rules = Rules(spec)
-        self.labeller = Labeller(spec, self.automaton.propositions)
+        self.tracker = ObjectiveTracker(spec)
+        self.automaton = self.tracker.automaton
+        self.labeller = self.tracker.labeller
         n_obj = len(self._kinds)
         self._is_item = np.array([k < self.rules.n_items for k in self._kinds])
         self._inv_offset = 4 + 3 * n_obj
         n_obs = self._inv_offset + len(self.rules.inventory_names)
         self.observation_space = gym.spaces.Box(-1.0, 1.0, (n_obs,), dtype=np.float32)
         self.action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
-        self._rows = self.automaton.delta.tolist()
-        self._accepting = self.automaton.accepting.tolist()
-        self._rejecting = self.automaton.rejecting.tolist()
         self._step_reward = spec.step_reward
         self._boundary_reward = cfg.boundary_reward
-        self._completion = spec.completion_reward
         self._wall_limit = self.half - AGENT_HALF - 0.02  # agent touching the boundary wall
         self._obs = np.zeros(n_obs, dtype=np.float32)
         self._positions = np.zeros((n_obj, 2))
@@ -109,10 +106,8 @@ class ContinuousWorldEnv(gym.Env):
         self._radius2 = self.radius ** 2
         self._offset_scale = np.zeros((n_obj, 1))
         self._obs_objects = self._object_view()
-        self._label_names: dict[int, tuple[str, ...]] = {}
         self._renderer = None
         self._started = False
-        self.automaton_state = self.automaton.initial
         self.inventory_counts = self.rules.new_inventory()
 
     def _object_view(self) -> np.ndarray:
@@ -131,6 +126,10 @@ class ContinuousWorldEnv(gym.Env):
             "inventory": slice(self._inv_offset, self._inv_offset + len(self.inventory_counts)),
             "inventory_names": self.rules.inventory_names,
         }
+
+    @property
+    def automaton_state(self) -> int:
+        return self.tracker.state
 
     @property
     def inventory(self) -> dict[str, int]:
@@ -225,15 +224,12 @@ class ContinuousWorldEnv(gym.Env):
         mujoco.mj_forward(model, data)
         self.inventory_counts = self.rules.new_inventory()
         self._level_mask = self.labeller.levels(self.inventory_counts)
-        self.automaton_state = self.automaton.initial
         self._started = True
         obs = self._obs
         obs[:] = 0.0
         self._obs_objects[:, 2] = 1.0
         self._write_observation(self._positions - data.qpos[:2])
-        info = {"labels": (), "label_mask": 0, "automaton_state": self.automaton_state,
-                "automaton_transition": None, "is_success": False, "violation": False}
-        return obs.copy(), info
+        return obs.copy(), self.tracker.reset()
 
     def _write_observation(self, offsets: np.ndarray):
         """Agent state and object offsets (``offsets`` = object positions - agent position)."""
@@ -282,19 +278,8 @@ class ContinuousWorldEnv(gym.Env):
             self._any_inside = bool(inside.any())
         self._write_observation(offsets)
 
-        w = self.automaton_state
-        w2 = self._rows[w][mask]
-        self.automaton_state = w2
-        success, violation = self._accepting[w2], self._rejecting[w2]
-        if success:
-            reward += self._completion
-        labels = self._label_names.get(mask)
-        if labels is None:
-            labels = self._label_names[mask] = self.labeller.names(mask)
-        info = {"labels": labels, "label_mask": mask, "automaton_state": w2,
-                "automaton_transition": (w, mask, w2), "is_success": success,
-                "violation": violation}
-        return self._obs.copy(), reward, success or violation, False, info
+        bonus, done, info = self.tracker.advance(mask)
+        return self._obs.copy(), reward + bonus, done, False, info
 
     def _touch(self, inside: np.ndarray, mask: int, reward: float) -> tuple[int, float]:
         """Apply the rules to every object whose zone the agent is in; return (label, reward)."""
@@ -352,9 +337,8 @@ class ContinuousWorldEnv(gym.Env):
                 raise RuntimeError(gl_error_hint(err)) from err
         self._renderer.update_scene(self.data, camera="top")
         frame = self._renderer.render()
-        w = self.automaton_state
-        flag = "accepted" if self._accepting[w] else "violated" if self._rejecting[w] else ""
-        panel = status_panel(self.width, self.inventory, w, self.automaton.n_states, flag)
+        panel = status_panel(self.width, self.inventory, self.automaton_state, self.automaton.n_states,
+                             self.tracker.flag)
         return np.concatenate([frame, panel], axis=0)
 
     def close(self):

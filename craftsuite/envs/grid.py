@@ -5,9 +5,9 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 
-from ..labelling import Labeller
 from ..rendering.grid import EMPTY, WALL, draw_grid, grid_text
 from ..rules import Rules
+from ..tracking import ObjectiveTracker
 from ..spec import TaskSpec
 from ..registration import resolve_task
 
@@ -76,9 +76,10 @@ class GridWorldEnv(gym.Env):
         self.size = size
         self.render_mode = render_mode
         spec = self.task
-        self.automaton = spec.automaton
         self.rules = Rules(spec)
-        self.labeller = Labeller(spec, self.automaton.propositions)
+        self.tracker = ObjectiveTracker(spec)
+        self.automaton = self.tracker.automaton
+        self.labeller = self.tracker.labeller
         self._objects = spec.objects
         self._obstacles = sorted({y * size + x for x, y in spec.grid.obstacles})
         n_cells = size * size
@@ -96,15 +97,9 @@ class GridWorldEnv(gym.Env):
         self.action_space = gym.spaces.Discrete(4)
         self._inv_scale = self.rules.scale
         self._step_reward = spec.step_reward
-        self._completion = spec.completion_reward
-        self._rows = self.automaton.delta.tolist()
-        self._accepting = self.automaton.accepting.tolist()
-        self._rejecting = self.automaton.rejecting.tolist()
-        self._label_names: dict[int, tuple[str, ...]] = {}
         self._cells: list[int] = []
         self._obs = np.zeros(n_obs, dtype=np.float32)
         self._agent = 0
-        self.automaton_state = self.automaton.initial
         self.inventory_counts = self.rules.new_inventory()
 
     # -- public views --------------------------------------------------------------------------
@@ -118,6 +113,10 @@ class GridWorldEnv(gym.Env):
             "inventory_names": self.rules.inventory_names,
             "inventory_scale": tuple(self._inv_scale),
         }
+
+    @property
+    def automaton_state(self) -> int:
+        return self.tracker.state
 
     @property
     def inventory(self) -> dict[str, int]:
@@ -177,11 +176,7 @@ class GridWorldEnv(gym.Env):
                 obs[(2 + k) * n_cells + c] = 1.0
         self.inventory_counts = self.rules.new_inventory()
         self._level_mask = self.labeller.levels(self.inventory_counts)
-        self.automaton_state = self.automaton.initial
-        w = self.automaton_state
-        info = {"labels": (), "label_mask": 0, "automaton_state": w,
-                "automaton_transition": None, "is_success": False, "violation": False}
-        return obs.copy(), info
+        return obs.copy(), self.tracker.reset()
 
     def step(self, action):
         try:
@@ -226,20 +221,8 @@ class GridWorldEnv(gym.Env):
             elif arrived >= 0:
                 mask = self.labeller(inv, 0, arrived)
 
-        w = self.automaton_state
-        w2 = self._rows[w][mask]
-        self.automaton_state = w2
-        success = self._accepting[w2]
-        violation = self._rejecting[w2]
-        if success:
-            reward += self._completion
-        labels = self._label_names.get(mask)
-        if labels is None:
-            labels = self._label_names[mask] = self.labeller.names(mask)
-        info = {"labels": labels, "label_mask": mask, "automaton_state": w2,
-                "automaton_transition": (w, mask, w2), "is_success": success,
-                "violation": violation}
-        return obs.copy(), reward, success or violation, False, info
+        bonus, done, info = self.tracker.advance(mask)
+        return obs.copy(), reward + bonus, done, False, info
 
     def render(self):
         if self.render_mode is None:
@@ -251,9 +234,7 @@ class GridWorldEnv(gym.Env):
             text = grid_text(self.size, self._cells, self._agent, self._objects)
             held = ", ".join(f"{k} {v}" for k, v in self.inventory.items() if v) or "nothing"
             return f"{text}\ninventory: {held}; automaton state {self.automaton_state}\n"
-        w = self.automaton_state
-        flag = "accepted" if self._accepting[w] else "violated" if self._rejecting[w] else ""
-        panel = {"inventory": self.inventory, "automaton_state": w,
-                 "n_states": self.automaton.n_states, "flag": flag}
+        panel = {"inventory": self.inventory, "automaton_state": self.automaton_state,
+                 "n_states": self.automaton.n_states, "flag": self.tracker.flag}
         return draw_grid(self.size, self._cells, self._agent, self._objects,
                          self.rules.is_place, panel)

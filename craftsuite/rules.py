@@ -74,15 +74,23 @@ class Rules:
 
     @staticmethod
     def _max_counts(spec: TaskSpec, slot: dict[str, int]) -> list[float]:
-        """An upper bound of each inventory count, to normalise observations into [0, 1]."""
-        top = [0.0] * len(slot)
+        """An upper bound of each inventory count, to normalise observations into [0, 1].
+
+        Capacity limits what is held at once, not what flows through recipes over an
+        episode (3 wood carried 2 at a time still make 3 tools), and a place recipe runs
+        again on every arrival: produced counts are bounded by the total supply.
+        """
+        supply = [0.0] * len(slot)  # how many can ever be obtained in an episode
+        held = [0.0] * len(slot)
         for it in spec.items:
-            top[slot[it.name]] = float(it.capacity or it.count)
+            supply[slot[it.name]] = float(it.count)
+            held[slot[it.name]] = float(min(it.capacity or it.count, it.count))
         for r in spec.recipes:  # recipes appear after what they consume in spec.inventory
-            runs = min(top[slot[n]] // k for n, k in r.consume.items())
+            runs = min(supply[slot[n]] // k for n, k in r.consume.items())
             for n, k in r.produce.items():
-                top[slot[n]] += k * (runs if r.repeat else min(runs, 1))
-        return [max(t, 1.0) for t in top]
+                supply[slot[n]] += k * runs
+                held[slot[n]] = supply[slot[n]]
+        return [max(h, 1.0) for h in held]
 
     def new_inventory(self) -> list[int]:
         return [0] * len(self.inventory_names)

@@ -374,6 +374,8 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
         produce = r.counts(rec.get("produce", {}), f"{where}.produce", inventory)
         if not consume or not produce:
             r.fail(where, "a recipe needs both 'consume' and 'produce'")
+        if repeat and all(produce.get(n, 0) >= k for n, k in consume.items()):
+            r.fail(f"{where}.repeat", "this recipe gives back all it consumes: repeating it would never stop")
         recipes.append(Recipe(consume=consume, produce=produce, at=at, repeat=repeat))
 
     if "propositions" not in data:

@@ -81,6 +81,11 @@ class ContinuousWorldEnv(gym.Env):
         self.scene = scene = build_scene(spec)
         self.model = mujoco.MjModel.from_xml_string(scene.xml)
         self.data = mujoco.MjData(self.model)
+        # An orthographic fovy is the vertical extent in metres; widen it for tall frames so
+        # the whole arena stays in view across the narrower side.
+        top = self.model.camera("top").id
+        self.model.cam_fovy[top] *= max(1.0, height / width)
+        self._view_height = float(self.model.cam_fovy[top])
         self._body_ids = np.array([self.model.body(n).id for n in scene.object_bodies])
         self._geom_ids = np.array([self.model.geom(n).id for n in scene.object_bodies])
         self._rgba = self.model.geom_rgba[self._geom_ids].copy()
@@ -319,9 +324,10 @@ class ContinuousWorldEnv(gym.Env):
     # -- rendering -----------------------------------------------------------------------------------
     def world_to_pixel(self, x: float, y: float) -> tuple[int, int]:
         """(column, row) of an arena point in the camera image (top-down, orthographic)."""
-        extent = self.model.cam_fovy[self.model.camera("top").id]
-        col = (x / extent + 0.5) * self.width
-        row = (0.5 - y / extent) * self.height
+        tall = self._view_height
+        wide = tall * self.width / self.height
+        col = (x / wide + 0.5) * self.width
+        row = (0.5 - y / tall) * self.height
         return int(col), int(row)
 
     def render(self):

@@ -193,6 +193,26 @@ def test_frame_shows_the_agent_where_it_is(gl_available):
     env.close()
 
 
+@pytest.mark.parametrize("width, height", [(240, 240), (480, 240), (240, 480)])
+def test_world_to_pixel_any_frame_shape(gl_available, width, height):
+    if not gl_available:
+        pytest.skip(gl_available.reason)
+    env = make(render_mode="rgb_array", width=width, height=height)
+    env.reset(seed=0)
+    env._positions[:] = 1e6
+    place_agent(env, np.array([-1.0, -1.0]))
+    elsewhere = env.render()[:height].max(axis=2)
+    place_agent(env, np.array([1.0, 1.0]))
+    here = env.render()[:height].max(axis=2)
+    agent = np.argwhere((here < 40) & (elsewhere > 100))  # pixels the agent moved onto
+    row, col = agent.mean(axis=0)
+    assert np.allclose((col, row), env.world_to_pixel(1.0, 1.0), atol=3)
+    for corner in ((-3.5, -3.5), (3.5, 3.5)):  # the whole arena is in view
+        c, r = env.world_to_pixel(*corner)
+        assert 0 <= c < width and 0 <= r < height
+    env.close()
+
+
 def test_renderer_closes_cleanly_at_exit(gl_available):
     if not gl_available:
         pytest.skip(gl_available.reason)

@@ -144,3 +144,21 @@ def test_product_observation_tail_is_automaton_one_hot(env_id):
         prev = w2
         if term or trunc:
             break
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_observations_stay_in_the_space_through_whole_episodes(env_id):
+    """check_env only looks at a few steps; scripted play reaches full inventories."""
+    from craftsuite.scripted import scripted_policy
+
+    for product in (False, True):
+        env = gym.make(env_id, product=product)
+        policy = scripted_policy(env)
+        for seed in range(3):
+            obs, _ = env.reset(seed=seed)
+            done = False
+            while not done:
+                assert env.observation_space.contains(obs), (seed, obs[obs > 1], obs[obs < -1])
+                obs, _, term, trunc, _ = env.step(policy(obs))
+                done = term or trunc
+            assert env.observation_space.contains(obs)

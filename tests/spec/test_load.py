@@ -94,6 +94,18 @@ def test_bad_spec_names_file_field_and_problem(tmp_path, edit, field, problem):
     assert problem in message, message
 
 
+def test_recipe_that_feeds_itself_is_rejected(tmp_path):
+    text = GOOD + """
+[[recipes]]
+at = "trap"
+consume = { coin = 1 }
+produce = { coin = 1, gem = 1 }
+repeat = true
+"""
+    with pytest.raises(SpecError, match="recipes\\[0\\].repeat: .*never stop"):
+        load_spec(write(tmp_path, text))
+
+
 def test_bad_toml_and_missing_file(tmp_path):
     with pytest.raises(SpecError, match=re.escape("not valid TOML")):
         load_spec(write(tmp_path, "name = \n"))

@@ -6,12 +6,10 @@ import gymnasium as gym
 import mujoco
 import numpy as np
 
-from ..registration import resolve_task
 from ..rendering.gl import gl_error_hint
 from ..rendering.panel import status_panel
-from ..rules import Rules
-from ..tracking import ObjectiveTracker
 from ..spec import TaskSpec
+from .base import CraftWorld
 from .scene import AGENT_HALF, build_scene
 
 FRAME_SKIP = 2  # physics steps of 0.025 s per action: control period 0.05 s
@@ -20,7 +18,7 @@ _PLACEMENT_TRIES = 200
 _FAR = 1e6  # where consumed objects are parked: never within reach
 
 
-class ContinuousWorldEnv(gym.Env):
+class ContinuousWorldEnv(CraftWorld):
     """A CraftSuite task in a MuJoCo arena with a point-mass agent.
 
     ## Description
@@ -67,12 +65,8 @@ class ContinuousWorldEnv(gym.Env):
 
     def __init__(self, task: str | TaskSpec = "BlindCraftsman", render_mode: str | None = None,
                  width: int = 240, height: int = 240):
-        self.task = spec = resolve_task(task)
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(
-                f"render_mode {render_mode!r} is not supported; use one of {self.metadata['render_modes']}"
-            )
-        self.render_mode = render_mode
+        super().__init__(task, render_mode)
+        spec = self.task
         self.width, self.height = width, height
         cfg = spec.continuous
         self.arena = cfg.arena
@@ -90,10 +84,6 @@ class ContinuousWorldEnv(gym.Env):
         self._geom_ids = np.array([self.model.geom(n).id for n in scene.object_bodies])
         self._rgba = self.model.geom_rgba[self._geom_ids].copy()
         self._kinds = list(scene.object_kinds)
-        self.rules = Rules(spec)
-        self.tracker = ObjectiveTracker(spec)
-        self.automaton = self.tracker.automaton
-        self.labeller = self.tracker.labeller
         n_obj = len(self._kinds)
         self._is_item = np.array([k < self.rules.n_items for k in self._kinds])
         self._inv_offset = 4 + 3 * n_obj
@@ -131,14 +121,6 @@ class ContinuousWorldEnv(gym.Env):
             "inventory": slice(self._inv_offset, self._inv_offset + len(self.inventory_counts)),
             "inventory_names": self.rules.inventory_names,
         }
-
-    @property
-    def automaton_state(self) -> int:
-        return self.tracker.state
-
-    @property
-    def inventory(self) -> dict[str, int]:
-        return dict(zip(self.rules.inventory_names, self.inventory_counts))
 
     @property
     def agent_position(self) -> np.ndarray:

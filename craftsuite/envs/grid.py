@@ -6,17 +6,15 @@ import gymnasium as gym
 import numpy as np
 
 from ..rendering.grid import EMPTY, WALL, draw_grid, grid_text
-from ..rules import Rules
-from ..tracking import ObjectiveTracker
 from ..spec import TaskSpec
-from ..registration import resolve_task
+from .base import CraftWorld
 
 # action -> (dx, dy); y grows downwards (row 0 is the top row)
 _MOVES = {0: (0, -1), 1: (1, 0), 2: (0, 1), 3: (-1, 0)}
 ACTION_NAMES = ("up", "right", "down", "left")
 
 
-class GridWorldEnv(gym.Env):
+class GridWorldEnv(CraftWorld):
     """A CraftSuite task on a square grid, with its LTLf objective tracked as a DFA.
 
     ## Description
@@ -66,20 +64,11 @@ class GridWorldEnv(gym.Env):
 
     def __init__(self, task: str | TaskSpec = "BlindCraftsman", size: int = 7,
                  render_mode: str | None = None):
-        self.task = resolve_task(task)
+        super().__init__(task, render_mode)
         if not isinstance(size, int) or size < 2:
             raise ValueError(f"size must be an integer >= 2, got {size!r}")
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(
-                f"render_mode {render_mode!r} is not supported; use one of {self.metadata['render_modes']}"
-            )
         self.size = size
-        self.render_mode = render_mode
         spec = self.task
-        self.rules = Rules(spec)
-        self.tracker = ObjectiveTracker(spec)
-        self.automaton = self.tracker.automaton
-        self.labeller = self.tracker.labeller
         self._objects = spec.objects
         self._obstacles = sorted({y * size + x for x, y in spec.grid.obstacles})
         n_cells = size * size
@@ -100,7 +89,6 @@ class GridWorldEnv(gym.Env):
         self._cells: list[int] = []
         self._obs = np.zeros(n_obs, dtype=np.float32)
         self._agent = 0
-        self.inventory_counts = self.rules.new_inventory()
 
     # -- public views --------------------------------------------------------------------------
     @property
@@ -113,14 +101,6 @@ class GridWorldEnv(gym.Env):
             "inventory_names": self.rules.inventory_names,
             "inventory_scale": tuple(self._inv_scale),
         }
-
-    @property
-    def automaton_state(self) -> int:
-        return self.tracker.state
-
-    @property
-    def inventory(self) -> dict[str, int]:
-        return dict(zip(self.rules.inventory_names, self.inventory_counts))
 
     @property
     def agent_position(self) -> tuple[int, int]:

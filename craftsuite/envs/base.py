@@ -1,0 +1,37 @@
+"""What every CraftSuite world shares: its task, rules, objective tracker and their views."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+
+from ..registration import resolve_task
+from ..rules import Rules
+from ..spec import TaskSpec
+from ..tracking import ObjectiveTracker
+
+
+class CraftWorld(gym.Env):
+    """Base of the grid and MuJoCo worlds. Subclasses lay out the world and move the agent;
+    touching objects goes through ``self.rules``, labels through ``self.labeller`` and the
+    objective through ``self.tracker``."""
+
+    def __init__(self, task: str | TaskSpec, render_mode: str | None):
+        self.task = resolve_task(task)
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode {render_mode!r} is not supported; use one of {self.metadata['render_modes']}"
+            )
+        self.render_mode = render_mode
+        self.rules = Rules(self.task)
+        self.tracker = ObjectiveTracker(self.task)
+        self.automaton = self.tracker.automaton
+        self.labeller = self.tracker.labeller
+        self.inventory_counts = self.rules.new_inventory()
+
+    @property
+    def automaton_state(self) -> int:
+        return self.tracker.state
+
+    @property
+    def inventory(self) -> dict[str, int]:
+        return dict(zip(self.rules.inventory_names, self.inventory_counts))

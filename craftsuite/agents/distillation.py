@@ -1,0 +1,181 @@
+"""Automaton distillation: a teacher's knowledge as Q-values on automaton transitions.
+
+``AutomatonQTable`` holds ``q[w, sigma]`` and ``counts[w, sigma]`` over the automaton
+states and label masks of one task (dense: ``(n_states, 2**n_props)``), with the
+automaton's fingerprint so that it cannot be applied to another task by mistake.
+
+* ``dynamic_distillation``: from a teacher's replay, the mean Q of the action taken, per
+  (w, sigma) (the paper's Eq. 3-4; the authors' code uses the taken action, not the max).
+* ``static_distillation``: value iteration over the abstract MDP whose states are
+  automaton states and whose actions are labels (the paper's static baseline).
+
+``DistilledTarget`` is the students' one change (Eq. 5-6): Q' = beta Q_teacher +
+(1 - beta) Q_target with beta = rho ** eta_student(w, sigma), beta = 0 where the teacher
+has no value.
+"""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch as th
+
+from ..automata import Automaton
+
+FORMAT_VERSION = 1
+
+
+class DistillationError(ValueError):
+    """A distilled table that cannot be used here (corrupt, or made for another automaton)."""
+
+
+@dataclass
+class AutomatonQTable:
+    q: np.ndarray  # (n_states, n_labels) float64; meaningless where counts == 0
+    counts: np.ndarray  # (n_states, n_labels) int64: teacher transitions behind each value
+    fingerprint: str
+    propositions: tuple[str, ...]
+    kind: str  # "dynamic" or "static"
+
+    @property
+    def seen(self) -> np.ndarray:
+        return self.counts > 0
+
+    def check(self, automaton: Automaton) -> None:
+        """Raise DistillationError unless the table was made for this automaton."""
+        if self.fingerprint != automaton.fingerprint or self.q.shape != automaton.delta.shape:
+            raise DistillationError(
+                f"this {self.kind} table was distilled for automaton {self.fingerprint} over "
+                f"{list(self.propositions)}, not for {automaton.fingerprint} over "
+                f"{list(automaton.propositions)} ({automaton.formula!r})"
+            )
+
+    def edge_values(self, automaton: Automaton) -> dict[tuple[int, int], float]:
+        """Mean value per (source, target) edge over its seen labels (for drawings)."""
+        self.check(automaton)
+        out = {}
+        for s, t in automaton.edges(include_sink=True):
+            sel = (automaton.delta[s] == t) & self.seen[s]
+            if sel.any():
+                out[(s, t)] = float(np.average(self.q[s, sel], weights=self.counts[s, sel]))
+        return out
+
+    def describe(self, automaton: Automaton) -> str:
+        values = self.edge_values(automaton)
+        lines = [f"{self.kind} automaton Q-table for {automaton.formula}"]
+        for s, t in automaton.edges(include_sink=True):
+            v = values.get((s, t))
+            lines.append(f"  {s} -> {t} [{automaton.guard(s, t, sink_free=True)}]: "
+                         + (f"{v:.2f}" if v is not None else "unseen"))
+        return "\n".join(lines)
+
+    def save(self, path) -> Path:
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(path.name + ".tmp")
+        meta = {"format": FORMAT_VERSION, "fingerprint": self.fingerprint, "kind": self.kind,
+                "propositions": list(self.propositions)}
+        with open(tmp, "wb") as f:
+            np.savez(f, q=self.q, counts=self.counts, meta=np.array(json.dumps(meta)))
+        tmp.replace(path)  # atomic: a crash never leaves half a table behind
+        return path
+
+    @classmethod
+    def load(cls, path, automaton: Automaton | None = None) -> "AutomatonQTable":
+        path = Path(path)
+        if not path.is_file():
+            raise FileNotFoundError(f"no distilled table at {path}")
+        try:
+            with np.load(path, allow_pickle=False) as f:
+                meta = json.loads(str(f["meta"]))
+                q, counts = f["q"], f["counts"]
+        except (OSError, ValueError, KeyError, zipfile.BadZipFile, json.JSONDecodeError) as err:
+            raise DistillationError(f"{path} is not a CraftSuite distilled table (corrupt?): {err}") from None
+        if meta.get("format") != FORMAT_VERSION or q.shape != counts.shape:
+            raise DistillationError(f"{path}: unsupported table format {meta.get('format')!r}")
+        table = cls(q=q, counts=counts, fingerprint=meta["fingerprint"],
+                    propositions=tuple(meta["propositions"]), kind=meta["kind"])
+        if automaton is not None:
+            table.check(automaton)
+        return table
+
+
+def dynamic_distillation(automaton: Automaton, w: np.ndarray, sigma: np.ndarray,
+                         q_taken: np.ndarray) -> AutomatonQTable:
+    """Mean teacher Q of the taken action per (w, sigma) over a teacher's transitions."""
+    w, sigma = np.asarray(w).reshape(-1), np.asarray(sigma).reshape(-1)
+    q_taken = np.asarray(q_taken, dtype=np.float64).reshape(-1)
+    if not (len(w) == len(sigma) == len(q_taken)):
+        raise ValueError("w, sigma and q_taken must have one entry per transition")
+    shape = automaton.delta.shape
+    if len(w) and (w.max() >= shape[0] or sigma.max() >= shape[1] or min(w.min(), sigma.min()) < 0):
+        raise DistillationError("transitions name automaton states or labels this automaton does not have")
+    sums = np.zeros(shape)
+    counts = np.zeros(shape, dtype=np.int64)
+    np.add.at(sums, (w, sigma), q_taken)
+    np.add.at(counts, (w, sigma), 1)
+    q = np.divide(sums, counts, out=np.zeros(shape), where=counts > 0)
+    return AutomatonQTable(q, counts, automaton.fingerprint, automaton.propositions, "dynamic")
+
+
+def static_distillation(automaton: Automaton, step_reward: float = -0.1, progress_reward: float = 1.0,
+                        completion_reward: float = 100.0, gamma: float = 0.99,
+                        tolerance: float = 1e-10) -> AutomatonQTable:
+    """Value iteration over the automaton alone, with the authors' rewards.
+
+    Each label is an action: -0.1 per transition, +1 when the automaton state changes,
+    +100 on reaching acceptance. Accepting states and the rejecting sink end the episode
+    (CraftSuite ends episodes there); entering the sink is no progress (no +1).
+    """
+    delta = automaton.delta.astype(np.int64)
+    accepting, rejecting = automaton.accepting, automaton.rejecting
+    terminal = accepting | rejecting
+    changed = delta != np.arange(len(delta))[:, None]
+    reward = (step_reward + progress_reward * (changed & ~rejecting[delta])
+              + completion_reward * accepting[delta])
+    cont = (~terminal[delta]).astype(np.float64)
+    v = np.zeros(len(delta))
+    for _ in range(100_000):
+        q = reward + gamma * cont * v[delta]
+        v_new = np.where(terminal, 0.0, q.max(axis=1))
+        if np.abs(v_new - v).max() < tolerance:
+            v = v_new
+            break
+        v = v_new
+    q = reward + gamma * cont * v[delta]
+    counts = np.where(terminal[:, None], 0, 1) * np.ones_like(delta)
+    return AutomatonQTable(q, counts.astype(np.int64), automaton.fingerprint, automaton.propositions, "static")
+
+
+class DistilledTarget:
+    """The students' target: Q' = beta Q_teacher(w, sigma) + (1 - beta) Q_target.
+
+    beta = rho ** eta_student(w, sigma), where eta_student counts how often (w, sigma) was
+    sampled in the student's minibatches before this one (the first use trusts the teacher
+    fully); beta = 0 where the teacher has no value. Counts go up by one per sampled
+    transition, duplicates in a minibatch included.
+    """
+
+    def __init__(self, table: AutomatonQTable, automaton: Automaton, rho: float = 0.999):
+        table.check(automaton)
+        if not 0.0 <= rho <= 1.0:
+            raise ValueError(f"rho must lie in [0, 1], got {rho}")
+        self.table, self.rho = table, rho
+        self.q_teacher = table.q.astype(np.float32)
+        self.seen = table.seen
+        self.student_counts = np.zeros(table.q.shape, dtype=np.int64)
+
+    def beta(self, w: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+        return np.where(self.seen[w, sigma], self.rho ** self.student_counts[w, sigma], 0.0)
+
+    def __call__(self, w: np.ndarray, sigma: np.ndarray, q_target: th.Tensor) -> th.Tensor:
+        beta = self.beta(w, sigma).astype(np.float32)
+        np.add.at(self.student_counts, (w, sigma), 1)
+        teacher = self.q_teacher[w, sigma]
+        beta_t = th.as_tensor(beta, device=q_target.device).reshape(q_target.shape)
+        teacher_t = th.as_tensor(teacher, device=q_target.device).reshape(q_target.shape)
+        return beta_t * teacher_t + (1.0 - beta_t) * q_target

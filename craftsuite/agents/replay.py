@@ -1,0 +1,145 @@
+"""Replay with automaton fields and prioritized sampling, for SB3's off-policy algorithms.
+
+``AutomatonReplayBuffer`` is an SB3 ``ReplayBuffer`` that also keeps, per transition, the
+automaton transition ``(w, sigma, w')`` that the world put in ``info["automaton_transition"]``
+(SB3 hands ``add`` the infos of the step, including the terminal step of an episode under
+autoreset), and samples by priority: P(i) ~ p_i ** alpha, importance weights
+(N P(i)) ** -beta normalised by their maximum, new transitions at the maximum priority.
+"""
+
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import numpy as np
+import torch as th
+from gymnasium import spaces
+from stable_baselines3.common.buffers import ReplayBuffer
+
+
+class AutomatonSamples(NamedTuple):
+    observations: th.Tensor
+    actions: th.Tensor
+    next_observations: th.Tensor
+    dones: th.Tensor
+    rewards: th.Tensor
+    discounts: th.Tensor | None
+    weights: th.Tensor  # importance weights (ones when sampling uniformly), shape (B, 1)
+    indices: np.ndarray  # flat buffer indices, for update_priorities
+    w: np.ndarray  # automaton state before the step
+    sigma: np.ndarray  # label mask of the step
+    w_next: np.ndarray  # automaton state after the step
+
+
+class SumTree:
+    """Priorities in a binary sum tree: O(log n) updates and proportional sampling, batched."""
+
+    def __init__(self, capacity: int):
+        self.leaves = 1 << max(0, int(np.ceil(np.log2(max(capacity, 1)))))
+        self.tree = np.zeros(2 * self.leaves)
+
+    def total(self) -> float:
+        return float(self.tree[1])
+
+    def update(self, indices: np.ndarray, values: np.ndarray) -> None:
+        nodes = np.asarray(indices) + self.leaves
+        self.tree[nodes] = values
+        nodes = np.unique(nodes // 2)
+        while nodes[0] >= 1:
+            self.tree[nodes] = self.tree[2 * nodes] + self.tree[2 * nodes + 1]
+            if nodes[0] == 1:
+                break
+            nodes = np.unique(nodes // 2)
+
+    def find(self, targets: np.ndarray) -> np.ndarray:
+        """Leaf index whose cumulative-sum interval contains each target."""
+        nodes = np.ones(len(targets), dtype=np.int64)
+        targets = targets.copy()
+        while nodes[0] < self.leaves:
+            left = 2 * nodes
+            go_right = targets >= self.tree[left]
+            targets = np.where(go_right, targets - self.tree[left], targets)
+            nodes = np.where(go_right, left + 1, left)
+        return nodes - self.leaves
+
+
+class AutomatonReplayBuffer(ReplayBuffer):
+    """SB3 replay buffer + ``(w, sigma, w')`` per transition + optional prioritized sampling.
+
+    Args (beyond SB3's):
+        prioritized: sample by priority (else uniformly, with unit weights).
+        alpha: priority exponent (0.7 in the paper's code).
+        beta: importance-weight exponent.
+        epsilon: added to |TD error| when priorities are updated (0.1 in the paper's code).
+    """
+
+    def __init__(self, buffer_size: int, observation_space: spaces.Space, action_space: spaces.Space,
+                 device: th.device | str = "auto", n_envs: int = 1, optimize_memory_usage: bool = False,
+                 handle_timeout_termination: bool = True, prioritized: bool = True,
+                 alpha: float = 0.7, beta: float = 0.4, epsilon: float = 0.1):
+        super().__init__(buffer_size, observation_space, action_space, device, n_envs,
+                         optimize_memory_usage=optimize_memory_usage,
+                         handle_timeout_termination=handle_timeout_termination)
+        self.w = np.zeros((self.buffer_size, self.n_envs), dtype=np.int32)
+        self.sigma = np.zeros((self.buffer_size, self.n_envs), dtype=np.int32)
+        self.w_next = np.zeros((self.buffer_size, self.n_envs), dtype=np.int32)
+        self.prioritized = prioritized
+        self.alpha, self.beta, self.epsilon = alpha, beta, epsilon
+        self.tree = SumTree(self.buffer_size * self.n_envs) if prioritized else None
+        self.max_priority = 1.0
+
+    def add(self, obs, next_obs, action, reward, done, infos: list[dict[str, Any]]) -> None:
+        pos = self.pos
+        for env, info in enumerate(infos):
+            try:
+                self.w[pos, env], self.sigma[pos, env], self.w_next[pos, env] = info["automaton_transition"]
+            except (KeyError, TypeError, ValueError):
+                raise ValueError(
+                    "AutomatonReplayBuffer needs info['automaton_transition'] = (w, sigma, w') from every "
+                    "step: use a CraftSuite world (any id, product=True for an automaton-aware policy)"
+                ) from None
+        if self.tree is not None:
+            flat = pos * self.n_envs + np.arange(self.n_envs)
+            self.tree.update(flat, np.full(self.n_envs, self.max_priority ** self.alpha))
+        super().add(obs, next_obs, action, reward, done, infos)
+
+    def sample(self, batch_size: int, env=None) -> AutomatonSamples:
+        size = self.buffer_size if self.full else self.pos
+        if size == 0:
+            raise RuntimeError("cannot sample from an empty replay buffer")
+        if self.tree is None:
+            flat = np.random.randint(0, size * self.n_envs, size=batch_size)
+            weights = np.ones(batch_size, dtype=np.float32)
+        else:
+            total = self.tree.total()
+            targets = (np.arange(batch_size) + np.random.random(batch_size)) * (total / batch_size)
+            flat = np.minimum(self.tree.find(np.minimum(targets, total * (1 - 1e-12))), size * self.n_envs - 1)
+            probs = self.tree.tree[flat + self.tree.leaves] / total
+            weights = (size * self.n_envs * probs) ** (-self.beta)
+            weights = (weights / weights.max()).astype(np.float32)
+        return self._samples(flat, weights, env)
+
+    def _samples(self, flat: np.ndarray, weights: np.ndarray, env=None) -> AutomatonSamples:
+        batch, envs = np.divmod(flat, self.n_envs)
+        if self.optimize_memory_usage:
+            next_obs = self.observations[(batch + 1) % self.buffer_size, envs, :]
+        else:
+            next_obs = self.next_observations[batch, envs, :]
+        dones = self.dones[batch, envs] * (1 - self.timeouts[batch, envs])
+        tensors = tuple(map(self.to_torch, (
+            self._normalize_obs(self.observations[batch, envs, :], env),
+            self.actions[batch, envs, :],
+            self._normalize_obs(next_obs, env),
+            dones.reshape(-1, 1),
+            self._normalize_reward(self.rewards[batch, envs].reshape(-1, 1), env),
+        )))
+        return AutomatonSamples(*tensors, None, self.to_torch(weights.reshape(-1, 1)), flat,
+                                self.w[batch, envs], self.sigma[batch, envs], self.w_next[batch, envs])
+
+    def update_priorities(self, indices: np.ndarray, td_errors: np.ndarray) -> None:
+        """New priorities |TD error| + epsilon for the sampled transitions."""
+        if self.tree is None:
+            return
+        priorities = np.abs(np.asarray(td_errors, dtype=np.float64).reshape(-1)) + self.epsilon
+        self.max_priority = max(self.max_priority, float(priorities.max()))
+        self.tree.update(indices, priorities ** self.alpha)

@@ -1,0 +1,111 @@
+"""DQN teachers and students: SB3's DQN with a dueling head, the double-DQN target,
+prioritized replay and, for students, the distilled target.
+
+Where this differs from SB3's DQN, and nowhere else:
+* ``DuelingQNetwork``: Q = V + A - mean(A) on SB3's MLP trunk (a policy class).
+* ``AutomatonDQN._td_target``: the one seam for the target (double DQN, then the distilled
+  mix when a ``DistilledTarget`` is given).
+* ``AutomatonDQN.train``: SB3's loop, with the loss weighted by importance weights and
+  the priorities updated from the TD errors.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch as th
+import torch.nn.functional as F
+from stable_baselines3 import DQN
+from stable_baselines3.common.torch_layers import create_mlp
+from stable_baselines3.dqn.policies import DQNPolicy, QNetwork
+from torch import nn
+
+from .distillation import DistilledTarget
+from .replay import AutomatonReplayBuffer, AutomatonSamples
+
+
+class _DuelingHead(nn.Module):
+    def __init__(self, in_dim: int, n_actions: int, net_arch: list[int], activation_fn):
+        super().__init__()
+        self.trunk = nn.Sequential(*create_mlp(in_dim, -1, net_arch, activation_fn))
+        width = net_arch[-1] if net_arch else in_dim
+        self.value = nn.Linear(width, 1)
+        self.advantage = nn.Linear(width, n_actions)
+
+    def forward(self, x: th.Tensor) -> th.Tensor:
+        h = self.trunk(x)
+        a = self.advantage(h)
+        return self.value(h) + a - a.mean(dim=1, keepdim=True)
+
+
+class DuelingQNetwork(QNetwork):
+    """SB3's QNetwork with its MLP replaced by a dueling head (same trunk sizes)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.q_net = _DuelingHead(self.features_dim, int(self.action_space.n), self.net_arch, self.activation_fn)
+
+
+class DuelingDQNPolicy(DQNPolicy):
+    def make_q_net(self) -> DuelingQNetwork:
+        net_args = self._update_features_extractor(self.net_args, features_extractor=None)
+        return DuelingQNetwork(**net_args).to(self.device)
+
+
+class AutomatonDQN(DQN):
+    """DQN for CraftSuite worlds: dueling, double, prioritized, optionally distilled.
+
+    Args (beyond SB3's DQN):
+        double: use the double-DQN target (online argmax, target-network value).
+        dueling: with ``policy="MlpPolicy"``, use ``DuelingDQNPolicy``.
+        prioritized: prioritized replay (``AutomatonReplayBuffer``), else uniform.
+        distill: a ``DistilledTarget`` for students; None for teachers and baselines.
+    """
+
+    def __init__(self, policy, env, *, double: bool = True, dueling: bool = True, prioritized: bool = True,
+                 distill: DistilledTarget | None = None, replay_buffer_kwargs: dict | None = None, **kwargs):
+        if dueling and policy == "MlpPolicy":
+            policy = DuelingDQNPolicy
+        kwargs.setdefault("replay_buffer_class", AutomatonReplayBuffer)
+        replay_buffer_kwargs = {"prioritized": prioritized, **(replay_buffer_kwargs or {})}
+        self.double = double
+        self.distill = distill
+        super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, **kwargs)
+
+    def _td_target(self, data: AutomatonSamples) -> th.Tensor:
+        """r + gamma * Q_target(s', a*), a* from the online net when double; then distilled."""
+        with th.no_grad():
+            next_q = self.q_net_target(data.next_observations)
+            if self.double:
+                best = self.q_net(data.next_observations).argmax(dim=1, keepdim=True)
+                next_q = th.gather(next_q, dim=1, index=best)
+            else:
+                next_q = next_q.max(dim=1, keepdim=True)[0]
+            target = data.rewards + (1 - data.dones) * self.gamma * next_q
+            if self.distill is not None:
+                target = self.distill(data.w, data.sigma, target)
+        return target
+
+    def train(self, gradient_steps: int, batch_size: int = 100) -> None:
+        self.policy.set_training_mode(True)
+        self._update_learning_rate(self.policy.optimizer)
+        losses = []
+        for _ in range(gradient_steps):
+            data = self.replay_buffer.sample(batch_size, env=self._vec_normalize_env)
+            target = self._td_target(data)
+            current = th.gather(self.q_net(data.observations), dim=1, index=data.actions.long())
+            loss = (data.weights * F.smooth_l1_loss(current, target, reduction="none")).mean()
+            losses.append(loss.item())
+            self.policy.optimizer.zero_grad()
+            loss.backward()
+            th.nn.utils.clip_grad_norm_(self.policy.parameters(), self.max_grad_norm)
+            self.policy.optimizer.step()
+            self.replay_buffer.update_priorities(data.indices, (current - target).detach().cpu().numpy())
+        self._n_updates += gradient_steps
+        self.logger.record("train/n_updates", self._n_updates, exclude="tensorboard")
+        self.logger.record("train/loss", np.mean(losses))
+
+    def q_values(self, observations: np.ndarray) -> np.ndarray:
+        """Q(s, .) of the online network for a batch of observations."""
+        with th.no_grad():
+            obs = th.as_tensor(np.asarray(observations), device=self.device, dtype=th.float32)
+            return self.q_net(obs).cpu().numpy()

@@ -1,0 +1,115 @@
+"""Every method of the paper under one interface: ``make_agent(method, env_id, ...)``.
+
+Grid (DQN): ``dqn`` (vanilla, no automaton state), ``product-dqn``, ``crm``,
+``static`` and ``dynamic`` (distilled students; ``dynamic`` needs a teacher's table).
+MuJoCo (TD3): ``td3`` (from scratch), ``product-td3``, ``td3-static``, ``td3-dynamic``.
+A teacher is ``product-dqn`` on a 7x7 grid; ``distill_from_replay`` turns it into a table.
+"""
+
+from __future__ import annotations
+
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from stable_baselines3.common.env_util import make_vec_env
+
+from .crm import CRMReplayBuffer
+from .distillation import AutomatonQTable, DistilledTarget, dynamic_distillation, static_distillation
+from .dqn import AutomatonDQN
+from .td3 import AutomatonTD3
+
+
+@dataclass(frozen=True)
+class Method:
+    name: str
+    algorithm: type
+    product: bool  # the automaton one-hot in the observation
+    distill: str | None = None  # "static" or "dynamic"
+    crm: bool = False
+    description: str = ""
+
+
+METHODS = {m.name: m for m in (
+    Method("dqn", AutomatonDQN, False, description="DQN without the automaton state"),
+    Method("product-dqn", AutomatonDQN, True, description="DQN over the product MDP (also the teacher)"),
+    Method("crm", AutomatonDQN, True, crm=True, description="product DQN with counterfactual experiences"),
+    Method("static", AutomatonDQN, True, "static", description="DQN student, statically distilled automaton"),
+    Method("dynamic", AutomatonDQN, True, "dynamic", description="DQN student, teacher distilled into the automaton"),
+    Method("td3", AutomatonTD3, False, description="TD3 from scratch"),
+    Method("product-td3", AutomatonTD3, True, description="TD3 over the product MDP"),
+    Method("td3-static", AutomatonTD3, True, "static", description="TD3 student, statically distilled automaton"),
+    Method("td3-dynamic", AutomatonTD3, True, "dynamic", description="TD3 student, teacher distilled into the automaton"),
+)}
+
+# The authors' settings (REFERENCE.md section 5), scaled to what a small MLP needs.
+DQN_DEFAULTS = dict(learning_rate=1e-3, buffer_size=150_000, batch_size=64, learning_starts=1_000,
+                    gamma=0.99, train_freq=4, target_update_interval=1_000, exploration_fraction=0.01,
+                    exploration_initial_eps=0.1, exploration_final_eps=0.1,
+                    policy_kwargs=dict(net_arch=[64, 64]))
+TD3_DEFAULTS = dict(learning_rate=1e-4, buffer_size=1_000_000, batch_size=64, learning_starts=1_000,
+                    gamma=0.99, tau=0.005, target_policy_noise=0.2, target_noise_clip=0.5,
+                    policy_kwargs=dict(net_arch=[400, 300]))
+
+
+def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None, seed: int = 0,
+               n_envs: int = 1, rho: float = 0.999, verbose: int = 0, **overrides):
+    """An untrained agent of ``method`` on ``n_envs`` copies of ``env_id``."""
+    if method not in METHODS:
+        raise KeyError(f"unknown method {method!r}; methods: {sorted(METHODS)}")
+    m = METHODS[method]
+    continuous = "-Cont-" in env_id
+    if continuous != (m.algorithm is AutomatonTD3):
+        kind = "MuJoCo (-Cont-)" if m.algorithm is AutomatonTD3 else "grid"
+        raise ValueError(f"method {method!r} is for {kind} ids, not {env_id}")
+    env = make_vec_env(env_id, n_envs=n_envs, seed=seed, env_kwargs={"product": m.product})
+    base = env.envs[0].unwrapped
+    automaton = base.automaton
+    kwargs = dict(TD3_DEFAULTS if continuous else DQN_DEFAULTS)
+    kwargs.update(overrides)
+    if m.algorithm is AutomatonTD3:
+        from stable_baselines3.common.noise import NormalActionNoise
+        kwargs.setdefault("action_noise", NormalActionNoise(np.zeros(2), 0.3 * np.ones(2)))
+    if m.crm:
+        kwargs["replay_buffer_class"] = CRMReplayBuffer
+        kwargs["replay_buffer_kwargs"] = {"automaton": automaton, "completion_reward": base.task.completion_reward,
+                                          **kwargs.get("replay_buffer_kwargs", {})}
+    if m.distill == "dynamic":
+        if table is None:
+            raise ValueError(f"method {method!r} needs a teacher's table (distill_from_replay)")
+        kwargs["distill"] = DistilledTarget(table, automaton, rho)
+    elif m.distill == "static":
+        kwargs["distill"] = DistilledTarget(table or static_distillation(
+            automaton, completion_reward=base.task.completion_reward), automaton, rho)
+    return m.algorithm("MlpPolicy", env, seed=seed, verbose=verbose, **kwargs)
+
+
+def distill_from_replay(teacher: AutomatonDQN, chunk: int = 4096) -> AutomatonQTable:
+    """Dynamic distillation of a DQN teacher: mean Q of the taken action per (w, sigma)."""
+    buf = teacher.replay_buffer
+    rows = buf.buffer_size if buf.full else buf.pos
+    if rows == 0:
+        raise ValueError("the teacher's replay buffer is empty: train it first")
+    obs = buf.observations[:rows].reshape(rows * buf.n_envs, -1)
+    actions = buf.actions[:rows].reshape(-1).astype(np.int64)
+    q = np.concatenate([teacher.q_values(obs[i:i + chunk]) for i in range(0, len(obs), chunk)])
+    q_taken = q[np.arange(len(actions)), actions]
+    automaton = teacher.get_env().envs[0].unwrapped.automaton
+    return dynamic_distillation(automaton, buf.w[:rows].reshape(-1), buf.sigma[:rows].reshape(-1), q_taken)
+
+
+def load_agent(path, env=None):
+    """Load a saved agent (any method) with a clear error for missing or corrupt files."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no saved agent at {path}")
+    if not zipfile.is_zipfile(path):
+        raise ValueError(f"{path} is not a saved agent (not a zip archive: corrupt or another file?)")
+    errors = []
+    for algorithm in (AutomatonDQN, AutomatonTD3):
+        try:
+            return algorithm.load(path, env=env, device="cpu")
+        except Exception as err:  # a checkpoint of the other algorithm, or damaged inside
+            errors.append(f"{algorithm.__name__}: {type(err).__name__}: {err}")
+    raise ValueError(f"{path} could not be loaded: {'; '.join(errors)}")

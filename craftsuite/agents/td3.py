@@ -1,0 +1,90 @@
+"""TD3 students for the MuJoCo worlds: SB3's TD3 with prioritized replay, the paper's actor
+delay schedule and, for distilled students, the distilled target.
+
+Where this differs from SB3's TD3, and nowhere else:
+* ``AutomatonTD3._td_target``: the one seam for the target (clipped double-Q with target
+  policy smoothing, as SB3; then the distilled mix when a ``DistilledTarget`` is given).
+* ``AutomatonTD3.train``: SB3's loop, with the critic loss weighted by importance weights,
+  priorities updated from the first critic's TD errors, and the actor delayed by
+  ``policy_delay_at(num_timesteps)`` (4 for the first 20,000 steps, 2 afterwards).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch as th
+from stable_baselines3 import TD3
+from stable_baselines3.common.utils import polyak_update
+
+from .distillation import DistilledTarget
+from .replay import AutomatonReplayBuffer, AutomatonSamples
+
+
+class AutomatonTD3(TD3):
+    """TD3 for CraftSuite worlds: prioritized, delay-scheduled, optionally distilled.
+
+    Args (beyond SB3's TD3, whose ``policy_delay`` this replaces):
+        prioritized: prioritized replay (``AutomatonReplayBuffer``), else uniform.
+        distill: a ``DistilledTarget``; None for TD3 from scratch and product TD3.
+        delay_schedule: ``((until_step, delay), ..., (None, delay))``.
+    """
+
+    def __init__(self, policy, env, *, prioritized: bool = True, distill: DistilledTarget | None = None,
+                 delay_schedule=((20_000, 4), (None, 2)), replay_buffer_kwargs: dict | None = None, **kwargs):
+        kwargs.setdefault("replay_buffer_class", AutomatonReplayBuffer)
+        replay_buffer_kwargs = {"prioritized": prioritized, **(replay_buffer_kwargs or {})}
+        self.distill = distill
+        self.delay_schedule = tuple(delay_schedule)
+        super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, **kwargs)
+
+    def policy_delay_at(self, step: int) -> int:
+        for until, delay in self.delay_schedule:
+            if until is None or step < until:
+                return delay
+        return self.delay_schedule[-1][1]
+
+    def _td_target(self, data: AutomatonSamples) -> th.Tensor:
+        with th.no_grad():
+            noise = data.actions.clone().data.normal_(0, self.target_policy_noise)
+            noise = noise.clamp(-self.target_noise_clip, self.target_noise_clip)
+            next_actions = (self.actor_target(data.next_observations) + noise).clamp(-1, 1)
+            next_q = th.cat(self.critic_target(data.next_observations, next_actions), dim=1)
+            next_q = th.min(next_q, dim=1, keepdim=True)[0]
+            target = data.rewards + (1 - data.dones) * self.gamma * next_q
+            if self.distill is not None:
+                target = self.distill(data.w, data.sigma, target)
+        return target
+
+    def train(self, gradient_steps: int, batch_size: int = 100) -> None:
+        self.policy.set_training_mode(True)
+        self._update_learning_rate([self.actor.optimizer, self.critic.optimizer])
+        delay = self.policy_delay_at(self.num_timesteps)
+        actor_losses, critic_losses = [], []
+        for _ in range(gradient_steps):
+            self._n_updates += 1
+            data = self.replay_buffer.sample(batch_size, env=self._vec_normalize_env)
+            target = self._td_target(data)
+            current = self.critic(data.observations, data.actions)
+            critic_loss = sum((data.weights * (q - target) ** 2).mean() for q in current)
+            critic_losses.append(critic_loss.item())
+            self.critic.optimizer.zero_grad()
+            critic_loss.backward()
+            self.critic.optimizer.step()
+            self.replay_buffer.update_priorities(data.indices, (current[0] - target).detach().cpu().numpy())
+
+            if self._n_updates % delay == 0:
+                actor_loss = -self.critic.q1_forward(data.observations, self.actor(data.observations)).mean()
+                actor_losses.append(actor_loss.item())
+                self.actor.optimizer.zero_grad()
+                actor_loss.backward()
+                self.actor.optimizer.step()
+                polyak_update(self.critic.parameters(), self.critic_target.parameters(), self.tau)
+                polyak_update(self.actor.parameters(), self.actor_target.parameters(), self.tau)
+                polyak_update(self.critic_batch_norm_stats, self.critic_batch_norm_stats_target, 1.0)
+                polyak_update(self.actor_batch_norm_stats, self.actor_batch_norm_stats_target, 1.0)
+
+        self.logger.record("train/n_updates", self._n_updates, exclude="tensorboard")
+        self.logger.record("train/policy_delay", delay)
+        if actor_losses:
+            self.logger.record("train/actor_loss", np.mean(actor_losses))
+        self.logger.record("train/critic_loss", np.mean(critic_losses))

@@ -42,14 +42,20 @@ class SumTree:
         return float(self.tree[1])
 
     def update(self, indices: np.ndarray, values: np.ndarray) -> None:
-        nodes = np.asarray(indices) + self.leaves
-        self.tree[nodes] = values
-        nodes = np.unique(nodes // 2)
-        while nodes[0] >= 1:
-            self.tree[nodes] = self.tree[2 * nodes] + self.tree[2 * nodes + 1]
-            if nodes[0] == 1:
-                break
-            nodes = np.unique(nodes // 2)
+        nodes = np.asarray(indices, dtype=np.int64).reshape(-1) + self.leaves
+        tree = self.tree
+        if len(nodes) == 1:  # one new transition per env step: plain Python is fastest
+            node = int(nodes[0])
+            tree[node] = float(np.asarray(values).reshape(-1)[0])
+            node //= 2
+            while node:
+                tree[node] = tree[2 * node] + tree[2 * node + 1]
+                node //= 2
+            return
+        tree[nodes] = values
+        while nodes[0] > 1:  # all leaves sit at one depth: climb level by level
+            nodes //= 2
+            tree[nodes] = tree[2 * nodes] + tree[2 * nodes + 1]  # repeats write equal sums
 
     def find(self, targets: np.ndarray) -> np.ndarray:
         """Leaf index whose cumulative-sum interval contains each target."""
@@ -99,8 +105,9 @@ class AutomatonReplayBuffer(ReplayBuffer):
                     "step: use a CraftSuite world (any id, product=True for an automaton-aware policy)"
                 ) from None
         if self.tree is not None:
-            flat = pos * self.n_envs + np.arange(self.n_envs)
-            self.tree.update(flat, np.full(self.n_envs, self.max_priority ** self.alpha))
+            priority = self.max_priority ** self.alpha
+            for env in range(self.n_envs):
+                self.tree.update(np.array([pos * self.n_envs + env]), np.array([priority]))
         super().add(obs, next_obs, action, reward, done, infos)
 
     def sample(self, batch_size: int, env=None) -> AutomatonSamples:

@@ -50,6 +50,8 @@ def main():
         ("DQN", GRID, args.dqn_steps, DQN, DQN_DEFAULTS, "product-dqn", "dynamic"),
         ("TD3", CONT, args.td3_steps, TD3, TD3_DEFAULTS, "product-td3", "td3-dynamic"),
     ):
+        if steps == 0:
+            continue
         same = dict(prioritized=False) | (dict(dueling=False, double=False) if name == "DQN" else {})
         builders = [
             lambda: plain_cls("MlpPolicy", make_vec_env(world, n_envs=1, seed=0, env_kwargs={"product": True}),

@@ -168,14 +168,21 @@ class DistilledTarget:
         self.q_teacher = table.q.astype(np.float32)
         self.seen = table.seen
         self.student_counts = np.zeros(table.q.shape, dtype=np.int64)
+        # flat views: one fancy index per array per minibatch (this runs every gradient step)
+        self._n_labels = table.q.shape[1]
+        self._teacher_flat = self.q_teacher.reshape(-1)
+        self._seen_flat = self.seen.reshape(-1).astype(np.float32)
+        self._counts_flat = self.student_counts.reshape(-1)
 
     def beta(self, w: np.ndarray, sigma: np.ndarray) -> np.ndarray:
-        return np.where(self.seen[w, sigma], self.rho ** self.student_counts[w, sigma], 0.0)
+        flat = np.asarray(w) * self._n_labels + np.asarray(sigma)
+        return self._seen_flat[flat] * self.rho ** self._counts_flat[flat]
 
     def __call__(self, w: np.ndarray, sigma: np.ndarray, q_target: th.Tensor) -> th.Tensor:
-        beta = self.beta(w, sigma).astype(np.float32)
-        np.add.at(self.student_counts, (w, sigma), 1)
-        teacher = self.q_teacher[w, sigma]
-        beta_t = th.as_tensor(beta, device=q_target.device).reshape(q_target.shape)
-        teacher_t = th.as_tensor(teacher, device=q_target.device).reshape(q_target.shape)
-        return beta_t * teacher_t + (1.0 - beta_t) * q_target
+        flat = w * self._n_labels + sigma
+        mix = np.empty((2, len(flat)), dtype=np.float32)
+        mix[0] = self._seen_flat[flat] * self.rho ** self._counts_flat[flat]  # beta
+        mix[1] = self._teacher_flat[flat]
+        np.add.at(self._counts_flat, flat, 1)
+        beta, teacher = th.from_numpy(mix).to(q_target.device).reshape(2, *q_target.shape)
+        return q_target + beta * (teacher - q_target)

@@ -93,13 +93,17 @@ class AutomatonDQN(DQN):
             data = self.replay_buffer.sample(batch_size, env=self._vec_normalize_env)
             target = self._td_target(data)
             current = th.gather(self.q_net(data.observations), dim=1, index=data.actions.long())
-            loss = (data.weights * F.smooth_l1_loss(current, target, reduction="none")).mean()
+            if self.replay_buffer.prioritized:
+                loss = (data.weights * F.smooth_l1_loss(current, target, reduction="none")).mean()
+            else:  # uniform replay: SB3's loss exactly
+                loss = F.smooth_l1_loss(current, target)
             losses.append(loss.item())
             self.policy.optimizer.zero_grad()
             loss.backward()
             th.nn.utils.clip_grad_norm_(self.policy.parameters(), self.max_grad_norm)
             self.policy.optimizer.step()
-            self.replay_buffer.update_priorities(data.indices, (current - target).detach().cpu().numpy())
+            if self.replay_buffer.prioritized:
+                self.replay_buffer.update_priorities(data.indices, (current - target).detach().cpu().numpy())
         self._n_updates += gradient_steps
         self.logger.record("train/n_updates", self._n_updates, exclude="tensorboard")
         self.logger.record("train/loss", np.mean(losses))

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 import torch as th
+import torch.nn.functional as F
 from stable_baselines3 import TD3
 from stable_baselines3.common.utils import polyak_update
 
@@ -65,12 +66,16 @@ class AutomatonTD3(TD3):
             data = self.replay_buffer.sample(batch_size, env=self._vec_normalize_env)
             target = self._td_target(data)
             current = self.critic(data.observations, data.actions)
-            critic_loss = sum((data.weights * (q - target) ** 2).mean() for q in current)
+            if self.replay_buffer.prioritized:
+                critic_loss = sum((data.weights * (q - target) ** 2).mean() for q in current)
+            else:  # uniform replay: SB3's loss exactly
+                critic_loss = sum(F.mse_loss(q, target) for q in current)
             critic_losses.append(critic_loss.item())
             self.critic.optimizer.zero_grad()
             critic_loss.backward()
             self.critic.optimizer.step()
-            self.replay_buffer.update_priorities(data.indices, (current[0] - target).detach().cpu().numpy())
+            if self.replay_buffer.prioritized:
+                self.replay_buffer.update_priorities(data.indices, (current[0] - target).detach().cpu().numpy())
 
             if self._n_updates % delay == 0:
                 actor_loss = -self.critic.q1_forward(data.observations, self.actor(data.observations)).mean()

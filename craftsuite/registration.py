@@ -34,12 +34,13 @@ def grid_id(task: str, size: int) -> str:
 
 
 def make_grid(task: str | TaskSpec, size: int, product: bool = False,
-              render_mode: str | None = None) -> gym.Env:
-    """Entry point of the grid ids; ``product=True`` adds the automaton one-hot."""
+              render_mode: str | None = None, layout_seed: int | None = None) -> gym.Env:
+    """Entry point of the grid ids; ``product=True`` adds the automaton one-hot,
+    ``layout_seed`` fixes the objects' layout across episodes."""
     from .envs.grid import GridWorldEnv
     from .wrappers import AutomatonObservation
 
-    env = GridWorldEnv(task, size, render_mode=render_mode)
+    env = GridWorldEnv(task, size, render_mode=render_mode, layout_seed=layout_seed)
     return AutomatonObservation(env) if product else env
 
 

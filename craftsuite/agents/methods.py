@@ -54,8 +54,12 @@ TD3_DEFAULTS = dict(learning_rate=1e-4, buffer_size=1_000_000, batch_size=64, le
 
 
 def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None, seed: int = 0,
-               n_envs: int = 1, rho: float = 0.999, verbose: int = 0, **overrides):
-    """An untrained agent of ``method`` on ``n_envs`` copies of ``env_id``."""
+               n_envs: int = 1, rho: float = 0.999, verbose: int = 0, env_kwargs: dict | None = None,
+               **overrides):
+    """An untrained agent of ``method`` on ``n_envs`` copies of ``env_id``.
+
+    ``env_kwargs`` go to ``gymnasium.make`` (e.g. ``{"layout_seed": 0}`` for a fixed grid
+    instance); ``overrides`` to the algorithm."""
     if method not in METHODS:
         raise KeyError(f"unknown method {method!r}; methods: {sorted(METHODS)}")
     m = METHODS[method]
@@ -63,7 +67,7 @@ def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None
     if continuous != (m.algorithm is AutomatonTD3):
         kind = "MuJoCo (-Cont-)" if m.algorithm is AutomatonTD3 else "grid"
         raise ValueError(f"method {method!r} is for {kind} ids, not {env_id}")
-    env = make_vec_env(env_id, n_envs=n_envs, seed=seed, env_kwargs={"product": m.product})
+    env = make_vec_env(env_id, n_envs=n_envs, seed=seed, env_kwargs={**(env_kwargs or {}), "product": m.product})
     base = env.envs[0].unwrapped
     automaton = base.automaton
     kwargs = dict(TD3_DEFAULTS if continuous else DQN_DEFAULTS)

@@ -42,7 +42,10 @@ class GridWorldEnv(CraftWorld):
 
     ## Starting State
     Objects, then the agent, on distinct random free cells ("corner" places on the
-    top-left cell); empty inventory; the automaton in its initial state.
+    top-left cell); empty inventory; the automaton in its initial state. With
+    ``layout_seed=K`` (``gymnasium.make`` keyword) the objects are the same in every
+    episode (one fixed instance, as the paper's teachers and students had) and only the
+    agent's start is drawn from the episode's seed.
 
     ## Episode End
     Terminated when the automaton accepts (``info["is_success"]``) or falls into its
@@ -63,8 +66,11 @@ class GridWorldEnv(CraftWorld):
     metadata = {"render_modes": ["rgb_array", "ansi"], "render_fps": 8}
 
     def __init__(self, task: str | TaskSpec = "BlindCraftsman", size: int = 7,
-                 render_mode: str | None = None):
+                 render_mode: str | None = None, layout_seed: int | None = None):
         super().__init__(task, render_mode)
+        if layout_seed is not None and (not isinstance(layout_seed, int) or layout_seed < 0):
+            raise ValueError(f"layout_seed must be a non-negative integer or None, got {layout_seed!r}")
+        self.layout_seed = layout_seed
         if not isinstance(size, int) or size < 2:
             raise ValueError(f"size must be an integer >= 2, got {size!r}")
         self.size = size
@@ -135,7 +141,9 @@ class GridWorldEnv(CraftWorld):
         for k in corner:
             cells[0] = k
         free = [c for c in range(n_cells) if cells[c] == EMPTY]
-        order = self.np_random.permutation(len(free)).tolist()
+        # a fixed instance draws its objects from layout_seed, the agent's start from the episode
+        layout_rng = np.random.default_rng(self.layout_seed) if self.layout_seed is not None else self.np_random
+        order = layout_rng.permutation(len(free)).tolist()
         i = 0
         for k, obj in enumerate(self._objects):
             if k in corner:
@@ -143,7 +151,11 @@ class GridWorldEnv(CraftWorld):
             for _ in range(obj.count):
                 cells[free[order[i]]] = k
                 i += 1
-        self._agent = free[order[i]]
+        if self.layout_seed is None:
+            self._agent = free[order[i]]
+        else:
+            empty = [c for c in free if cells[c] == EMPTY]
+            self._agent = empty[int(self.np_random.integers(len(empty)))]
         self._cells = cells
 
         obs = self._obs

@@ -201,3 +201,18 @@ def test_module_prefix_without_import(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip().startswith("(")
+
+
+def test_layout_seed_fixes_the_instance_not_the_start():
+    env = gym.make("CraftSuite/DiamondMine-Grid7-v0", layout_seed=3)
+    layouts, starts = set(), set()
+    for seed in range(6):
+        env.reset(seed=seed)
+        layouts.add(repr(env.unwrapped.object_positions()))
+        starts.add(env.unwrapped.agent_position)
+    assert len(layouts) == 1 and len(starts) > 1
+    other = gym.make("CraftSuite/DiamondMine-Grid7-v0", layout_seed=4)
+    other.reset(seed=0)
+    assert repr(other.unwrapped.object_positions()) not in layouts
+    with pytest.raises(ValueError, match="layout_seed"):
+        gym.make("CraftSuite/DiamondMine-Grid7-v0", layout_seed=-1)

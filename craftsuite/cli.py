@@ -105,6 +105,13 @@ def _video(args) -> int:
     return 0
 
 
+def _positive(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="craftsuite", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -122,7 +129,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("demo", help="roll out the scripted policy on every id; write pictures")
     p.add_argument("--out", default="out/demo", help="output directory (default: out/demo)")
     p.add_argument("--task", help="only this task (default: all)")
-    p.add_argument("--episodes", type=int, default=10, help="episodes per id (default: 10)")
+    p.add_argument("--episodes", type=_positive, default=10, help="episodes per id (default: 10)")
     p.add_argument("--seed", type=int, default=0, help="first seed (default: 0)")
     p.set_defaults(run=_demo)
 
@@ -130,7 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("env_id", help="a registered id, e.g. CraftSuite/BlindCraftsman-Cont-v0")
     p.add_argument("--policy", default="scripted",
                    help="'random', 'scripted' (default) or a stable-baselines3 checkpoint (.zip)")
-    p.add_argument("--episodes", type=int, default=1, help="episodes to record (default: 1)")
+    p.add_argument("--episodes", type=_positive, default=1, help="episodes to record (default: 1)")
     p.add_argument("--out", default="rollout.mp4", help="output .mp4 (default: rollout.mp4)")
     p.add_argument("--seed", type=int, default=0, help="seed of the first episode (default: 0)")
     p.add_argument("--fps", type=float, help="frames per second (default: the env's render_fps)")

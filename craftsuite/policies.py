@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -27,23 +26,14 @@ def load_policy(name: str, env, seed: int = 0):
 
 
 def _load_checkpoint(path: Path, env):
+    from .agents.methods import load_agent
+
     if not path.is_file():
         raise FileNotFoundError(
             f"no such checkpoint {str(path)!r}; a policy is 'random', 'scripted' or a checkpoint file")
-    if not zipfile.is_zipfile(path):
-        raise ValueError(f"{path} is not a stable-baselines3 checkpoint (not a zip file: corrupt or wrong file?)")
-    import stable_baselines3 as sb3
-
-    errors = []
-    for algo in (sb3.DQN, sb3.TD3, sb3.SAC, sb3.PPO, sb3.A2C, sb3.DDPG):
-        try:
-            model = algo.load(path, device="cpu")
-        except Exception as err:  # a checkpoint of another algorithm: try the next one
-            errors.append(f"{algo.__name__}: {type(err).__name__}")
-            continue
-        if model.observation_space.shape != env.observation_space.shape:
-            raise ValueError(
-                f"{path}: the policy expects observations of shape {model.observation_space.shape}, "
-                f"the env gives {env.observation_space.shape} (another task, or product=True missing?)")
-        return lambda obs: model.predict(np.asarray(obs), deterministic=True)[0]
-    raise ValueError(f"{path}: not loadable by any stable-baselines3 algorithm ({'; '.join(errors)})")
+    model = load_agent(path)
+    if model.observation_space.shape != env.observation_space.shape:
+        raise ValueError(
+            f"{path}: the policy expects observations of shape {model.observation_space.shape}, "
+            f"the env gives {env.observation_space.shape} (another task, or product=True missing?)")
+    return lambda obs: model.predict(np.asarray(obs), deterministic=True)[0]

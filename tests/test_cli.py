@@ -42,3 +42,24 @@ def test_help_explains_commands(capsys):
     out = capsys.readouterr().out
     for command in ("tasks", "automaton", "demo"):
         assert command in out
+
+
+def test_video_loads_craftsuite_agents(tmp_path, capsys):
+    from craftsuite.agents.methods import make_agent
+
+    agent = make_agent("product-dqn", "CraftSuite/DungeonQuest-Grid7-v0", learning_starts=10, buffer_size=500)
+    agent.learn(50)
+    agent.save(tmp_path / "teacher.zip")
+    out = tmp_path / "v.mp4"
+    assert main(["video", "CraftSuite/DungeonQuest-Grid7-v0", "--product", "--policy",
+                 str(tmp_path / "teacher.zip"), "--out", str(out)]) == 0
+    assert out.stat().st_size > 0
+    assert main(["video", "CraftSuite/DungeonQuest-Grid7-v0", "--policy",
+                 str(tmp_path / "teacher.zip"), "--out", str(out)]) == 2  # product=True missing
+    assert "product=True missing" in capsys.readouterr().err
+
+
+def test_zero_episodes_is_a_clear_error(capsys):
+    with pytest.raises(SystemExit):
+        main(["demo", "--episodes", "0"])
+    assert "must be at least 1" in capsys.readouterr().err

@@ -74,7 +74,8 @@ def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None
     kwargs.update(overrides)
     if m.algorithm is AutomatonTD3:
         from stable_baselines3.common.noise import NormalActionNoise
-        kwargs.setdefault("action_noise", NormalActionNoise(np.zeros(2), 0.3 * np.ones(2)))
+        n = env.action_space.shape[0]
+        kwargs.setdefault("action_noise", NormalActionNoise(np.zeros(n), 0.3 * np.ones(n)))
     if m.crm:
         kwargs["replay_buffer_class"] = CRMReplayBuffer
         kwargs["replay_buffer_kwargs"] = {"automaton": automaton, "completion_reward": base.task.completion_reward,
@@ -104,16 +105,20 @@ def distill_from_replay(teacher: AutomatonDQN, chunk: int = 4096) -> AutomatonQT
 
 
 def load_agent(path, env=None):
-    """Load a saved agent (any method) with a clear error for missing or corrupt files."""
+    """Load a saved agent (any CraftSuite method, or a plain stable-baselines3 checkpoint)
+    with a clear error for missing or corrupt files."""
+    import stable_baselines3 as sb3
+
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no saved agent at {path}")
     if not zipfile.is_zipfile(path):
-        raise ValueError(f"{path} is not a saved agent (not a zip archive: corrupt or another file?)")
+        raise ValueError(f"{path} is not a saved agent: not a stable-baselines3 checkpoint "
+                         "(not a zip archive: corrupt or another file?)")
     errors = []
-    for algorithm in (AutomatonDQN, AutomatonTD3):
+    for algorithm in (AutomatonDQN, AutomatonTD3, sb3.DQN, sb3.TD3, sb3.SAC, sb3.PPO, sb3.A2C, sb3.DDPG):
         try:
             return algorithm.load(path, env=env, device="cpu")
         except Exception as err:  # a checkpoint of the other algorithm, or damaged inside
-            errors.append(f"{algorithm.__name__}: {type(err).__name__}: {err}")
+            errors.append(f"{algorithm.__name__}: {type(err).__name__}")
     raise ValueError(f"{path} could not be loaded: {'; '.join(errors)}")

@@ -174,10 +174,15 @@ class GridWorldEnv(CraftWorld):
         try:
             dx, dy = _MOVES[action]
         except (KeyError, TypeError):
-            raise ValueError(
-                f"invalid action {action!r} for {self.task.name}: expected an integer in [0, 4) "
-                f"({', '.join(f'{i} {n}' for i, n in enumerate(ACTION_NAMES))})"
-            ) from None
+            # a 0-d integer array (what SB3's predict returns) is a valid Discrete action
+            if isinstance(action, np.ndarray) and action.shape == () and action.dtype.kind in "iu" \
+                    and int(action) in _MOVES:
+                dx, dy = _MOVES[int(action)]
+            else:
+                raise ValueError(
+                    f"invalid action {action!r} for {self.task.name}: expected an integer in [0, 4) "
+                    f"({', '.join(f'{i} {n}' for i, n in enumerate(ACTION_NAMES))})"
+                ) from None
         if not self._cells:
             raise RuntimeError("call reset() before step()")
         size = self.size

@@ -176,6 +176,9 @@ def test_numpy_integer_actions_work():
     env = gym.make("CraftSuite/BlindCraftsman-Grid7-v0")
     env.reset(seed=0)
     env.step(np.int64(1))
+    env.step(np.array(2))  # 0-d, as SB3's predict returns
+    with pytest.raises(ValueError, match="invalid action"):
+        env.step(np.array(2.5))
 
 
 def test_step_before_reset():

@@ -105,6 +105,130 @@ def _video(args) -> int:
     return 0
 
 
+def _hyper(text: str | None) -> dict:
+    import json
+
+    if not text:
+        return {}
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as err:
+        raise ValueError(f"--hyper is not JSON ({err}): {text!r}") from None
+    if not isinstance(value, dict):
+        raise ValueError(f"--hyper must be a JSON object, e.g. '{{\"learning_rate\": 1e-4}}', not {text!r}")
+    return value
+
+
+def _teacher(args) -> int:
+    from .training import TeacherConfig, train_teacher
+
+    config = TeacherConfig(task=args.task, size=args.size, layout_seed=None if args.layout_seed < 0 else args.layout_seed,
+                           seed=args.seed, max_steps=args.max_steps, target_success=args.target_success,
+                           eval_every=args.eval_every, eval_episodes=args.eval_episodes,
+                           hyperparameters=_hyper(args.hyper))
+    path = train_teacher(config, args.out)
+    print((path / "result.json").read_text().strip())
+    print(f"teacher run: {path}\n  teacher: {path / 'teacher.zip'}\n  dynamic table: {path / 'table.npz'}")
+    return 0
+
+
+def _distill(args) -> int:
+    from .agents import AutomatonQTable
+    from .agents.distillation import static_distillation
+    from .registration import resolve_task
+
+    if args.static:
+        spec = resolve_task(args.source)
+        table = static_distillation(spec.automaton, completion_reward=spec.completion_reward)
+        automaton = spec.automaton
+    else:
+        from .agents.methods import distill_from_replay, load_agent
+
+        source = Path(args.source)
+        if source.is_dir():  # a teacher run directory: its replay buffer is in the checkpoint
+            model, replay = source / "checkpoint" / "model.zip", source / "checkpoint" / "replay.pkl"
+        else:
+            model, replay = source, Path(args.replay) if args.replay else None
+        if replay is None or not replay.is_file():
+            raise FileNotFoundError(f"dynamic distillation needs the teacher's replay buffer: "
+                                    f"{replay or 'pass --replay'} (or a teacher run directory)")
+        teacher = load_agent(model)
+        if teacher.get_env() is None:
+            env_id = args.env_id or f"CraftSuite/{args.task}-Grid7-v0"
+            from stable_baselines3.common.env_util import make_vec_env
+            teacher.set_env(make_vec_env(env_id, n_envs=1, env_kwargs={"product": True}))
+        teacher.load_replay_buffer(replay)
+        table = distill_from_replay(teacher)
+        automaton = teacher.get_env().envs[0].unwrapped.automaton
+    table.save(args.out)
+    print(table.describe(automaton))
+    print(f"wrote {args.out}")
+    if args.draw:
+        from .automata import write_image
+
+        values = table.edge_values(automaton)
+        unseen = {e for e in automaton.edges() if e not in values}
+        path = write_image(automaton, args.draw, title=f"{table.kind} distillation: {automaton.formula}",
+                           edge_notes={e: f"{v:.1f}" for e, v in values.items()}, dotted=unseen)
+        print(f"drew {path}")
+    return 0
+
+
+def _student(args) -> int:
+    from .training import StudentConfig, train_student
+
+    config = StudentConfig(task=args.task, method=args.method, world=args.world, seed=args.seed, steps=args.steps,
+                           table=args.table, eval_every=args.eval_every, eval_episodes=args.eval_episodes,
+                           hyperparameters=_hyper(args.hyper))
+    if args.method.endswith("dynamic") and not args.table:
+        raise ValueError(f"method {args.method!r} needs --table (a teacher's table.npz: craftsuite teacher)")
+    path = train_student(config, args.out)
+    print((path / "result.json").read_text().strip())
+    print(f"student run: {path}")
+    return 0
+
+
+def _transfer(args) -> int:
+    import dataclasses
+
+    from .suites import SUITES, transfer
+
+    if args.suite not in SUITES:
+        raise KeyError(f"unknown suite {args.suite!r}; suites: {sorted(SUITES)}")
+    suite = SUITES[args.suite]
+    changes = {k: v for k, v in (("tasks", tuple(args.tasks) if args.tasks else None), ("seeds", args.seeds),
+                                 ("student_steps", args.steps), ("methods", tuple(args.methods) if args.methods else None),
+                                 ("teacher_max_steps", args.teacher_steps), ("eval_every", args.eval_every))
+               if v is not None}
+    suite = dataclasses.replace(suite, **changes)
+    print(f"suite {suite.name}: {suite.description}")
+    result = transfer(suite, args.out, workers=args.workers, ray=args.ray, video=not args.no_video)
+    print(f"leaderboard: {result.leaderboard} (and .csv)")
+    for plot in result.plots:
+        print(f"learning curves: {plot}")
+    if result.video:
+        print(f"video of the best student: {result.video}")
+    return 0
+
+
+def _leaderboard(args) -> int:
+    from . import leaderboard
+
+    root = Path(args.runs)
+    students = root / "students" if (root / "students").is_dir() else root
+    if not students.is_dir():
+        raise FileNotFoundError(f"no run directory at {root}")
+    entries = leaderboard.build(students)
+    if not entries:
+        raise ValueError(f"no finished student runs under {students}")
+    out = Path(args.out or root)
+    path = leaderboard.write(entries, out)
+    plots = leaderboard.plot_curves(students, out)
+    print(path.read_text())
+    print(f"wrote {path}, {out / 'leaderboard.csv'}" + "".join(f", {p}" for p in plots))
+    return 0
+
+
 def _positive(text: str) -> int:
     value = int(text)
     if value < 1:
@@ -132,6 +256,62 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--episodes", type=_positive, default=10, help="episodes per id (default: 10)")
     p.add_argument("--seed", type=int, default=0, help="first seed (default: 0)")
     p.set_defaults(run=_demo)
+
+    p = sub.add_parser("teacher", help="train a grid DQN teacher until 90%% greedy success; distil it")
+    p.add_argument("task", help="task name, e.g. BlindCraftsman")
+    p.add_argument("--out", default="runs/teachers", help="runs directory (default: runs/teachers)")
+    p.add_argument("--size", type=int, default=7, help="grid size (default: 7)")
+    p.add_argument("--layout-seed", type=int, default=0, help="the fixed grid instance (-1: a new one per episode)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--max-steps", type=_positive, default=300_000, help="give up after this many steps")
+    p.add_argument("--target-success", type=float, default=0.9, help="stop at this greedy success (default: 0.9)")
+    p.add_argument("--eval-every", type=_positive, default=5_000)
+    p.add_argument("--eval-episodes", type=_positive, default=50)
+    p.add_argument("--hyper", help="JSON overrides of the DQN settings, e.g. '{\"learning_rate\": 1e-3}'")
+    p.set_defaults(run=_teacher)
+
+    p = sub.add_parser("distill", help="distil a teacher (dynamic) or a task's automaton (static) into a table")
+    p.add_argument("source", help="a teacher run directory or teacher .zip (dynamic), or a task name (--static)")
+    p.add_argument("--out", required=True, help="the table to write (.npz)")
+    p.add_argument("--static", action="store_true", help="value iteration over the automaton alone")
+    p.add_argument("--replay", help="the teacher's replay buffer (.pkl), when SOURCE is a .zip")
+    p.add_argument("--task", default="BlindCraftsman", help="the teacher's task, when SOURCE is a .zip")
+    p.add_argument("--env-id", help="the teacher's env id (default: CraftSuite/<task>-Grid7-v0)")
+    p.add_argument("--draw", help="also draw the values on the automaton (.png/.svg/.dot; unseen edges dotted)")
+    p.set_defaults(run=_distill)
+
+    p = sub.add_parser("student", help="train one student or baseline run (any method, one seed)")
+    p.add_argument("task", help="task name, e.g. BlindCraftsman")
+    p.add_argument("--method", default="td3-dynamic", help="td3-dynamic, td3-static, td3, product-td3 (MuJoCo); "
+                   "dynamic, static, dqn, product-dqn, crm (grids)")
+    p.add_argument("--world", default="Cont", help="Cont (MuJoCo, default), Grid10 or Grid7")
+    p.add_argument("--table", help="a teacher's table.npz (the *dynamic methods)")
+    p.add_argument("--out", default="runs/students", help="runs directory (default: runs/students)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--steps", type=_positive, default=20_000)
+    p.add_argument("--eval-every", type=_positive, default=2_000)
+    p.add_argument("--eval-episodes", type=_positive, default=10)
+    p.add_argument("--hyper", help="JSON overrides of the algorithm's settings")
+    p.set_defaults(run=_student)
+
+    p = sub.add_parser("transfer", help="a suite end to end: teacher, distillation, students, leaderboard, video")
+    p.add_argument("--suite", default="quick", help="quick (default, ~15 min), standard or paper")
+    p.add_argument("--out", default="runs/quick", help="output directory (default: runs/quick)")
+    p.add_argument("--tasks", nargs="+", help="override the suite's tasks")
+    p.add_argument("--methods", nargs="+", help="override the suite's methods")
+    p.add_argument("--seeds", type=_positive, help="override the number of seeds")
+    p.add_argument("--steps", type=_positive, help="override the student budget (env steps)")
+    p.add_argument("--teacher-steps", type=_positive, help="override the teacher's step limit")
+    p.add_argument("--eval-every", type=_positive, help="override the evaluation interval")
+    p.add_argument("--workers", type=_positive, help="parallel local processes (default: one per core)")
+    p.add_argument("--ray", metavar="ADDRESS", help="run the students on Ray ('local' starts one here)")
+    p.add_argument("--no-video", action="store_true", help="skip the rollout video of the best student")
+    p.set_defaults(run=_transfer)
+
+    p = sub.add_parser("leaderboard", help="leaderboard (Markdown, CSV) and learning curves from run directories")
+    p.add_argument("runs", help="a transfer output directory, or a directory of student runs")
+    p.add_argument("--out", help="where to write (default: RUNS)")
+    p.set_defaults(run=_leaderboard)
 
     p = sub.add_parser("video", help="record rollouts of a policy as an MP4 (grid and MuJoCo ids)")
     p.add_argument("env_id", help="a registered id, e.g. CraftSuite/BlindCraftsman-Cont-v0")

@@ -94,6 +94,27 @@ class AutomatonReplayBuffer(ReplayBuffer):
         self.tree = SumTree(self.buffer_size * self.n_envs) if prioritized else None
         self.max_priority = 1.0
 
+    _ROWS = ("observations", "next_observations", "actions", "rewards", "dones", "timeouts", "w", "sigma", "w_next")
+
+    def __getstate__(self) -> dict:
+        """Pickle only the filled rows: a checkpoint of a 20k-step run holds 20k rows, not
+        the 1M that SB3 allocates up front."""
+        state = self.__dict__.copy()
+        if not self.full:
+            for name in self._ROWS:
+                if isinstance(state.get(name), np.ndarray):
+                    state[name] = state[name][:self.pos].copy()
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        for name in self._ROWS:
+            rows = getattr(self, name, None)
+            if isinstance(rows, np.ndarray) and len(rows) < self.buffer_size:
+                full = np.zeros((self.buffer_size, *rows.shape[1:]), dtype=rows.dtype)
+                full[:len(rows)] = rows
+                setattr(self, name, full)
+
     def add(self, obs, next_obs, action, reward, done, infos: list[dict[str, Any]]) -> None:
         pos = self.pos
         for env, info in enumerate(infos):

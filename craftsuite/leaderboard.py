@@ -1,0 +1,227 @@
+"""Leaderboards and learning curves from student run directories.
+
+Per run (``run_metrics``):
+
+* ``success``: greedy success rate at the last evaluation;
+* ``return``: mean training-episode return over the last 10% of the run's steps;
+* ``auc``: area under the evaluation success curve, as a fraction of the budget (the mean
+  of the evaluations, which are equally spaced): 1.0 means solved from the first one;
+* ``steps_to_80``: env steps at the first evaluation with success >= 0.8 (None: never).
+
+Per task, world and method (``build``): the mean over seeds with a 95% bootstrap
+confidence interval (percentile, 2,000 resamples of the seeds). A run that never reached
+80% counts as its budget, and the entry reads ">= ...": a lower bound.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .runs import atomic_write, read_csv
+
+METRICS = ("success", "return", "auc", "steps_to_80")
+
+# REFERENCE.md section 5: the authors' shipped continuous results, one run each, mean
+# episode reward over the last 5% of 2e6 steps (not the same metric window as ours).
+PAPER_REFERENCE = {
+    "BlindCraftsman": {"td3-dynamic": 19.95, "td3": 17.06},
+    "DungeonQuest": {"td3-dynamic": 90.45, "td3": 87.97},
+    "DiamondMine": {"td3-dynamic": 29.59, "td3": 8.58},
+}
+
+
+def run_metrics(run: Path) -> dict | None:
+    """The metrics of one finished run directory (None if it has not finished)."""
+    run = Path(run)
+    if not (run / "result.json").exists():
+        return None
+    result = json.loads((run / "result.json").read_text())
+    config = json.loads((run / "config.json").read_text())
+    budget = int(config["steps"])
+    episodes = read_csv(run / "episodes.csv")
+    evals = read_csv(run / "evals.csv")
+    tail = [float(e["return"]) for e in episodes if int(e["step"]) > 0.9 * budget]
+    if not tail and episodes:  # fewer episodes than the window: the last one
+        tail = [float(episodes[-1]["return"])]
+    success = [float(e["success"]) for e in evals]
+    reached = next((int(e["step"]) for e in evals if float(e["success"]) >= 0.8), None)
+    return {
+        "task": config["task"], "world": config["world"], "method": config["method"], "seed": config["seed"],
+        "budget": budget, "steps": result["steps"],
+        "success": success[-1] if success else float("nan"),
+        "return": float(np.mean(tail)) if tail else float("nan"),
+        "auc": float(np.mean(success)) if success else float("nan"),
+        "steps_to_80": reached,
+    }
+
+
+def bootstrap_ci(values, resamples: int = 2000, level: float = 0.95, seed: int = 0) -> tuple[float, float, float]:
+    """Mean and percentile-bootstrap interval of the mean over ``values`` (seeds)."""
+    x = np.asarray(values, dtype=float)
+    if len(x) == 0:
+        return float("nan"), float("nan"), float("nan")
+    if len(x) == 1:
+        return float(x[0]), float(x[0]), float(x[0])
+    rng = np.random.default_rng(seed)
+    means = x[rng.integers(0, len(x), size=(resamples, len(x)))].mean(axis=1)
+    lo, hi = np.quantile(means, [(1 - level) / 2, 1 - (1 - level) / 2])
+    return float(x.mean()), float(lo), float(hi)
+
+
+@dataclass
+class Entry:
+    task: str
+    world: str
+    method: str
+    seeds: int
+    stats: dict  # metric -> (mean, lo, hi)
+    censored: int  # runs that never reached 80% (counted at their budget)
+
+
+def build(students_root) -> list[Entry]:
+    """One entry per (task, world, method) over the finished runs under ``students_root``."""
+    groups: dict[tuple, list[dict]] = {}
+    for run in sorted(Path(students_root).iterdir()) if Path(students_root).is_dir() else []:
+        m = run_metrics(run)
+        if m is not None:
+            groups.setdefault((m["task"], m["world"], m["method"]), []).append(m)
+    entries = []
+    for (task, world, method), runs in sorted(groups.items()):
+        stats = {k: bootstrap_ci([r[k] for r in runs]) for k in ("success", "return", "auc")}
+        steps = [r["steps_to_80"] if r["steps_to_80"] is not None else r["budget"] for r in runs]
+        stats["steps_to_80"] = bootstrap_ci(steps)
+        entries.append(Entry(task, world, method, len(runs), stats,
+                             sum(r["steps_to_80"] is None for r in runs)))
+    return entries
+
+
+def _fmt(stat, digits=2, integer=False, prefix="") -> str:
+    mean, lo, hi = stat
+    if np.isnan(mean):
+        return "n/a"
+    if integer:
+        return f"{prefix}{mean:,.0f} [{lo:,.0f}, {hi:,.0f}]"
+    return f"{prefix}{mean:.{digits}f} [{lo:.{digits}f}, {hi:.{digits}f}]"
+
+
+def to_markdown(entries: list[Entry]) -> str:
+    lines = ["# Leaderboard", "",
+             "Mean over seeds [95% bootstrap interval]. success: greedy, last evaluation; return: training "
+             "episodes, last 10% of steps; AUC: mean evaluation success over training; steps to 80%: "
+             "'>=' when some seeds never got there (counted at their budget).", ""]
+    for key in sorted({(e.task, e.world) for e in entries}):
+        lines += [f"## {key[0]} ({key[1]})", "",
+                  "| method | seeds | success | return (last 10%) | AUC | steps to 80% success |",
+                  "|---|---|---|---|---|---|"]
+        rows = sorted((e for e in entries if (e.task, e.world) == key),
+                      key=lambda e: (-e.stats["auc"][0], -e.stats["return"][0]))
+        for e in rows:
+            steps = _fmt(e.stats["steps_to_80"], integer=True, prefix=">= " if e.censored else "")
+            if e.censored:
+                steps += f" ({e.seeds - e.censored}/{e.seeds} reached)"
+            lines.append(f"| {e.method} | {e.seeds} | {_fmt(e.stats['success'])} | {_fmt(e.stats['return'], 1)} "
+                         f"| {_fmt(e.stats['auc'])} | {steps} |")
+        ref = PAPER_REFERENCE.get(key[0]) if key[1] == "Cont" else None
+        if ref:
+            for method, value in ref.items():
+                lines.append(f"| *reference: authors' {method}, 1 run, 2M steps (return over the last 5%)* "
+                             f"| 1 | | {value:.2f} | | |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def to_csv(entries: list[Entry]) -> str:
+    buf = io.StringIO()
+    writer = csv.writer(buf)
+    writer.writerow(["task", "world", "method", "seeds", *(f"{m}{s}" for m in METRICS for s in ("", "_lo", "_hi")),
+                     "steps_to_80_censored"])
+    for e in entries:
+        writer.writerow([e.task, e.world, e.method, e.seeds, *(v for m in METRICS for v in e.stats[m]), e.censored])
+    return buf.getvalue()
+
+
+def write(entries: list[Entry], out) -> Path:
+    """``leaderboard.md`` and ``leaderboard.csv`` in ``out``; returns the Markdown path."""
+    out = Path(out)
+    atomic_write(out / "leaderboard.csv", to_csv(entries))
+    atomic_write(out / "leaderboard.md", to_markdown(entries))
+    return out / "leaderboard.md"
+
+
+def _curve(values_at, grid):
+    """Step function of (step, value) pairs sampled on ``grid`` (NaN before the first)."""
+    steps = np.array([s for s, _ in values_at], dtype=float)
+    vals = np.array([v for _, v in values_at], dtype=float)
+    idx = np.searchsorted(steps, grid, side="right") - 1
+    return np.where(idx >= 0, vals[np.maximum(idx, 0)], np.nan)
+
+
+def plot_curves(students_root, out) -> list[Path]:
+    """Figure-5-style learning curves per task and world: mean and 95% band over seeds."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    runs: dict[tuple, list[tuple[dict, list, list, int]]] = {}
+    for run in sorted(Path(students_root).iterdir()) if Path(students_root).is_dir() else []:
+        if not (run / "result.json").exists():
+            continue
+        config = json.loads((run / "config.json").read_text())
+        episodes = read_csv(run / "episodes.csv")
+        evals = read_csv(run / "evals.csv")
+        key = (config["task"], config["world"])
+        runs.setdefault(key, []).append((config, episodes, evals, int(config["steps"])))
+    paths = []
+    for (task, world), group in sorted(runs.items()):
+        budget = max(g[3] for g in group)
+        grid = np.linspace(budget / 50, budget, 50)
+        fig, axes = plt.subplots(1, 2, figsize=(10, 3.6))
+        for method in sorted({g[0]["method"] for g in group}):
+            mine = [g for g in group if g[0]["method"] == method]
+            for ax, series in zip(axes, (
+                [_smoothed([(int(e["step"]), float(e["return"])) for e in g[1]], grid) for g in mine],
+                [_curve([(int(e["step"]), float(e["success"])) for e in g[2]], grid) for g in mine],
+            )):
+                data = np.array(series)
+                if data.size == 0:
+                    continue
+                valid = ~np.isnan(data).all(axis=0)  # before a run's first episode: no value yet
+                mean = np.full(len(grid), np.nan)
+                mean[valid] = np.nanmean(data[:, valid], axis=0)
+                band = [bootstrap_ci(col[~np.isnan(col)])[1:] for col in data.T]
+                lo, hi = np.array(band).T
+                line, = ax.plot(grid, mean, label=f"{method} ({len(mine)} seeds)")
+                ax.fill_between(grid, lo, hi, color=line.get_color(), alpha=0.2)
+        axes[0].set(title=f"{task} ({world}): training episode return", xlabel="env steps", ylabel="return")
+        axes[1].set(title="greedy success (evaluation)", xlabel="env steps", ylabel="success rate", ylim=(-0.02, 1.02))
+        axes[1].legend(loc="upper left", fontsize=8)
+        fig.tight_layout()
+        path = Path(out) / f"curves-{task}-{world}.png"
+        tmp = path.with_name(f".{path.name}.tmp.png")
+        fig.savefig(tmp, dpi=110)
+        plt.close(fig)
+        tmp.replace(path)
+        paths.append(path)
+    return paths
+
+
+def _smoothed(values_at, grid, window: float = 0.1):
+    """Mean return of the episodes that ended in the last ``window`` of the budget before each grid point."""
+    if not values_at:
+        return np.full(len(grid), np.nan)
+    steps = np.array([s for s, _ in values_at], dtype=float)
+    vals = np.array([v for _, v in values_at], dtype=float)
+    width = window * grid[-1]
+    out = np.full(len(grid), np.nan)
+    for i, g in enumerate(grid):
+        sel = (steps <= g) & (steps > g - width)
+        if sel.any():
+            out[i] = vals[sel].mean()
+    return out

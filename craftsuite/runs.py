@@ -1,0 +1,167 @@
+"""Run directories: one per run, safe to kill, resume and read while it runs.
+
+A run directory holds
+
+* ``config.json``: the run's configuration (a dataclass, see ``craftsuite.training``);
+* ``episodes.csv``: one row per finished training episode (step, return, length, success);
+* ``evals.csv``: one row per evaluation (step, success rate, mean return, episodes);
+* ``checkpoint/``: the last model and replay buffer, written together at each evaluation;
+* ``tb/``: TensorBoard logs;
+* ``result.json``: written last; its presence means the run is finished and reusable.
+
+Every whole-file write goes through a temporary file and ``os.replace``, so a killed run
+never leaves a half-written file. A lock file with the owner's pid keeps two live runs out
+of one directory; a lock left by a dead process is taken over (that run resumes).
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import hashlib
+import json
+import os
+import socket
+from pathlib import Path
+
+EPISODE_FIELDS = ("step", "return", "length", "success")
+EVAL_FIELDS = ("step", "success", "return", "episodes")
+
+
+class RunError(RuntimeError):
+    """A run directory that cannot be used (locked by a live run, or holding another config)."""
+
+
+def atomic_write(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` so that readers see the old file or the new one, never half."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    with open(tmp, "w") as f:
+        f.write(text)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def config_key(config) -> str:
+    """A short stable hash of a config dataclass: equal configs share a run directory."""
+    text = json.dumps(dataclasses.asdict(config), sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:10]
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+class RunDir:
+    """One run's directory. Use as a context manager: it holds the lock while open."""
+
+    def __init__(self, path, config):
+        self.path = Path(path)
+        self.config = config
+        self._lock = self.path / ".lock"
+
+    # -- ownership -------------------------------------------------------------------------------
+    def __enter__(self) -> "RunDir":
+        self.path.mkdir(parents=True, exist_ok=True)
+        self._acquire()
+        saved = self.path / "config.json"
+        mine = json.dumps(dataclasses.asdict(self.config), indent=2, sort_keys=True)
+        if saved.exists() and json.loads(saved.read_text()) != json.loads(mine):
+            self._release()
+            raise RunError(f"{self.path} holds a run with another configuration ({saved}); "
+                           "choose another output directory")
+        atomic_write(saved, mine + "\n")
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._release()
+
+    def _acquire(self) -> None:
+        me = f"{socket.gethostname()} {os.getpid()}"
+        for _ in range(2):
+            try:
+                fd = os.open(self._lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+            except FileExistsError:
+                host, _, pid = self._lock.read_text().strip().partition(" ")
+                if host == socket.gethostname() and pid.isdigit() and not _pid_alive(int(pid)):
+                    self._lock.unlink(missing_ok=True)  # its owner died: take over and resume
+                    continue
+                raise RunError(f"{self.path} is in use by another run (process {pid} on {host}); "
+                               f"delete {self._lock} if that run is gone") from None
+            with os.fdopen(fd, "w") as f:
+                f.write(me)
+            return
+        raise RunError(f"could not lock {self.path}")
+
+    def _release(self) -> None:
+        self._lock.unlink(missing_ok=True)
+
+    # -- files -----------------------------------------------------------------------------------
+    @property
+    def checkpoint(self) -> Path:
+        return self.path / "checkpoint" / "model.zip"
+
+    @property
+    def replay(self) -> Path:
+        return self.path / "checkpoint" / "replay.pkl"
+
+    @property
+    def result_path(self) -> Path:
+        return self.path / "result.json"
+
+    def finished(self) -> bool:
+        return self.result_path.exists()
+
+    def result(self) -> dict:
+        return json.loads(self.result_path.read_text())
+
+    def write_result(self, result: dict) -> None:
+        atomic_write(self.result_path, json.dumps(result, indent=2) + "\n")
+
+    def write_progress(self, step: int, total: int) -> None:
+        atomic_write(self.path / "progress.json", json.dumps({"step": step, "total": total}))
+
+    def trim_logs(self, step: int) -> None:
+        """Drop log rows after ``step`` (the checkpoint a resumed run starts from): those
+        episodes are played again, and would otherwise be counted twice."""
+        for name, fields in (("episodes.csv", EPISODE_FIELDS), ("evals.csv", EVAL_FIELDS)):
+            rows = [r for r in read_csv(self.path / name) if int(float(r["step"])) <= step]
+            write_csv(self.path / name, fields, rows)
+
+    def append(self, name: str, fields: tuple[str, ...], rows: list[dict]) -> None:
+        """Append rows to a CSV log (header on first write), flushed to disk."""
+        path = self.path / name
+        new = not path.exists() or path.stat().st_size == 0
+        with open(path, "a", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=fields)
+            if new:
+                writer.writeheader()
+            writer.writerows(rows)
+            f.flush()
+            os.fsync(f.fileno())
+
+
+def read_csv(path) -> list[dict]:
+    path = Path(path)
+    if not path.exists():
+        return []
+    with open(path, newline="") as f:
+        return [row for row in csv.DictReader(f) if None not in row.values()]  # a torn last line
+
+
+def write_csv(path, fields, rows) -> None:
+    import io
+
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=fields)
+    writer.writeheader()
+    writer.writerows(rows)
+    atomic_write(Path(path), buf.getvalue())

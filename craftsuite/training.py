@@ -1,0 +1,253 @@
+"""Teachers and students as runs: a config dataclass in, a finished run directory out.
+
+``train_teacher`` trains a product-DQN teacher on a grid until its greedy policy completes
+the task on ``target_success`` of fresh-seed evaluation episodes, then distils it into the
+automaton (``table.npz``). ``train_student`` trains any method of ``METHODS`` for a fixed
+budget. Both evaluate and checkpoint every ``eval_every`` steps into a ``RunDir``; started
+again on the same directory, a finished run is reused and a killed one resumes from its
+last checkpoint.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import shutil
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+from stable_baselines3.common.callbacks import BaseCallback
+
+from .runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, config_key, read_csv
+
+
+@dataclass(frozen=True)
+class TeacherConfig:
+    task: str = "BlindCraftsman"
+    size: int = 7
+    layout_seed: int | None = 0  # one fixed grid instance, as in the paper (None: a new one per episode)
+    seed: int = 0
+    max_steps: int = 300_000
+    target_success: float = 0.9
+    eval_every: int = 5_000
+    eval_episodes: int = 50
+    hyperparameters: dict = field(default_factory=dict)  # overrides of DQN_DEFAULTS
+
+    @property
+    def env_id(self) -> str:
+        return f"CraftSuite/{self.task}-Grid{self.size}-v0"
+
+    @property
+    def env_kwargs(self) -> dict:
+        return {} if self.layout_seed is None else {"layout_seed": self.layout_seed}
+
+    def run_name(self) -> str:
+        return f"teacher-{self.task}-Grid{self.size}-s{self.seed}-{config_key(self)}"
+
+
+@dataclass(frozen=True)
+class StudentConfig:
+    task: str = "BlindCraftsman"
+    method: str = "td3-dynamic"
+    world: str = "Cont"  # "Cont" (MuJoCo) or "Grid10" / "Grid7"
+    seed: int = 0
+    steps: int = 20_000
+    table: str | None = None  # a teacher's table.npz (method *-dynamic)
+    eval_every: int = 2_000
+    eval_episodes: int = 10
+    hyperparameters: dict = field(default_factory=dict)
+
+    @property
+    def env_id(self) -> str:
+        return f"CraftSuite/{self.task}-{self.world}-v0"
+
+    def run_name(self) -> str:
+        return f"student-{self.task}-{self.world}-{self.method}-s{self.seed}-{config_key(self)}"
+
+
+def config_from_dict(data: dict):
+    """The config dataclass a ``config.json`` was written from."""
+    cls = TeacherConfig if "max_steps" in data else StudentConfig
+    return cls(**data)
+
+
+def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kwargs: dict | None = None):
+    """Greedy episodes on fresh seeds: (success rate, mean return)."""
+    env = gym.make(env_id, product=product, **(env_kwargs or {}))
+    wins, returns = 0, []
+    for i in range(episodes):
+        obs, _ = env.reset(seed=seed + i)
+        done, total = False, 0.0
+        while not done:
+            action, _ = agent.predict(obs, deterministic=True)
+            obs, reward, term, trunc, info = env.step(action)
+            total += float(reward)
+            done = term or trunc
+        wins += bool(info["is_success"])
+        returns.append(total)
+    env.close()
+    return wins / episodes, float(np.mean(returns))
+
+
+class RunCallback(BaseCallback):
+    """Logs episodes, evaluates, checkpoints, reports progress; stops at ``stop_at`` success."""
+
+    def __init__(self, run: RunDir, total: int, eval_every: int, evaluate_fn, stop_at: float | None = None,
+                 bar=None):
+        super().__init__()
+        self.run, self.total, self.eval_every = run, total, eval_every
+        self.evaluate_fn, self.stop_at, self.bar = evaluate_fn, stop_at, bar
+        self.pending: list[dict] = []
+        self.last_success = 0.0
+
+    def _on_training_start(self) -> None:
+        self.next_eval = (self.num_timesteps // self.eval_every + 1) * self.eval_every
+        self.next_flush = self.num_timesteps + 1_000
+        if self.bar is not None:
+            self.bar.update(self.num_timesteps - self.bar.n)
+
+    def _on_step(self) -> bool:
+        for info in self.locals["infos"]:
+            if "episode" in info:
+                self.pending.append({"step": self.num_timesteps, "return": round(float(info["episode"]["r"]), 4),
+                                     "length": int(info["episode"]["l"]), "success": int(bool(info.get("is_success")))})
+        if self.bar is not None:
+            self.bar.update(self.num_timesteps - self.bar.n)
+        if self.num_timesteps >= self.next_flush:
+            self._flush()
+            self.next_flush = self.num_timesteps + 1_000
+        if self.num_timesteps >= self.next_eval or self.num_timesteps >= self.total:
+            self.next_eval += self.eval_every
+            return self._evaluate_and_checkpoint()
+        return True
+
+    def _flush(self) -> None:
+        if self.pending:
+            self.run.append("episodes.csv", EPISODE_FIELDS, self.pending)
+            self.pending = []
+        self.run.write_progress(self.num_timesteps, self.total)
+
+    def _evaluate_and_checkpoint(self) -> bool:
+        self._flush()
+        success, ret = self.evaluate_fn(self.model, self.num_timesteps)
+        self.last_success = success
+        self.run.append("evals.csv", EVAL_FIELDS, [{"step": self.num_timesteps, "success": success,
+                                                     "return": round(ret, 4), "episodes": 0}])
+        self.logger.record("eval/success", success)
+        self.logger.record("eval/return", ret)
+        save_checkpoint(self.model, self.run)
+        if self.bar is not None:
+            self.bar.set_postfix(success=f"{success:.2f}")
+        return self.stop_at is None or success < self.stop_at
+
+
+def save_checkpoint(agent, run: RunDir) -> None:
+    """Model and replay buffer together: written beside, then swapped in."""
+    new, final, old = run.path / "checkpoint-new", run.checkpoint.parent, run.path / "checkpoint-old"
+    shutil.rmtree(new, ignore_errors=True)
+    new.mkdir()
+    agent.save(new / "model.zip")
+    agent.save_replay_buffer(new / "replay.pkl")
+    if final.exists():
+        final.rename(old)
+    new.rename(final)
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def _checkpoint_dir(run: RunDir) -> Path | None:
+    for d in (run.checkpoint.parent, run.path / "checkpoint-old"):  # -old: killed mid-swap
+        if (d / "model.zip").exists() and (d / "replay.pkl").exists():
+            return d
+    return None
+
+
+def _learn(run: RunDir, fresh, total: int, eval_every: int, evaluate_fn, stop_at=None, progress=True,
+           desc: str = ""):
+    """Train ``fresh`` (or the run's checkpoint, if there is one) up to ``total`` steps."""
+    from tqdm import tqdm
+
+    agent = fresh
+    saved = _checkpoint_dir(run)
+    if saved is not None:
+        agent = type(fresh).load(saved / "model.zip", env=fresh.get_env(), device="cpu")
+        agent.load_replay_buffer(saved / "replay.pkl")
+        run.trim_logs(agent.num_timesteps)
+    else:
+        run.trim_logs(0)
+    agent.tensorboard_log = str(run.path / "tb")
+    with tqdm(total=total, desc=desc, unit="step", disable=not progress, dynamic_ncols=True,
+              mininterval=1.0) as bar:
+        callback = RunCallback(run, total, eval_every, evaluate_fn, stop_at, bar)
+        if agent.num_timesteps < total and not _stopped(run, stop_at):
+            agent.learn(total - agent.num_timesteps, callback=callback, reset_num_timesteps=False,
+                        tb_log_name="run")
+    return agent
+
+
+def _stopped(run: RunDir, stop_at) -> bool:
+    evals = read_csv(run.path / "evals.csv")
+    return stop_at is not None and bool(evals) and float(evals[-1]["success"]) >= stop_at
+
+
+def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
+    """A teacher run under ``root``; returns its directory (with teacher.zip and table.npz)."""
+    from .agents.methods import distill_from_replay, make_agent
+
+    with RunDir(Path(root) / config.run_name(), config) as run:
+        if run.finished():
+            return run.path
+        start = time.perf_counter()
+        fresh = make_agent("product-dqn", config.env_id, seed=config.seed, env_kwargs=config.env_kwargs,
+                           **config.hyperparameters)
+
+        def evaluate_fn(model, step):
+            return evaluate(model, config.env_id, config.eval_episodes, seed=10**7 + step, product=True,
+                            env_kwargs=config.env_kwargs)
+
+        agent = _learn(run, fresh, config.max_steps, config.eval_every, evaluate_fn, stop_at=config.target_success,
+                       progress=progress, desc=f"teacher {config.task}")
+        agent.save(run.path / "teacher.zip")
+        distill_from_replay(agent).save(run.path / "table.npz")
+        evals = read_csv(run.path / "evals.csv")
+        success = float(evals[-1]["success"]) if evals else 0.0
+        run.write_result({"kind": "teacher", "env_id": config.env_id, "steps": int(agent.num_timesteps),
+                          "success": success, "reached_target": success >= config.target_success,
+                          "seconds_this_session": round(time.perf_counter() - start, 1),
+                          "table": "table.npz", "model": "teacher.zip"})
+        return run.path
+
+
+def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
+    """A student (or baseline) run under ``root``; returns its directory."""
+    from .agents import AutomatonQTable
+    from .agents.methods import METHODS, make_agent
+
+    method = METHODS[config.method] if config.method in METHODS else None
+    if method is None:
+        raise KeyError(f"unknown method {config.method!r}; methods: {sorted(METHODS)}")
+    with RunDir(Path(root) / config.run_name(), config) as run:
+        if run.finished():
+            return run.path
+        start = time.perf_counter()
+        table = AutomatonQTable.load(config.table) if method.distill == "dynamic" else None
+        hyper = dict(config.hyperparameters)
+        hyper.setdefault("buffer_size", min(config.steps, 1_000_000))
+        fresh = make_agent(config.method, config.env_id, table=table, seed=config.seed, **hyper)
+
+        def evaluate_fn(model, step):
+            return evaluate(model, config.env_id, config.eval_episodes, seed=10**7 + step, product=method.product)
+
+        agent = _learn(run, fresh, config.steps, config.eval_every, evaluate_fn, progress=progress,
+                       desc=f"{config.method} {config.task} s{config.seed}")
+        agent.save(run.path / "model.zip")
+        run.write_result({"kind": "student", "env_id": config.env_id, "method": config.method,
+                          "task": config.task, "seed": config.seed, "steps": int(agent.num_timesteps),
+                          "product": method.product, "model": "model.zip",
+                          "seconds_this_session": round(time.perf_counter() - start, 1)})
+        return run.path
+
+
+def as_dict(config) -> dict:
+    return dataclasses.asdict(config)

@@ -1,5 +1,6 @@
 # The two commands a new user needs (both do the whole set-up first, once):
-#   make demo   the main job (for now: roll out a grid world, write pictures to out/)
+#   make demo   the main job: the quick transfer benchmark (grid teacher -> MuJoCo students),
+#               ending in a leaderboard, learning curves and a video in runs/quick
 #   make test   the default test run (slow tests excluded; `make test-slow` runs them)
 VENV ?= .venv
 PY := $(VENV)/bin/python
@@ -14,7 +15,7 @@ $(STAMP): pyproject.toml constraints.txt scripts/setup.sh
 setup: $(STAMP)
 
 demo: $(STAMP)
-	$(PY) -m craftsuite demo --out out/demo
+	$(PY) -m craftsuite transfer --suite quick --out runs/quick
 
 test: $(STAMP)
 	$(PY) -m pytest -q

@@ -61,7 +61,7 @@ SUITES = {s.name: s for s in (
     Suite("quick", "Blind Craftsman: grid teacher -> MuJoCo TD3 student, dynamic distillation vs scratch "
           "(about 15 minutes on 2 cores)",
           tasks=("BlindCraftsman",), worlds=("Cont",), methods=("td3-dynamic", "td3"), seeds=2,
-          student_steps=12_000, eval_every=2_000, eval_episodes=5,
+          student_steps=20_000, eval_every=2_000, eval_episodes=5,
           student_hyperparameters={"policy_kwargs": {"net_arch": [256, 256]}}),
     Suite("standard", "all three tasks in MuJoCo: dynamic, static and scratch TD3, 5 seeds, 200k steps",
           tasks=("BlindCraftsman", "DungeonQuest", "DiamondMine"), worlds=("Cont",),

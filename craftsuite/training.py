@@ -170,7 +170,7 @@ def _checkpoint_dir(run: RunDir) -> Path | None:
 def _learn(run: RunDir, fresh, total: int, eval_every: int, evaluate_fn, stop_at=None, progress=True,
            desc: str = ""):
     """Train ``fresh`` (or the run's checkpoint, if there is one) up to ``total`` steps."""
-    from tqdm import tqdm
+    import torch
 
     agent = fresh
     saved = _checkpoint_dir(run)
@@ -181,6 +181,17 @@ def _learn(run: RunDir, fresh, total: int, eval_every: int, evaluate_fn, stop_at
     else:
         run.trim_logs(0)
     agent.tensorboard_log = str(run.path / "tb")
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)  # these nets are small: one thread is faster, and leaves cores to other runs
+    try:
+        return _learn_loop(run, agent, total, eval_every, evaluate_fn, stop_at, progress, desc)
+    finally:
+        torch.set_num_threads(threads)
+
+
+def _learn_loop(run, agent, total, eval_every, evaluate_fn, stop_at, progress, desc):
+    from tqdm import tqdm
+
     with tqdm(total=total, desc=desc, unit="step", disable=not progress, dynamic_ncols=True,
               mininterval=1.0) as bar:
         callback = RunCallback(run, total, eval_every, evaluate_fn, stop_at, bar)

@@ -18,7 +18,7 @@ demo: $(STAMP)
 	$(PY) -m craftsuite transfer --suite quick --out runs/quick
 
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q --nbmake tests notebooks
 
 test-slow: $(STAMP)
 	$(PY) -m pytest -q -m slow

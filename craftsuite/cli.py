@@ -145,18 +145,30 @@ def _distill(args) -> int:
         from .agents.methods import distill_from_replay, load_agent
 
         source = Path(args.source)
-        if source.is_dir():  # a teacher run directory: its replay buffer is in the checkpoint
-            model, replay = source / "checkpoint" / "model.zip", source / "checkpoint" / "replay.pkl"
+        env_id, env_kwargs = args.env_id or f"CraftSuite/{args.task}-Grid7-v0", {}
+        if source.is_dir():  # a teacher run directory: its config names the env, its checkpoint the replay
+            import json
+
+            from .training import TeacherConfig, checkpoint_dir
+            from .runs import RunDir
+
+            config_path = source / "config.json"
+            if not config_path.is_file():
+                raise FileNotFoundError(f"{source} is not a teacher run directory (no config.json)")
+            config = TeacherConfig(**json.loads(config_path.read_text()))
+            env_id, env_kwargs = config.env_id, config.env_kwargs
+            saved = checkpoint_dir(RunDir(source, config))
+            if saved is None:
+                raise FileNotFoundError(f"{source} has no checkpoint (model and replay buffer) yet")
+            model, replay = saved / "model.zip", saved / "replay.pkl"
         else:
             model, replay = source, Path(args.replay) if args.replay else None
         if replay is None or not replay.is_file():
             raise FileNotFoundError(f"dynamic distillation needs the teacher's replay buffer: "
                                     f"{replay or 'pass --replay'} (or a teacher run directory)")
-        teacher = load_agent(model)
-        if teacher.get_env() is None:
-            env_id = args.env_id or f"CraftSuite/{args.task}-Grid7-v0"
-            from stable_baselines3.common.env_util import make_vec_env
-            teacher.set_env(make_vec_env(env_id, n_envs=1, env_kwargs={"product": True}))
+        from stable_baselines3.common.env_util import make_vec_env
+
+        teacher = load_agent(model, env=make_vec_env(env_id, n_envs=1, env_kwargs={"product": True, **env_kwargs}))
         teacher.load_replay_buffer(replay)
         table = distill_from_replay(teacher)
         automaton = teacher.get_env().envs[0].unwrapped.automaton
@@ -178,7 +190,7 @@ def _student(args) -> int:
     from .training import StudentConfig, train_student
 
     config = StudentConfig(task=args.task, method=args.method, world=args.world, seed=args.seed, steps=args.steps,
-                           table=args.table, eval_every=args.eval_every, eval_episodes=args.eval_episodes,
+                           table=str(Path(args.table).resolve()) if args.table else None, eval_every=args.eval_every, eval_episodes=args.eval_episodes,
                            hyperparameters=_hyper(args.hyper))
     if args.method.endswith("dynamic") and not args.table:
         raise ValueError(f"method {args.method!r} needs --table (a teacher's table.npz: craftsuite teacher)")
@@ -339,7 +351,7 @@ def main(argv=None) -> int:
         return args.run(args)
     except BrokenPipeError:  # output piped into `head` and the like
         return 0
-    except (KeyError, ValueError, RuntimeError, FileNotFoundError, gym_error()) as err:
+    except (KeyError, ValueError, TypeError, RuntimeError, FileNotFoundError, gym_error()) as err:
         print(f"craftsuite {args.command}: error: {err.args[0] if isinstance(err, KeyError) else err}",
               file=sys.stderr)
         return 2

@@ -5,7 +5,8 @@ Per run (``run_metrics``):
 * ``success``: greedy success rate at the last evaluation;
 * ``return``: mean training-episode return over the last 10% of the run's steps;
 * ``auc``: area under the evaluation success curve, as a fraction of the budget (the mean
-  of the evaluations, which are equally spaced): 1.0 means solved from the first one;
+  of the evaluations, every ``eval_every`` steps and at the end): 1.0 means solved from the
+  first one;
 * ``steps_to_80``: env steps at the first evaluation with success >= 0.8 (None: never).
 
 Per task, world and method (``build``): the mean over seeds with a 95% bootstrap
@@ -43,6 +44,8 @@ def run_metrics(run: Path) -> dict | None:
         return None
     result = json.loads((run / "result.json").read_text())
     config = json.loads((run / "config.json").read_text())
+    if result.get("kind") != "student":
+        return None  # a teacher run
     budget = int(config["steps"])
     episodes = read_csv(run / "episodes.csv")
     evals = read_csv(run / "evals.csv")
@@ -164,14 +167,11 @@ def _curve(values_at, grid):
 
 def plot_curves(students_root, out) -> list[Path]:
     """Figure-5-style learning curves per task and world: mean and 95% band over seeds."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure  # not pyplot: no global backend switch in the caller's session
 
     runs: dict[tuple, list[tuple[dict, list, list, int]]] = {}
     for run in sorted(Path(students_root).iterdir()) if Path(students_root).is_dir() else []:
-        if not (run / "result.json").exists():
+        if run_metrics(run) is None:
             continue
         config = json.loads((run / "config.json").read_text())
         episodes = read_csv(run / "episodes.csv")
@@ -182,7 +182,8 @@ def plot_curves(students_root, out) -> list[Path]:
     for (task, world), group in sorted(runs.items()):
         budget = max(g[3] for g in group)
         grid = np.linspace(budget / 50, budget, 50)
-        fig, axes = plt.subplots(1, 2, figsize=(10, 3.6))
+        fig = Figure(figsize=(10, 3.6))
+        axes = fig.subplots(1, 2)
         for method in sorted({g[0]["method"] for g in group}):
             mine = [g for g in group if g[0]["method"] == method]
             for ax, series in zip(axes, (
@@ -206,7 +207,6 @@ def plot_curves(students_root, out) -> list[Path]:
         path = Path(out) / f"curves-{task}-{world}.png"
         tmp = path.with_name(f".{path.name}.tmp.png")
         fig.savefig(tmp, dpi=110)
-        plt.close(fig)
         tmp.replace(path)
         paths.append(path)
     return paths

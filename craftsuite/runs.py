@@ -10,14 +10,16 @@ A run directory holds
 * ``result.json``: written last; its presence means the run is finished and reusable.
 
 Every whole-file write goes through a temporary file and ``os.replace``, so a killed run
-never leaves a half-written file. A lock file with the owner's pid keeps two live runs out
-of one directory; a lock left by a dead process is taken over (that run resumes).
+never leaves a half-written file. An advisory lock (``flock`` on ``.lock``, which names its
+holder) keeps two live runs out of one directory; the kernel drops it when its holder
+dies, so a killed run can be started again at once (it resumes).
 """
 
 from __future__ import annotations
 
 import csv
 import dataclasses
+import fcntl
 import hashlib
 import json
 import os
@@ -37,27 +39,20 @@ def atomic_write(path: Path, text: str) -> None:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(tmp, "w") as f:
-        f.write(text)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "w") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 def config_key(config) -> str:
     """A short stable hash of a config dataclass: equal configs share a run directory."""
     text = json.dumps(dataclasses.asdict(config), sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:10]
-
-
-def _pid_alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
 
 
 class RunDir:
@@ -85,24 +80,20 @@ class RunDir:
         self._release()
 
     def _acquire(self) -> None:
-        me = f"{socket.gethostname()} {os.getpid()}"
-        for _ in range(2):
-            try:
-                fd = os.open(self._lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
-            except FileExistsError:
-                host, _, pid = self._lock.read_text().strip().partition(" ")
-                if host == socket.gethostname() and pid.isdigit() and not _pid_alive(int(pid)):
-                    self._lock.unlink(missing_ok=True)  # its owner died: take over and resume
-                    continue
-                raise RunError(f"{self.path} is in use by another run (process {pid} on {host}); "
-                               f"delete {self._lock} if that run is gone") from None
-            with os.fdopen(fd, "w") as f:
-                f.write(me)
-            return
-        raise RunError(f"could not lock {self.path}")
+        # An advisory lock held on an open file: the kernel drops it when its owner dies, so a
+        # killed run's directory is free again at once, and two live runs can never both hold it.
+        self._fd = os.open(self._lock, os.O_CREAT | os.O_RDWR)
+        try:
+            fcntl.flock(self._fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            owner = os.pread(self._fd, 200, 0).decode(errors="replace").strip() or "unknown"
+            os.close(self._fd)
+            raise RunError(f"{self.path} is in use by another run (process {owner})") from None
+        os.ftruncate(self._fd, 0)
+        os.pwrite(self._fd, f"{socket.gethostname()} {os.getpid()}".encode(), 0)
 
     def _release(self) -> None:
-        self._lock.unlink(missing_ok=True)
+        os.close(self._fd)  # releases the lock; the file stays (unlinking it would race a new owner)
 
     # -- files -----------------------------------------------------------------------------------
     @property

@@ -8,7 +8,8 @@ one end to end under an output directory::
     <out>/leaderboard.md, leaderboard.csv, curves-<Task>-<world>.png, best-<...>.mp4
 
 Student runs go to local processes (``workers`` at a time) or, with ``ray``, to a Ray
-cluster (``"local"`` starts one in-process). Runs that already finished are reused.
+cluster (``"local"`` starts one in-process; a real cluster needs ``out`` on a filesystem
+every node sees). Runs that already finished are reused.
 """
 
 from __future__ import annotations
@@ -43,6 +44,9 @@ class Suite:
     student_hyperparameters: dict = field(default_factory=dict)
 
     def student_configs(self, tables: dict[str, str]) -> list[StudentConfig]:
+        unknown = [m for m in self.methods if m not in GRID_METHODS + CONT_METHODS]
+        if unknown:
+            raise KeyError(f"unknown method(s) {unknown}; methods: {sorted(GRID_METHODS + CONT_METHODS)}")
         out = []
         for task in self.tasks:
             for world in self.worlds:
@@ -54,6 +58,9 @@ class Suite:
                             table=tables[task] if method.endswith("dynamic") else None,
                             eval_every=self.eval_every, eval_episodes=self.eval_episodes,
                             hyperparameters=dict(self.student_hyperparameters)))
+        if not out:
+            raise ValueError(f"no method of {list(self.methods)} runs in the worlds {list(self.worlds)} "
+                             f"(grid: {list(GRID_METHODS)}; Cont: {list(CONT_METHODS)})")
         return out
 
 
@@ -161,6 +168,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     """The suite end to end: teachers, distillation, students, leaderboard, plots, video."""
     from . import leaderboard
 
+    suite.student_configs({task: "" for task in suite.tasks})  # a bad suite fails before any training
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     atomic_write(out / "suite.json", json.dumps(dataclasses.asdict(suite), indent=2) + "\n")
@@ -171,7 +179,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         result = json.loads((path / "result.json").read_text())
         log(f"teacher {task}: {result['steps']:,} steps, greedy success {result['success']:.2f} "
             f"({'reached' if result['reached_target'] else 'did NOT reach'} {config.target_success:.0%}) -> {path}")
-        teachers[task], tables[task] = path, str(path / "table.npz")
+        teachers[task], tables[task] = path, str((path / "table.npz").resolve())
     configs = suite.student_configs(tables)
     students = run_students(configs, out / "students", workers=workers, ray=ray, progress=progress)
     board = leaderboard.build(out / "students")
@@ -186,7 +194,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
 
 
 def _best_student_video(board, students_root: Path, out: Path) -> Path | None:
-    """A rollout of the best student run (highest final success, then return) of the best method."""
+    """A rollout of the best student run of the suite (highest final success, then return)."""
     from .rollouts import record_video
 
     runs = []

@@ -10,7 +10,6 @@ last checkpoint.
 
 from __future__ import annotations
 
-import dataclasses
 import shutil
 import time
 from dataclasses import dataclass, field
@@ -67,12 +66,6 @@ class StudentConfig:
         return f"student-{self.task}-{self.world}-{self.method}-s{self.seed}-{config_key(self)}"
 
 
-def config_from_dict(data: dict):
-    """The config dataclass a ``config.json`` was written from."""
-    cls = TeacherConfig if "max_steps" in data else StudentConfig
-    return cls(**data)
-
-
 def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kwargs: dict | None = None):
     """Greedy episodes on fresh seeds, played side by side so that the policy sees one
     batch per step (an untrained policy that never finishes costs 1,000 batched calls, not
@@ -98,13 +91,12 @@ def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kw
 class RunCallback(BaseCallback):
     """Logs episodes, evaluates, checkpoints, reports progress; stops at ``stop_at`` success."""
 
-    def __init__(self, run: RunDir, total: int, eval_every: int, evaluate_fn, stop_at: float | None = None,
-                 bar=None):
+    def __init__(self, run: RunDir, total: int, eval_every: int, eval_episodes: int, evaluate_fn,
+                 stop_at: float | None = None, bar=None):
         super().__init__()
-        self.run, self.total, self.eval_every = run, total, eval_every
+        self.run, self.total, self.eval_every, self.eval_episodes = run, total, eval_every, eval_episodes
         self.evaluate_fn, self.stop_at, self.bar = evaluate_fn, stop_at, bar
         self.pending: list[dict] = []
-        self.last_success = 0.0
 
     def _on_training_start(self) -> None:
         self.next_eval = (self.num_timesteps // self.eval_every + 1) * self.eval_every
@@ -136,9 +128,8 @@ class RunCallback(BaseCallback):
     def _evaluate_and_checkpoint(self) -> bool:
         self._flush()
         success, ret = self.evaluate_fn(self.model, self.num_timesteps)
-        self.last_success = success
         self.run.append("evals.csv", EVAL_FIELDS, [{"step": self.num_timesteps, "success": success,
-                                                     "return": round(ret, 4), "episodes": 0}])
+                                                     "return": round(ret, 4), "episodes": self.eval_episodes}])
         self.logger.record("eval/success", success)
         self.logger.record("eval/return", ret)
         save_checkpoint(self.model, self.run)
@@ -151,6 +142,7 @@ def save_checkpoint(agent, run: RunDir) -> None:
     """Model and replay buffer together: written beside, then swapped in."""
     new, final, old = run.path / "checkpoint-new", run.checkpoint.parent, run.path / "checkpoint-old"
     shutil.rmtree(new, ignore_errors=True)
+    shutil.rmtree(old, ignore_errors=True)  # left by a kill during the last swap
     new.mkdir()
     agent.save(new / "model.zip")
     agent.save_replay_buffer(new / "replay.pkl")
@@ -160,23 +152,25 @@ def save_checkpoint(agent, run: RunDir) -> None:
     shutil.rmtree(old, ignore_errors=True)
 
 
-def _checkpoint_dir(run: RunDir) -> Path | None:
+def checkpoint_dir(run: RunDir) -> Path | None:
+    """The directory of the run's last complete checkpoint (model and replay), if any."""
     for d in (run.checkpoint.parent, run.path / "checkpoint-old"):  # -old: killed mid-swap
         if (d / "model.zip").exists() and (d / "replay.pkl").exists():
             return d
     return None
 
 
-def _learn(run: RunDir, fresh, total: int, eval_every: int, evaluate_fn, stop_at=None, progress=True,
-           desc: str = ""):
+def _learn(run: RunDir, fresh, total: int, eval_every: int, eval_episodes: int, evaluate_fn, stop_at=None,
+           progress=True, desc: str = ""):
     """Train ``fresh`` (or the run's checkpoint, if there is one) up to ``total`` steps."""
     import torch
 
     agent = fresh
-    saved = _checkpoint_dir(run)
+    saved = checkpoint_dir(run)
     if saved is not None:
-        agent = type(fresh).load(saved / "model.zip", env=fresh.get_env(), device="cpu")
+        agent = type(fresh).load(saved / "model.zip", env=fresh.get_env(), device=fresh.device)
         agent.load_replay_buffer(saved / "replay.pkl")
+        agent.replay_buffer.device = agent.device
         run.trim_logs(agent.num_timesteps)
     else:
         run.trim_logs(0)
@@ -184,17 +178,17 @@ def _learn(run: RunDir, fresh, total: int, eval_every: int, evaluate_fn, stop_at
     threads = torch.get_num_threads()
     torch.set_num_threads(1)  # these nets are small: one thread is faster, and leaves cores to other runs
     try:
-        return _learn_loop(run, agent, total, eval_every, evaluate_fn, stop_at, progress, desc)
+        return _learn_loop(run, agent, total, eval_every, eval_episodes, evaluate_fn, stop_at, progress, desc)
     finally:
         torch.set_num_threads(threads)
 
 
-def _learn_loop(run, agent, total, eval_every, evaluate_fn, stop_at, progress, desc):
+def _learn_loop(run, agent, total, eval_every, eval_episodes, evaluate_fn, stop_at, progress, desc):
     from tqdm import tqdm
 
     with tqdm(total=total, desc=desc, unit="step", disable=not progress, dynamic_ncols=True,
               mininterval=1.0) as bar:
-        callback = RunCallback(run, total, eval_every, evaluate_fn, stop_at, bar)
+        callback = RunCallback(run, total, eval_every, eval_episodes, evaluate_fn, stop_at, bar)
         if agent.num_timesteps < total and not _stopped(run, stop_at):
             agent.learn(total - agent.num_timesteps, callback=callback, reset_num_timesteps=False,
                         tb_log_name="run")
@@ -221,7 +215,8 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
             return evaluate(model, config.env_id, config.eval_episodes, seed=10**7 + step, product=True,
                             env_kwargs=config.env_kwargs)
 
-        agent = _learn(run, fresh, config.max_steps, config.eval_every, evaluate_fn, stop_at=config.target_success,
+        agent = _learn(run, fresh, config.max_steps, config.eval_every, config.eval_episodes, evaluate_fn,
+                       stop_at=config.target_success,
                        progress=progress, desc=f"teacher {config.task}")
         agent.save(run.path / "teacher.zip")
         distill_from_replay(agent).save(run.path / "table.npz")
@@ -254,7 +249,8 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
         def evaluate_fn(model, step):
             return evaluate(model, config.env_id, config.eval_episodes, seed=10**7 + step, product=method.product)
 
-        agent = _learn(run, fresh, config.steps, config.eval_every, evaluate_fn, progress=progress,
+        agent = _learn(run, fresh, config.steps, config.eval_every, config.eval_episodes, evaluate_fn,
+                       progress=progress,
                        desc=f"{config.method} {config.task} s{config.seed}")
         agent.save(run.path / "model.zip")
         run.write_result({"kind": "student", "env_id": config.env_id, "method": config.method,
@@ -263,6 +259,3 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
                           "seconds_this_session": round(time.perf_counter() - start, 1)})
         return run.path
 
-
-def as_dict(config) -> dict:
-    return dataclasses.asdict(config)

@@ -168,11 +168,21 @@ class DistilledTarget:
         self.q_teacher = table.q.astype(np.float32)
         self.seen = table.seen
         self.student_counts = np.zeros(table.q.shape, dtype=np.int64)
-        # flat views: one fancy index per array per minibatch (this runs every gradient step)
         self._n_labels = table.q.shape[1]
+        self._make_views()
+
+    def _make_views(self) -> None:
+        # flat views: one fancy index per array per minibatch (this runs every gradient step)
         self._teacher_flat = self.q_teacher.reshape(-1)
         self._seen_flat = self.seen.reshape(-1).astype(np.float32)
         self._counts_flat = self.student_counts.reshape(-1)
+
+    def __getstate__(self) -> dict:  # views do not survive pickling (checkpoints): rebuild them
+        return {k: v for k, v in self.__dict__.items() if not k.endswith("_flat")}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._make_views()
 
     def beta(self, w: np.ndarray, sigma: np.ndarray) -> np.ndarray:
         flat = np.asarray(w) * self._n_labels + np.asarray(sigma)

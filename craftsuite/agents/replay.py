@@ -101,9 +101,10 @@ class AutomatonReplayBuffer(ReplayBuffer):
         the 1M that SB3 allocates up front."""
         state = self.__dict__.copy()
         if not self.full:
+            rows = self.pos + 1 if self.optimize_memory_usage else self.pos  # next obs live at row pos
             for name in self._ROWS:
                 if isinstance(state.get(name), np.ndarray):
-                    state[name] = state[name][:self.pos].copy()
+                    state[name] = state[name][:rows].copy()
         return state
 
     def __setstate__(self, state: dict) -> None:

@@ -1,0 +1,90 @@
+"""Leaderboard numbers on synthetic run directories with known answers."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from craftsuite import leaderboard
+from craftsuite.runs import EPISODE_FIELDS, EVAL_FIELDS, write_csv
+
+
+def fake_run(root, method, seed, evals, episodes, budget=1_000, task="BlindCraftsman", world="Cont"):
+    run = root / f"student-{task}-{world}-{method}-s{seed}"
+    run.mkdir(parents=True)
+    (run / "config.json").write_text(json.dumps({"task": task, "world": world, "method": method, "seed": seed,
+                                                 "steps": budget}))
+    (run / "result.json").write_text(json.dumps({"kind": "student", "steps": budget}))
+    write_csv(run / "evals.csv", EVAL_FIELDS,
+              [{"step": s, "success": v, "return": 0.0, "episodes": 10} for s, v in evals])
+    write_csv(run / "episodes.csv", EPISODE_FIELDS,
+              [{"step": s, "return": r, "length": 10, "success": 0} for s, r in episodes])
+    return run
+
+
+@pytest.fixture
+def runs(tmp_path):
+    root = tmp_path / "students"
+    # fast: 80% at step 500 on both seeds; returns in the last 10% (step > 900): 10 and 20
+    fake_run(root, "td3-dynamic", 0, [(250, 0.2), (500, 0.8), (750, 1.0), (1000, 1.0)],
+             [(100, -50.0), (950, 10.0), (1000, 10.0)])
+    fake_run(root, "td3-dynamic", 1, [(250, 0.4), (500, 0.8), (750, 0.8), (1000, 0.6)],
+             [(900, -99.0), (990, 20.0)])
+    # slow: one seed reaches 80% at 1000, the other never does
+    fake_run(root, "td3", 0, [(250, 0.0), (500, 0.0), (750, 0.4), (1000, 0.8)], [(995, 0.0)])
+    fake_run(root, "td3", 1, [(250, 0.0), (500, 0.0), (750, 0.0), (1000, 0.0)], [(995, -100.0)])
+    (root / "student-unfinished").mkdir()  # no result.json: ignored
+    teacher = root / "teacher-BlindCraftsman-Grid7"  # a teacher run: not on the board
+    teacher.mkdir()
+    (teacher / "config.json").write_text(json.dumps({"task": "BlindCraftsman", "max_steps": 10}))
+    (teacher / "result.json").write_text(json.dumps({"kind": "teacher", "steps": 10}))
+    return root
+
+
+def test_run_metrics_known_answers(runs):
+    m = leaderboard.run_metrics(runs / "student-BlindCraftsman-Cont-td3-dynamic-s0")
+    assert m["success"] == 1.0
+    assert m["auc"] == pytest.approx((0.2 + 0.8 + 1.0 + 1.0) / 4)
+    assert m["steps_to_80"] == 500
+    assert m["return"] == 10.0  # only the episodes after step 900
+    m = leaderboard.run_metrics(runs / "student-BlindCraftsman-Cont-td3-s1")
+    assert m["steps_to_80"] is None and m["success"] == 0.0 and m["return"] == -100.0
+
+
+def test_entries_average_seeds_with_bootstrap_intervals(runs):
+    entries = {e.method: e for e in leaderboard.build(runs)}
+    assert set(entries) == {"td3-dynamic", "td3"}
+    dyn, td3 = entries["td3-dynamic"], entries["td3"]
+    assert dyn.seeds == 2 and dyn.censored == 0
+    mean, lo, hi = dyn.stats["success"]
+    assert mean == pytest.approx(0.8) and lo == pytest.approx(0.6) and hi == pytest.approx(1.0)
+    assert dyn.stats["return"][0] == pytest.approx(15.0)
+    assert dyn.stats["steps_to_80"] == (500.0, 500.0, 500.0)  # both seeds agree: a point interval
+    assert td3.censored == 1
+    assert td3.stats["steps_to_80"][0] == 1000.0  # the censored seed counts at its budget
+
+
+def test_bootstrap_interval_covers_the_mean_and_narrows_with_seeds():
+    rng = np.random.default_rng(1)
+    few, many = rng.normal(size=4), rng.normal(size=400)
+    m, lo, hi = leaderboard.bootstrap_ci(few)
+    assert lo <= m <= hi and hi > lo
+    m2, lo2, hi2 = leaderboard.bootstrap_ci(many)
+    assert hi2 - lo2 < hi - lo
+    assert abs(m2) < 0.2 and lo2 < 0 < hi2
+
+
+def test_markdown_csv_and_plot(runs, tmp_path):
+    entries = leaderboard.build(runs)
+    md = leaderboard.write(entries, tmp_path).read_text()
+    assert "## BlindCraftsman (Cont)" in md
+    assert md.index("| td3-dynamic |") < md.index("| td3 |")  # ranked by AUC
+    assert ">= 1,000" in md and "(1/2 reached)" in md
+    assert "reference: authors' td3-dynamic" in md and "19.95" in md
+    with open(tmp_path / "leaderboard.csv") as f:
+        rows = {r["method"]: r for r in csv.DictReader(f)}
+    assert float(rows["td3-dynamic"]["success"]) == pytest.approx(0.8)
+    assert rows["td3"]["steps_to_80_censored"] == "1"
+    [png] = leaderboard.plot_curves(runs, tmp_path)
+    assert png.name == "curves-BlindCraftsman-Cont.png" and png.read_bytes()[:4] == b"\x89PNG"

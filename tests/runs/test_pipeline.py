@@ -1,0 +1,83 @@
+"""The CLI end to end on a tiny config, and the same students on a local Ray instance."""
+
+import json
+import re
+
+import pytest
+
+from craftsuite.cli import main
+from craftsuite.runs import read_csv
+from craftsuite.suites import SUITES, Suite, run_students
+from craftsuite.training import StudentConfig
+
+TINY = '{"learning_starts": 100, "buffer_size": 5000}'
+
+
+def test_cli_teacher_distill_student_leaderboard_video(tmp_path, capsys, gl_available):
+    runs = tmp_path / "runs"
+    assert main(["teacher", "BlindCraftsman", "--out", str(runs / "teachers"), "--max-steps", "400",
+                 "--eval-every", "200", "--eval-episodes", "2", "--hyper", TINY]) == 0
+    [teacher] = (runs / "teachers").iterdir()
+    assert main(["distill", str(teacher), "--out", str(tmp_path / "again.npz"),
+                 "--draw", str(tmp_path / "values.dot")]) == 0
+    assert "dynamic automaton Q-table" in capsys.readouterr().out
+    dot = (tmp_path / "values.dot").read_text()
+    assert re.search(r'label="[^"]*-?\d+\.\d', dot), "no distilled value printed on an edge"
+    for method in ("td3-dynamic", "td3"):
+        assert main(["student", "BlindCraftsman", "--method", method, "--table", str(tmp_path / "again.npz"),
+                     "--out", str(runs / "students"), "--steps", "300", "--eval-every", "150",
+                     "--eval-episodes", "1", "--hyper", '{"learning_starts": 100}']) == 0
+    capsys.readouterr()
+    assert main(["leaderboard", str(runs)]) == 0
+    out = capsys.readouterr().out
+    assert "| td3-dynamic | 1 |" in out and "| td3 | 1 |" in out
+    assert (runs / "leaderboard.csv").is_file() and (runs / "curves-BlindCraftsman-Cont.png").is_file()
+    if not gl_available:
+        pytest.skip(gl_available.reason)
+    student = next((runs / "students").glob("*td3-dynamic*"))
+    assert main(["video", "CraftSuite/BlindCraftsman-Cont-v0", "--policy", str(student / "model.zip"),
+                 "--product", "--out", str(tmp_path / "student.mp4")]) == 0
+    assert (tmp_path / "student.mp4").stat().st_size > 1000
+
+
+def test_cli_errors_name_the_problem(tmp_path, capsys):
+    assert main(["student", "BlindCraftsman", "--method", "td3-dynamic", "--out", str(tmp_path)]) == 2
+    assert "needs --table" in capsys.readouterr().err
+    assert main(["student", "BlindCraftsman", "--method", "td3", "--hyper", "{oops", "--out", str(tmp_path)]) == 2
+    assert "--hyper is not JSON" in capsys.readouterr().err
+    assert main(["transfer", "--suite", "huge", "--out", str(tmp_path)]) == 2
+    assert "unknown suite 'huge'" in capsys.readouterr().err
+    assert main(["leaderboard", str(tmp_path / "nothing")]) == 2
+    assert "no run directory" in capsys.readouterr().err
+    bad = tmp_path / "bad.npz"
+    bad.write_bytes(b"not a table")
+    assert main(["student", "BlindCraftsman", "--table", str(bad), "--out", str(tmp_path)]) == 2
+    assert "not a CraftSuite distilled table" in capsys.readouterr().err
+    assert main(["transfer", "--methods", "td3-dinamic", "--out", str(tmp_path)]) == 2
+    assert "unknown method(s) ['td3-dinamic']" in capsys.readouterr().err
+    assert main(["transfer", "--methods", "crm", "--out", str(tmp_path)]) == 2  # a grid method, MuJoCo suite
+    assert "no method of ['crm'] runs in the worlds ['Cont']" in capsys.readouterr().err
+    assert main(["distill", str(tmp_path), "--out", str(tmp_path / "t.npz")]) == 2
+    assert "not a teacher run directory" in capsys.readouterr().err
+
+
+def test_suites_are_well_formed():
+    assert {"quick", "standard", "paper"} <= set(SUITES)
+    quick = SUITES["quick"].student_configs({"BlindCraftsman": "t.npz"})
+    assert {c.method for c in quick} == {"td3-dynamic", "td3"}
+    assert all(c.world == "Cont" for c in quick)
+    assert all((c.table == "t.npz") == (c.method == "td3-dynamic") for c in quick)
+    paper = SUITES["paper"].student_configs({t: "t.npz" for t in SUITES["paper"].tasks})
+    assert {(c.world, c.method) for c in paper} >= {("Grid10", "crm"), ("Cont", "td3-static")}
+    assert not any(c.world == "Cont" and c.method == "dqn" for c in paper)
+
+
+def test_students_on_a_local_ray_instance(tmp_path):
+    pytest.importorskip("ray")
+    configs = [StudentConfig(method="dqn", world="Grid7", seed=s, steps=300, eval_every=150, eval_episodes=1,
+                             hyperparameters={"learning_starts": 100, "buffer_size": 1000}) for s in (0, 1)]
+    paths = run_students(configs, tmp_path, ray="local", progress=False)
+    assert [p.name for p in paths] == [c.run_name() for c in configs]
+    for p in paths:
+        assert json.loads((p / "result.json").read_text())["steps"] == 300
+        assert [int(r["step"]) for r in read_csv(p / "evals.csv")] == [150, 300]

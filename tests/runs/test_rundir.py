@@ -1,0 +1,70 @@
+"""Run directories: locking, config mismatch, atomic writes, log trimming."""
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from craftsuite.runs import EPISODE_FIELDS, RunDir, RunError, atomic_write, read_csv
+from craftsuite.training import StudentConfig
+
+
+def test_two_live_runs_never_share_a_directory(tmp_path):
+    config = StudentConfig(steps=10)
+    with RunDir(tmp_path / "r", config):
+        with pytest.raises(RunError, match="in use by another run"):
+            with RunDir(tmp_path / "r", config):
+                pass
+    with RunDir(tmp_path / "r", config):  # released: usable again
+        pass
+
+
+def test_a_dead_owners_lock_is_taken_over(tmp_path):
+    holder = ("import sys, time; from craftsuite.runs import RunDir; from craftsuite.training import StudentConfig\n"
+              "with RunDir(sys.argv[1], StudentConfig(steps=10)):\n    print('held', flush=True); time.sleep(60)")
+    proc = subprocess.Popen([sys.executable, "-c", holder, str(tmp_path / "r")], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().strip() == "held"
+        with pytest.raises(RunError, match=f"process .* {proc.pid}"):
+            with RunDir(tmp_path / "r", StudentConfig(steps=10)):
+                pass
+    finally:
+        proc.kill()
+        proc.wait()
+    with RunDir(tmp_path / "r", StudentConfig(steps=10)) as run:  # its holder died: free at once
+        assert (run.path / ".lock").read_text().endswith(str(os.getpid()))
+
+
+def test_a_directory_of_another_config_is_refused_and_kept(tmp_path):
+    with RunDir(tmp_path / "r", StudentConfig(steps=10)) as run:
+        run.append("episodes.csv", EPISODE_FIELDS, [{"step": 5, "return": 1.0, "length": 5, "success": 1}])
+    with pytest.raises(RunError, match="another configuration"):
+        with RunDir(tmp_path / "r", StudentConfig(steps=20)):
+            pass
+    assert json.loads((tmp_path / "r" / "config.json").read_text())["steps"] == 10
+    assert len(read_csv(tmp_path / "r" / "episodes.csv")) == 1
+    with RunDir(tmp_path / "r", StudentConfig(steps=10)):  # the refused open released its lock
+        pass
+
+
+def test_trim_logs_drops_rows_after_the_checkpoint(tmp_path):
+    with RunDir(tmp_path / "r", StudentConfig(steps=10)) as run:
+        run.append("episodes.csv", EPISODE_FIELDS,
+                   [{"step": s, "return": 0.0, "length": 1, "success": 0} for s in (100, 200, 300)])
+        run.trim_logs(200)
+        assert [int(r["step"]) for r in read_csv(run.path / "episodes.csv")] == [100, 200]
+
+
+def test_read_csv_ignores_a_torn_last_line(tmp_path):
+    path = tmp_path / "e.csv"
+    path.write_text("step,return,length,success\n1,0.5,1,0\n2,0.")
+    assert [r["step"] for r in read_csv(path)] == ["1"]
+
+
+def test_atomic_write_leaves_no_temporary_files(tmp_path):
+    atomic_write(tmp_path / "a.json", "{}")
+    atomic_write(tmp_path / "a.json", "[]")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json"]
+    assert (tmp_path / "a.json").read_text() == "[]"

@@ -1,0 +1,84 @@
+"""Teacher and student runs: reuse, resume after a kill, evaluation logs."""
+
+import json
+import signal
+import subprocess
+import sys
+import time
+import zipfile
+
+import pytest
+
+from craftsuite.runs import read_csv
+from craftsuite.runs import RunDir
+from craftsuite.training import StudentConfig, TeacherConfig, checkpoint_dir, train_student, train_teacher
+
+TINY_DQN = {"learning_starts": 100, "buffer_size": 5_000}
+
+
+def test_teacher_run_writes_table_and_is_reused(tmp_path):
+    config = TeacherConfig(max_steps=400, eval_every=200, eval_episodes=2, hyperparameters=TINY_DQN)
+    path = train_teacher(config, tmp_path, progress=False)
+    result = json.loads((path / "result.json").read_text())
+    assert result["steps"] == 400 and not result["reached_target"]
+    assert (path / "table.npz").is_file() and (path / "teacher.zip").is_file()
+    assert [int(r["step"]) for r in read_csv(path / "evals.csv")] == [200, 400]
+    before = (path / "teacher.zip").stat().st_mtime_ns
+    assert train_teacher(config, tmp_path, progress=False) == path  # same config: reused, not retrained
+    assert (path / "teacher.zip").stat().st_mtime_ns == before
+
+
+def test_student_run_logs_every_episode(tmp_path):
+    config = StudentConfig(method="dqn", world="Grid7", steps=900, eval_every=300, eval_episodes=2,
+                           hyperparameters={**TINY_DQN, "learning_starts": 200})
+    path = train_student(config, tmp_path, progress=False)
+    episodes = read_csv(path / "episodes.csv")
+    steps = [int(e["step"]) for e in episodes]
+    assert steps == sorted(steps) and all(0 < s <= 900 for s in steps)
+    assert sum(int(e["length"]) for e in episodes) <= 900
+    assert [int(r["step"]) for r in read_csv(path / "evals.csv")] == [300, 600, 900]
+
+
+_KILLABLE = """
+import sys, craftsuite
+from craftsuite.training import StudentConfig, train_student
+config = StudentConfig(method="dqn", world="Grid7", steps=3_000, eval_every=500, eval_episodes=1,
+                       hyperparameters={"learning_starts": 200, "buffer_size": 10_000})
+train_student(config, sys.argv[1], progress=False)
+"""
+
+
+def test_a_killed_run_resumes_from_its_checkpoint(tmp_path):
+    proc = subprocess.Popen([sys.executable, "-c", _KILLABLE, str(tmp_path)])
+    try:
+        deadline = time.time() + 120
+        while time.time() < deadline:
+            ckpt = list(tmp_path.glob("*/checkpoint/model.zip"))
+            evals = read_csv(ckpt[0].parent.parent / "evals.csv") if ckpt else []
+            if len(evals) >= 3:  # the checkpoint after the second evaluation is on disk
+                break
+            time.sleep(0.05)
+        else:
+            pytest.fail("the run made no checkpoint in 120 s")
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+    finally:
+        proc.kill()
+    run = ckpt[0].parent.parent
+    assert not (run / "result.json").exists(), "the run finished before it could be killed"
+    assert (run / ".lock").exists()  # left behind by the killed process
+    kept = [(r["step"], r["return"]) for r in read_csv(run / "episodes.csv")]
+    config = StudentConfig(**json.loads((run / "config.json").read_text()))
+    with zipfile.ZipFile(checkpoint_dir(RunDir(run, config)) / "model.zip") as z:
+        checkpoint_step = json.loads(z.read("data"))["num_timesteps"]
+    assert checkpoint_step >= 1_000  # so the resumed run must keep some episodes
+    assert train_student(config, tmp_path, progress=False) == run  # takes the dead run's lock over
+    episodes = read_csv(run / "episodes.csv")
+    steps = [int(e["step"]) for e in episodes]
+    assert steps == sorted(steps) and steps[-1] <= 3_000
+    # one evaluation per interval: none lost, none repeated by the resumed run
+    assert [int(r["step"]) for r in read_csv(run / "evals.csv")] == list(range(500, 3_001, 500))
+    # episodes finished before the checkpoint the run resumed from are still there, unchanged
+    assert [k for k in kept if int(k[0]) <= checkpoint_step] == \
+        [(r["step"], r["return"]) for r in episodes if int(r["step"]) <= checkpoint_step]
+    assert json.loads((run / "result.json").read_text())["steps"] == 3_000

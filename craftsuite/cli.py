@@ -133,7 +133,6 @@ def _teacher(args) -> int:
 
 
 def _distill(args) -> int:
-    from .agents import AutomatonQTable
     from .agents.distillation import static_distillation
     from .registration import resolve_task
 

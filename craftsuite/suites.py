@@ -189,20 +189,19 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     log(board_md.read_text())
     movie = None
     if video:
-        movie = _best_student_video(board, out / "students", out)
+        movie = _best_student_video(out / "students", out)
     return TransferResult(out, teachers, students, board_md, plots, movie)
 
 
-def _best_student_video(board, students_root: Path, out: Path) -> Path | None:
+def _best_student_video(students_root: Path, out: Path) -> Path | None:
     """A rollout of the best student run of the suite (highest final success, then return)."""
     from .rollouts import record_video
+    from .runs import read_csv
 
     runs = []
     for run in Path(students_root).iterdir():
         result = run / "result.json"
         if result.exists():
-            from .runs import read_csv
-
             r = json.loads(result.read_text())
             evals = read_csv(run / "evals.csv")
             last = evals[-1] if evals else {"success": 0, "return": float("-inf")}

@@ -7,7 +7,7 @@ import pytest
 
 from craftsuite.cli import main
 from craftsuite.runs import read_csv
-from craftsuite.suites import SUITES, Suite, run_students
+from craftsuite.suites import SUITES, run_students
 from craftsuite.training import StudentConfig
 
 TINY = '{"learning_starts": 100, "buffer_size": 5000}'

@@ -190,7 +190,7 @@ def _student(args) -> int:
 
     config = StudentConfig(task=args.task, method=args.method, world=args.world, seed=args.seed, steps=args.steps,
                            table=str(Path(args.table).resolve()) if args.table else None, eval_every=args.eval_every, eval_episodes=args.eval_episodes,
-                           hyperparameters=_hyper(args.hyper))
+                           hyperparameters=_hyper(args.hyper), layout_seed=args.layout_seed)
     if args.method.endswith("dynamic") and not args.table:
         raise ValueError(f"method {args.method!r} needs --table (a teacher's table.npz: craftsuite teacher)")
     path = train_student(config, args.out)
@@ -207,7 +207,8 @@ def _transfer(args) -> int:
     if args.suite not in SUITES:
         raise KeyError(f"unknown suite {args.suite!r}; suites: {sorted(SUITES)}")
     suite = SUITES[args.suite]
-    changes = {k: v for k, v in (("tasks", tuple(args.tasks) if args.tasks else None), ("seeds", args.seeds),
+    changes = {k: v for k, v in (("tasks", tuple(args.tasks) if args.tasks else None),
+                                 ("worlds", tuple(args.worlds) if args.worlds else None), ("seeds", args.seeds),
                                  ("student_steps", args.steps), ("methods", tuple(args.methods) if args.methods else None),
                                  ("teacher_max_steps", args.teacher_steps), ("eval_every", args.eval_every))
                if v is not None}
@@ -303,12 +304,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--eval-every", type=_positive, default=2_000)
     p.add_argument("--eval-episodes", type=_positive, default=10)
     p.add_argument("--hyper", help="JSON overrides of the algorithm's settings")
+    p.add_argument("--layout-seed", type=int, help="grid worlds: one fixed instance (default: a new one per episode)")
     p.set_defaults(run=_student)
 
     p = sub.add_parser("transfer", help="a suite end to end: teacher, distillation, students, leaderboard, video")
     p.add_argument("--suite", default="quick", help="quick (default, ~15 min), standard or paper")
     p.add_argument("--out", default="runs/quick", help="output directory (default: runs/quick)")
     p.add_argument("--tasks", nargs="+", help="override the suite's tasks")
+    p.add_argument("--worlds", nargs="+", choices=("Cont", "Grid10", "Grid7"),
+                   help="override the student worlds (Cont: TD3 methods; Grid10, Grid7: DQN methods)")
     p.add_argument("--methods", nargs="+", help="override the suite's methods")
     p.add_argument("--seeds", type=_positive, help="override the number of seeds")
     p.add_argument("--steps", type=_positive, help="override the student budget (env steps)")

@@ -42,6 +42,9 @@ class Suite:
     eval_every: int = 2_000
     eval_episodes: int = 10
     student_hyperparameters: dict = field(default_factory=dict)
+    # grid students learn one fixed instance, generated independently of the teacher's (layout 0),
+    # as the paper's did; None gives them a new layout every episode
+    grid_layout_seed: int | None = 1
 
     def student_configs(self, tables: dict[str, str]) -> list[StudentConfig]:
         unknown = [m for m in self.methods if m not in GRID_METHODS + CONT_METHODS]
@@ -57,7 +60,8 @@ class Suite:
                             task=task, method=method, world=world, seed=seed, steps=self.student_steps,
                             table=tables[task] if method.endswith("dynamic") else None,
                             eval_every=self.eval_every, eval_episodes=self.eval_episodes,
-                            hyperparameters=dict(self.student_hyperparameters)))
+                            hyperparameters=dict(self.student_hyperparameters),
+                            layout_seed=self.grid_layout_seed if world.startswith("Grid") else None))
         if not out:
             raise ValueError(f"no method of {list(self.methods)} runs in the worlds {list(self.worlds)} "
                              f"(grid: {list(GRID_METHODS)}; Cont: {list(CONT_METHODS)})")

@@ -57,10 +57,20 @@ class StudentConfig:
     eval_every: int = 2_000
     eval_episodes: int = 10
     hyperparameters: dict = field(default_factory=dict)
+    layout_seed: int | None = None  # grid worlds: one fixed instance (None: a new one per episode)
+
+    def __post_init__(self):
+        if self.layout_seed is not None and not self.world.startswith("Grid"):
+            raise ValueError(f"layout_seed fixes a grid instance; the {self.world} world has none "
+                             "(its objects are placed anew every episode)")
 
     @property
     def env_id(self) -> str:
         return f"CraftSuite/{self.task}-{self.world}-v0"
+
+    @property
+    def env_kwargs(self) -> dict:
+        return {} if self.layout_seed is None else {"layout_seed": self.layout_seed}
 
     def run_name(self) -> str:
         return f"student-{self.task}-{self.world}-{self.method}-s{self.seed}-{config_key(self)}"
@@ -244,10 +254,12 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
         table = AutomatonQTable.load(config.table) if method.distill == "dynamic" else None
         hyper = dict(config.hyperparameters)
         hyper.setdefault("buffer_size", min(config.steps, 1_000_000))
-        fresh = make_agent(config.method, config.env_id, table=table, seed=config.seed, **hyper)
+        fresh = make_agent(config.method, config.env_id, table=table, seed=config.seed,
+                           env_kwargs=config.env_kwargs, **hyper)
 
         def evaluate_fn(model, step):
-            return evaluate(model, config.env_id, config.eval_episodes, seed=10**7 + step, product=method.product)
+            return evaluate(model, config.env_id, config.eval_episodes, seed=10**7 + step, product=method.product,
+                            env_kwargs=config.env_kwargs)
 
         agent = _learn(run, fresh, config.steps, config.eval_every, config.eval_episodes, evaluate_fn,
                        progress=progress,

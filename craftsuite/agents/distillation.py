@@ -168,6 +168,7 @@ class DistilledTarget:
         self.q_teacher = table.q.astype(np.float32)
         self.seen = table.seen
         self.student_counts = np.zeros(table.q.shape, dtype=np.int64)
+        self.last_weight = 0.0  # mean beta of the last minibatch: the teacher's share, logged by the agents
         self._n_labels = table.q.shape[1]
         self._make_views()
 
@@ -194,5 +195,6 @@ class DistilledTarget:
         mix[0] = self._seen_flat[flat] * self.rho ** self._counts_flat[flat]  # beta
         mix[1] = self._teacher_flat[flat]
         np.add.at(self._counts_flat, flat, 1)
+        self.last_weight = float(mix[0].mean())
         beta, teacher = th.from_numpy(mix).to(q_target.device).reshape(2, *q_target.shape)
         return q_target + beta * (teacher - q_target)

@@ -107,6 +107,8 @@ class AutomatonDQN(DQN):
         self._n_updates += gradient_steps
         self.logger.record("train/n_updates", self._n_updates, exclude="tensorboard")
         self.logger.record("train/loss", np.mean(losses))
+        if self.distill is not None:
+            self.logger.record("train/teacher_weight", self.distill.last_weight)
 
     def q_values(self, observations: np.ndarray) -> np.ndarray:
         """Q(s, .) of the online network for a batch of observations."""

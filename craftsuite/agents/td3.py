@@ -93,3 +93,5 @@ class AutomatonTD3(TD3):
         if actor_losses:
             self.logger.record("train/actor_loss", np.mean(actor_losses))
         self.logger.record("train/critic_loss", np.mean(critic_losses))
+        if self.distill is not None:
+            self.logger.record("train/teacher_weight", self.distill.last_weight)

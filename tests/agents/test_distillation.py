@@ -42,6 +42,7 @@ def test_counts_rise_per_sampled_transition_including_duplicates():
     assert target.student_counts[0, SWORD] == 2 and target.student_counts[0, SHIELD] == 1
     second = target(w, sigma, th.zeros((3, 1))).reshape(-1).tolist()
     assert second == pytest.approx([2.5, 2.5, 10.0])  # 0.5**2 * 10, 0.5**1 * 20
+    assert target.last_weight == pytest.approx((0.25 + 0.25 + 0.5) / 3)  # the teacher's mean share, logged
 
 
 def test_transitions_the_teacher_never_saw_use_the_td_target():

@@ -108,6 +108,16 @@ def test_top_speed_and_control_period():
     assert env.data.time == pytest.approx(40 * 0.05)
 
 
+def test_frame_skip_sets_the_control_period():
+    coarse = gym.make("CraftSuite/BlindCraftsman-Cont-v0", frame_skip=5).unwrapped
+    coarse.reset(seed=0)
+    coarse.step(np.zeros(2))
+    assert coarse.data.time == pytest.approx(5 * 0.025) and coarse.dt == pytest.approx(0.125)
+    assert coarse.metadata["render_fps"] == 8 and ContinuousWorldEnv.metadata["render_fps"] == 20
+    with pytest.raises(ValueError, match="frame_skip must be a positive integer"):
+        ContinuousWorldEnv(frame_skip=0)
+
+
 def test_boundary_push_costs_and_walls_hold():
     env = make()
     env.reset(seed=0)

@@ -57,6 +57,8 @@ def test_cli_errors_name_the_problem(tmp_path, capsys):
     assert "unknown method(s) ['td3-dinamic']" in capsys.readouterr().err
     assert main(["transfer", "--methods", "crm", "--out", str(tmp_path)]) == 2  # a grid method, MuJoCo suite
     assert "no method of ['crm'] runs in the worlds ['Cont']" in capsys.readouterr().err
+    assert main(["transfer", "--worlds", "Grid10", "--methods", "td3", "--out", str(tmp_path)]) == 2
+    assert "no method of ['td3'] runs in the worlds ['Grid10']" in capsys.readouterr().err
     assert main(["distill", str(tmp_path), "--out", str(tmp_path / "t.npz")]) == 2
     assert "not a teacher run directory" in capsys.readouterr().err
 
@@ -70,6 +72,9 @@ def test_suites_are_well_formed():
     paper = SUITES["paper"].student_configs({t: "t.npz" for t in SUITES["paper"].tasks})
     assert {(c.world, c.method) for c in paper} >= {("Grid10", "crm"), ("Cont", "td3-static")}
     assert not any(c.world == "Cont" and c.method == "dqn" for c in paper)
+    # grid students learn one instance of their own, as the paper's did; MuJoCo layouts vary
+    assert {c.layout_seed for c in paper if c.world == "Grid10"} == {SUITES["paper"].grid_layout_seed} != {0}
+    assert {c.layout_seed for c in paper if c.world == "Cont"} == {None}
 
 
 def test_students_on_a_local_ray_instance(tmp_path):

@@ -39,6 +39,31 @@ def test_student_run_logs_every_episode(tmp_path):
     assert [int(r["step"]) for r in read_csv(path / "evals.csv")] == [300, 600, 900]
 
 
+def test_grid_student_keeps_one_fixed_instance(tmp_path, monkeypatch):
+    import craftsuite.agents.methods as methods
+    import craftsuite.training as training
+
+    seen = []
+    real_make, real_evaluate = methods.make_agent, training.evaluate
+
+    def make_agent(*args, env_kwargs=None, **kwargs):
+        seen.append(("train", env_kwargs))
+        return real_make(*args, env_kwargs=env_kwargs, **kwargs)
+
+    def evaluate(*args, env_kwargs=None, **kwargs):
+        seen.append(("evaluate", env_kwargs))
+        return real_evaluate(*args, env_kwargs=env_kwargs, **kwargs)
+
+    monkeypatch.setattr(methods, "make_agent", make_agent)
+    monkeypatch.setattr(training, "evaluate", evaluate)
+    config = StudentConfig(method="dqn", world="Grid7", steps=300, eval_every=300, eval_episodes=1,
+                           hyperparameters={**TINY_DQN, "learning_starts": 200}, layout_seed=3)
+    train_student(config, tmp_path, progress=False)
+    assert seen == [("train", {"layout_seed": 3}), ("evaluate", {"layout_seed": 3})]
+    with pytest.raises(ValueError, match="the Cont world has none"):
+        StudentConfig(world="Cont", layout_seed=3)
+
+
 _KILLABLE = """
 import sys, craftsuite
 from craftsuite.training import StudentConfig, train_student

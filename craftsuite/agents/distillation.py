@@ -158,15 +158,24 @@ class DistilledTarget:
     sampled in the student's minibatches before this one (the first use trusts the teacher
     fully); beta = 0 where the teacher has no value. Counts go up by one per sampled
     transition, duplicates in a minibatch included.
+
+    ``self_loops=False`` (not in the paper) also sets beta = 0 on labels that leave the
+    automaton state unchanged, so the teacher speaks only about progress: its self-loop
+    values average over every world state of an automaton state and, trusted early, give
+    the student flat, optimistic values that gamma takes long to wash out
+    (docs/benchmarks.md, "Self-loops").
     """
 
-    def __init__(self, table: AutomatonQTable, automaton: Automaton, rho: float = 0.999):
+    def __init__(self, table: AutomatonQTable, automaton: Automaton, rho: float = 0.999,
+                 self_loops: bool = True):
         table.check(automaton)
         if not 0.0 <= rho <= 1.0:
             raise ValueError(f"rho must lie in [0, 1], got {rho}")
-        self.table, self.rho = table, rho
+        self.table, self.rho, self.self_loops = table, rho, self_loops
         self.q_teacher = table.q.astype(np.float32)
         self.seen = table.seen
+        if not self_loops:  # only transitions that change the automaton state carry the teacher's value
+            self.seen = self.seen & (automaton.delta != np.arange(len(automaton.delta))[:, None])
         self.student_counts = np.zeros(table.q.shape, dtype=np.int64)
         self.last_weight = 0.0  # mean beta of the last minibatch: the teacher's share, logged by the agents
         self._n_labels = table.q.shape[1]

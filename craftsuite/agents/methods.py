@@ -58,12 +58,13 @@ TD3_DEFAULTS = dict(learning_rate=1e-4, buffer_size=1_000_000, batch_size=64, le
 
 
 def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None, seed: int = 0,
-               n_envs: int = 1, rho: float = 0.999, verbose: int = 0, env_kwargs: dict | None = None,
-               **overrides):
+               n_envs: int = 1, rho: float = 0.999, self_loops: bool = True, verbose: int = 0,
+               env_kwargs: dict | None = None, **overrides):
     """An untrained agent of ``method`` on ``n_envs`` copies of ``env_id``.
 
     ``env_kwargs`` go to ``gymnasium.make`` (e.g. ``{"layout_seed": 0}`` for a fixed grid
-    instance); ``overrides`` to the algorithm."""
+    instance); ``rho`` and ``self_loops`` to the distilled target (``DistilledTarget``);
+    ``overrides`` to the algorithm."""
     if method not in METHODS:
         raise KeyError(f"unknown method {method!r}; methods: {sorted(METHODS)}")
     m = METHODS[method]
@@ -87,10 +88,10 @@ def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None
     if m.distill == "dynamic":
         if table is None:
             raise ValueError(f"method {method!r} needs a teacher's table (distill_from_replay)")
-        kwargs["distill"] = DistilledTarget(table, automaton, rho)
+        kwargs["distill"] = DistilledTarget(table, automaton, rho, self_loops)
     elif m.distill == "static":
         kwargs["distill"] = DistilledTarget(table or static_distillation(
-            automaton, completion_reward=base.task.completion_reward), automaton, rho)
+            automaton, completion_reward=base.task.completion_reward), automaton, rho, self_loops)
     return m.algorithm("MlpPolicy", env, seed=seed, verbose=verbose, **kwargs)
 
 

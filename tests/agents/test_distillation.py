@@ -51,6 +51,16 @@ def test_transitions_the_teacher_never_saw_use_the_td_target():
     assert out.reshape(-1).tolist() == pytest.approx([3.0, 4.0])
 
 
+def test_without_self_loops_the_teacher_speaks_only_about_progress():
+    values = {(0, 0): 50.0, (0, SWORD): 10.0}  # label {} keeps state 0, {sword} leaves it
+    assert TOY.delta[0, 0] == 0 and TOY.delta[0, SWORD] != 0
+    w, sigma, td = np.array([0, 0]), np.array([0, SWORD]), th.tensor([[3.0], [4.0]])
+    paper = DistilledTarget(table(values), TOY, rho=0.999)
+    assert paper(w, sigma, td).reshape(-1).tolist() == pytest.approx([50.0, 10.0])
+    progress_only = DistilledTarget(table(values), TOY, rho=0.999, self_loops=False)
+    assert progress_only(w, sigma, td).reshape(-1).tolist() == pytest.approx([3.0, 10.0])
+
+
 def test_dynamic_distillation_averages_taken_action_q():
     w = np.array([0, 0, 1, 0])
     sigma = np.array([SWORD, SWORD, 0, 0])

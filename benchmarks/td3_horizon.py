@@ -1,0 +1,119 @@
+"""TD3 students on a shorter horizon: does a coarser control period let them learn?
+
+Usage: python benchmarks/td3_horizon.py TABLE [--task T] [--frame-skip K] [--limit N]
+       [--steps N] [--seed S] [--methods td3 td3-dynamic]
+
+Trains each method (one process per method, one torch thread each) on
+``CraftSuite/<task>-Cont-v0`` made with ``frame_skip=K`` (physics steps of 0.025 s per
+action; the world's default is 2) and a time limit of N steps, with the quick suite's
+network ([256, 256]) and otherwise the package defaults. Every 5,000 steps it prints the
+greedy success and return over 10 fresh episodes and the training episodes completed so
+far. TABLE is a teacher's ``table.npz`` (``craftsuite teacher``) for the dynamic method.
+First it prints how many steps the scripted policy needs at this frame skip and at the
+default (mean over 10 episodes), i.e. how much the horizon shrinks, and how many rewarded
+events a persistent random walk (a new uniform action with probability 0.1 per step) meets
+per 1,000-step episode at the default (30 episodes): what exploration alone finds.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+
+def run(method: str, args) -> list[dict]:
+    import torch
+
+    torch.set_num_threads(1)
+    import craftsuite  # noqa: F401
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    from craftsuite.agents import AutomatonQTable
+    from craftsuite.agents.methods import METHODS, make_agent
+    from craftsuite.training import evaluate
+
+    env_id = f"CraftSuite/{args.task}-Cont-v0"
+    env_kwargs = {"frame_skip": args.frame_skip, "max_episode_steps": args.limit}
+    table = AutomatonQTable.load(args.table) if method.endswith("dynamic") else None
+    agent = make_agent(method, env_id, table=table, seed=args.seed, env_kwargs=env_kwargs,
+                       policy_kwargs={"net_arch": [256, 256]})
+    rows, start = [], time.perf_counter()
+
+    class Report(BaseCallback):
+        wins = episodes = 0
+
+        def _on_step(self) -> bool:
+            if self.locals["dones"][0]:
+                self.episodes += 1
+                self.wins += bool(self.locals["infos"][0].get("is_success"))
+            if self.num_timesteps % 5_000 == 0:
+                success, ret = evaluate(agent, env_id, 10, 10**6, METHODS[method].product, env_kwargs)
+                row = {"method": method, "step": self.num_timesteps, "eval_success": success,
+                       "eval_return": round(ret, 1), "train_episodes": self.episodes, "train_wins": self.wins,
+                       "seconds": round(time.perf_counter() - start)}
+                print(json.dumps(row), flush=True)
+                rows.append(row)
+            return True
+
+    agent.learn(args.steps, callback=Report())
+    return rows
+
+
+def scripted_steps(task: str, frame_skip: int, episodes: int = 10) -> float:
+    import gymnasium as gym
+
+    import craftsuite  # noqa: F401
+    from craftsuite.scripted import run_episode, scripted_policy
+
+    env = gym.make(f"CraftSuite/{task}-Cont-v0", frame_skip=frame_skip, max_episode_steps=5_000)
+    policy = scripted_policy(env)
+    return sum(run_episode(env, policy, seed=s)[1] for s in range(episodes)) / episodes
+
+
+def random_walk_events(task: str, episodes: int = 30) -> float:
+    import gymnasium as gym
+    import numpy as np
+
+    import craftsuite  # noqa: F401
+
+    env, rng, events = gym.make(f"CraftSuite/{task}-Cont-v0"), np.random.default_rng(0), 0
+    for episode in range(episodes):
+        env.reset(seed=episode)
+        action, done = rng.uniform(-1, 1, 2), False
+        while not done:
+            if rng.random() < 0.1:
+                action = rng.uniform(-1, 1, 2)
+            _, reward, terminated, truncated, _ = env.step(action)
+            events += reward > -0.05  # an item, a completion: more than the step and wall costs
+            done = terminated or truncated
+    return events / episodes
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("table", help="a teacher's table.npz")
+    parser.add_argument("--task", default="BlindCraftsman")
+    parser.add_argument("--frame-skip", type=int, default=5)
+    parser.add_argument("--limit", type=int, default=400, help="time limit in steps")
+    parser.add_argument("--steps", type=int, default=100_000)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--methods", nargs="+", default=["td3", "td3-dynamic"])
+    args = parser.parse_args()
+    for skip in sorted({2, args.frame_skip}):
+        print(f"scripted policy, frame_skip {skip}: {scripted_steps(args.task, skip):.1f} steps per episode")
+    print(f"persistent random walk: {random_walk_events(args.task):.2f} rewarded events per 1,000-step episode")
+    with ProcessPoolExecutor(len(args.methods)) as pool:
+        results = list(pool.map(run, args.methods, [args] * len(args.methods)))
+    print(f"\n{args.task}, frame_skip {args.frame_skip}, limit {args.limit}, seed {args.seed}")
+    print("| method | steps | greedy success | greedy return | training episodes | training wins |")
+    print("|---|---|---|---|---|---|")
+    for rows in results:
+        last = rows[-1]
+        print(f"| {last['method']} | {last['step']:,} | {last['eval_success']:.2f} | {last['eval_return']} "
+              f"| {last['train_episodes']} | {last['train_wins']} |")
+
+
+if __name__ == "__main__":
+    main()

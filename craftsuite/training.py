@@ -60,6 +60,8 @@ class StudentConfig:
     layout_seed: int | None = None  # grid worlds: one fixed instance (None: a new one per episode)
 
     def __post_init__(self):
+        if self.layout_seed is not None and (not isinstance(self.layout_seed, int) or self.layout_seed < 0):
+            raise ValueError(f"layout_seed must be a non-negative integer or None, got {self.layout_seed!r}")
         if self.layout_seed is not None and not self.world.startswith("Grid"):
             raise ValueError(f"layout_seed fixes a grid instance; the {self.world} world has none "
                              "(its objects are placed anew every episode)")

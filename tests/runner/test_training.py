@@ -62,6 +62,8 @@ def test_grid_student_keeps_one_fixed_instance(tmp_path, monkeypatch):
     assert seen == [("train", {"layout_seed": 3}), ("evaluate", {"layout_seed": 3})]
     with pytest.raises(ValueError, match="the Cont world has none"):
         StudentConfig(world="Cont", layout_seed=3)
+    with pytest.raises(ValueError, match="layout_seed must be a non-negative integer"):
+        StudentConfig(world="Grid7", layout_seed=-1)  # refused before a run directory is made
 
 
 _KILLABLE = """

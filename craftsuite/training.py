@@ -19,6 +19,7 @@ import gymnasium as gym
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
+from .envs.grid import layout_kwargs
 from .runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, config_key, read_csv
 
 
@@ -40,7 +41,7 @@ class TeacherConfig:
 
     @property
     def env_kwargs(self) -> dict:
-        return {} if self.layout_seed is None else {"layout_seed": self.layout_seed}
+        return layout_kwargs(self.layout_seed)
 
     def run_name(self) -> str:
         return f"teacher-{self.task}-Grid{self.size}-s{self.seed}-{config_key(self)}"
@@ -60,9 +61,7 @@ class StudentConfig:
     layout_seed: int | None = None  # grid worlds: one fixed instance (None: a new one per episode)
 
     def __post_init__(self):
-        if self.layout_seed is not None and (not isinstance(self.layout_seed, int) or self.layout_seed < 0):
-            raise ValueError(f"layout_seed must be a non-negative integer or None, got {self.layout_seed!r}")
-        if self.layout_seed is not None and not self.world.startswith("Grid"):
+        if self.env_kwargs and not self.world.startswith("Grid"):  # env_kwargs also checks the seed
             raise ValueError(f"layout_seed fixes a grid instance; the {self.world} world has none "
                              "(its objects are placed anew every episode)")
 
@@ -72,7 +71,7 @@ class StudentConfig:
 
     @property
     def env_kwargs(self) -> dict:
-        return {} if self.layout_seed is None else {"layout_seed": self.layout_seed}
+        return layout_kwargs(self.layout_seed)
 
     def run_name(self) -> str:
         return f"student-{self.task}-{self.world}-{self.method}-s{self.seed}-{config_key(self)}"

@@ -171,6 +171,8 @@ class DistilledTarget:
         table.check(automaton)
         if not 0.0 <= rho <= 1.0:
             raise ValueError(f"rho must lie in [0, 1], got {rho}")
+        if not isinstance(self_loops, bool):
+            raise ValueError(f"self_loops must be true or false, got {self_loops!r}")
         self.table, self.rho, self.self_loops = table, rho, self_loops
         self.q_teacher = table.q.astype(np.float32)
         self.seen = table.seen

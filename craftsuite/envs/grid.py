@@ -14,6 +14,16 @@ _MOVES = {0: (0, -1), 1: (1, 0), 2: (0, 1), 3: (-1, 0)}
 ACTION_NAMES = ("up", "right", "down", "left")
 
 
+def layout_kwargs(layout_seed: int | None) -> dict:
+    """``gymnasium.make`` keywords for grid instance ``layout_seed`` ({} for a new layout
+    every episode); raises ValueError for anything but None or an integer >= 0."""
+    if layout_seed is None:
+        return {}
+    if not isinstance(layout_seed, int) or isinstance(layout_seed, bool) or layout_seed < 0:
+        raise ValueError(f"layout_seed must be a non-negative integer or None, got {layout_seed!r}")
+    return {"layout_seed": layout_seed}
+
+
 class GridWorldEnv(CraftWorld):
     """A CraftSuite task on a square grid, with its LTLf objective tracked as a DFA.
 
@@ -68,8 +78,7 @@ class GridWorldEnv(CraftWorld):
     def __init__(self, task: str | TaskSpec = "BlindCraftsman", size: int = 7,
                  render_mode: str | None = None, layout_seed: int | None = None):
         super().__init__(task, render_mode)
-        if layout_seed is not None and (not isinstance(layout_seed, int) or layout_seed < 0):
-            raise ValueError(f"layout_seed must be a non-negative integer or None, got {layout_seed!r}")
+        layout_kwargs(layout_seed)  # validates
         self.layout_seed = layout_seed
         if not isinstance(size, int) or size < 2:
             raise ValueError(f"size must be an integer >= 2, got {size!r}")

@@ -59,6 +59,8 @@ def test_without_self_loops_the_teacher_speaks_only_about_progress():
     assert paper(w, sigma, td).reshape(-1).tolist() == pytest.approx([50.0, 10.0])
     progress_only = DistilledTarget(table(values), TOY, rho=0.999, self_loops=False)
     assert progress_only(w, sigma, td).reshape(-1).tolist() == pytest.approx([3.0, 10.0])
+    with pytest.raises(ValueError, match="self_loops must be true or false"):
+        DistilledTarget(table(values), TOY, self_loops="no")  # e.g. a string from --hyper
 
 
 def test_dynamic_distillation_averages_taken_action_q():

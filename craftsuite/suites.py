@@ -95,6 +95,22 @@ def _student_job(config: dict, root: str) -> str:
     return str(train_student(StudentConfig(**config), root, progress=False))
 
 
+def _exit_with(driver: int, period: float = 0.5) -> None:
+    """Exit this worker soon after ``driver``, the process that started it, is gone.
+
+    Killing ``craftsuite transfer`` with SIGTERM or SIGKILL gives it no chance to stop its
+    workers; without this they would train on unseen. Their checkpoints let a rerun resume.
+    """
+    import threading
+
+    def watch():
+        while os.getppid() == driver:  # an orphan is re-parented: its parent pid changes
+            time.sleep(period)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="craftsuite-driver-watch", daemon=True).start()
+
+
 def run_students(configs: list[StudentConfig], root, workers: int | None = None, ray: str | None = None,
                  progress: bool = True) -> list[Path]:
     """Run students in parallel (processes or Ray) with one progress bar over all their steps."""
@@ -125,7 +141,8 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
             workers = workers or min(len(jobs), os.cpu_count() or 1)
             import multiprocessing as mp
 
-            with ProcessPoolExecutor(workers, mp_context=mp.get_context("spawn")) as pool:
+            with ProcessPoolExecutor(workers, mp_context=mp.get_context("spawn"), initializer=_exit_with,
+                                     initargs=(os.getpid(),)) as pool:
                 futures = [pool.submit(_student_job, job, str(root)) for job in jobs]
                 while not all(f.done() for f in futures):
                     time.sleep(1.0)

@@ -1,7 +1,13 @@
 """The CLI end to end on a tiny config, and the same students on a local Ray instance."""
 
 import json
+import os
 import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
 
 import pytest
 
@@ -86,3 +92,46 @@ def test_students_on_a_local_ray_instance(tmp_path):
     for p in paths:
         assert json.loads((p / "result.json").read_text())["steps"] == 300
         assert [int(r["step"]) for r in read_csv(p / "evals.csv")] == [150, 300]
+
+
+_DRIVER = """
+import sys
+from craftsuite.suites import run_students
+from craftsuite.training import StudentConfig
+configs = [StudentConfig(method="dqn", world="Grid7", seed=s, steps=1_000_000, eval_every=100_000,
+                         hyperparameters={"learning_starts": 100, "buffer_size": 1000}) for s in (0, 1)]
+run_students(configs, sys.argv[1], workers=2, progress=False)
+"""
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, IndexError):
+        return False
+    return state not in ("Z", "X")  # an orphaned zombie waits for a reaper that may never come
+
+
+def test_killing_the_driver_stops_its_student_processes(tmp_path):
+    driver = subprocess.Popen([sys.executable, "-c", _DRIVER, str(tmp_path)])
+    workers = []
+    try:
+        deadline = time.time() + 120
+        while time.time() < deadline and len(workers) < 2:
+            time.sleep(0.2)
+            locks = [p.read_text().split() for p in tmp_path.glob("*/.lock")]
+            workers = [int(lock[1]) for lock in locks if len(lock) == 2]
+        assert len(workers) == 2, "the two students did not start in 120 s"
+        assert all(_alive(pid) for pid in workers)
+        driver.send_signal(signal.SIGTERM)  # no handler: the driver dies at once, as under `kill`
+        driver.wait(30)
+        deadline = time.time() + 30
+        while time.time() < deadline and any(_alive(pid) for pid in workers):
+            time.sleep(0.2)
+        assert not any(_alive(pid) for pid in workers), "student processes outlived their driver"
+    finally:
+        driver.kill()
+        for pid in workers:
+            if _alive(pid):
+                os.kill(pid, signal.SIGKILL)
+    assert not any(tmp_path.glob("*/result.json"))  # killed mid-run: both stay resumable

@@ -41,7 +41,10 @@ class Suite:
     teacher_max_steps: int = 300_000
     eval_every: int = 2_000
     eval_episodes: int = 10
-    student_hyperparameters: dict = field(default_factory=dict)
+    # overrides of each student algorithm's defaults (craftsuite.agents.methods): MuJoCo
+    # students are TD3, grid students DQN, so one network size never reaches the other
+    td3_hyperparameters: dict = field(default_factory=dict)
+    dqn_hyperparameters: dict = field(default_factory=dict)
     # grid students learn one fixed instance, generated independently of the teacher's (layout 0),
     # as the paper's did; None gives them a new layout every episode
     grid_layout_seed: int | None = 1
@@ -60,7 +63,8 @@ class Suite:
                             task=task, method=method, world=world, seed=seed, steps=self.student_steps,
                             table=tables[task] if method.endswith("dynamic") else None,
                             eval_every=self.eval_every, eval_episodes=self.eval_episodes,
-                            hyperparameters=dict(self.student_hyperparameters),
+                            hyperparameters=dict(self.td3_hyperparameters if world == "Cont"
+                                                 else self.dqn_hyperparameters),
                             layout_seed=self.grid_layout_seed if world.startswith("Grid") else None))
         if not out:
             raise ValueError(f"no method of {list(self.methods)} runs in the worlds {list(self.worlds)} "
@@ -73,7 +77,7 @@ SUITES = {s.name: s for s in (
           "(about 15 minutes on 2 cores)",
           tasks=("BlindCraftsman",), worlds=("Cont",), methods=("td3-dynamic", "td3"), seeds=2,
           student_steps=20_000, eval_every=2_000, eval_episodes=5,
-          student_hyperparameters={"policy_kwargs": {"net_arch": [256, 256]}}),
+          td3_hyperparameters={"policy_kwargs": {"net_arch": [256, 256]}}),
     Suite("standard", "all three tasks in MuJoCo: dynamic, static and scratch TD3, 5 seeds, 200k steps",
           tasks=("BlindCraftsman", "DungeonQuest", "DiamondMine"), worlds=("Cont",),
           methods=("td3-dynamic", "td3-static", "td3"), seeds=5, student_steps=200_000,

@@ -1,5 +1,6 @@
 """The CLI end to end on a tiny config, and the same students on a local Ray instance."""
 
+import dataclasses
 import json
 import os
 import re
@@ -75,6 +76,10 @@ def test_suites_are_well_formed():
     assert {c.method for c in quick} == {"td3-dynamic", "td3"}
     assert all(c.world == "Cont" for c in quick)
     assert all((c.table == "t.npz") == (c.method == "td3-dynamic") for c in quick)
+    # quick's TD3 network stays with its TD3 students when the worlds are overridden
+    both = dataclasses.replace(SUITES["quick"], worlds=("Cont", "Grid10"), methods=("td3", "dqn"))
+    nets = {c.world: c.hyperparameters.get("policy_kwargs") for c in both.student_configs({})}
+    assert nets == {"Cont": {"net_arch": [256, 256]}, "Grid10": None}
     paper = SUITES["paper"].student_configs({t: "t.npz" for t in SUITES["paper"].tasks})
     assert {(c.world, c.method) for c in paper} >= {("Grid10", "crm"), ("Cont", "td3-static")}
     assert not any(c.world == "Cont" and c.method == "dqn" for c in paper)

@@ -22,6 +22,8 @@ import json
 import time
 from concurrent.futures import ProcessPoolExecutor
 
+from random_walk import random_walk  # benchmarks/ is on sys.path when run as a script
+
 
 def run(method: str, args) -> list[dict]:
     import torch
@@ -72,25 +74,6 @@ def scripted_steps(task: str, frame_skip: int, episodes: int = 10) -> float:
     return sum(run_episode(env, policy, seed=s)[1] for s in range(episodes)) / episodes
 
 
-def random_walk_events(task: str, episodes: int = 30) -> float:
-    import gymnasium as gym
-    import numpy as np
-
-    import craftsuite  # noqa: F401
-
-    env, rng, events = gym.make(f"CraftSuite/{task}-Cont-v0"), np.random.default_rng(0), 0
-    for episode in range(episodes):
-        env.reset(seed=episode)
-        action, done = rng.uniform(-1, 1, 2), False
-        while not done:
-            if rng.random() < 0.1:
-                action = rng.uniform(-1, 1, 2)
-            _, reward, terminated, truncated, _ = env.step(action)
-            events += reward > -0.05  # an item, a completion: more than the step and wall costs
-            done = terminated or truncated
-    return events / episodes
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("table", help="a teacher's table.npz")
@@ -103,7 +86,8 @@ def main():
     args = parser.parse_args()
     for skip in sorted({2, args.frame_skip}):
         print(f"scripted policy, frame_skip {skip}: {scripted_steps(args.task, skip):.1f} steps per episode")
-    print(f"persistent random walk: {random_walk_events(args.task):.2f} rewarded events per 1,000-step episode")
+    walk = random_walk(args.task, episodes=30)
+    print(f"persistent random walk: {walk['rewarded_events']:.2f} rewarded events per 1,000-step episode")
     with ProcessPoolExecutor(len(args.methods)) as pool:
         results = list(pool.map(run, args.methods, [args] * len(args.methods)))
     print(f"\n{args.task}, frame_skip {args.frame_skip}, limit {args.limit}, seed {args.seed}")

@@ -1,4 +1,4 @@
-"""The CLI end to end on a tiny config, and the same students on a local Ray instance."""
+"""The CLI end to end on a tiny config, the same students on a local Ray instance, and a killed driver."""
 
 import dataclasses
 import json

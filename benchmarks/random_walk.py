@@ -4,9 +4,10 @@ Usage: python benchmarks/random_walk.py [--tasks T ...] [--episodes N] [--frame-
 
 The walk keeps a uniform random thrust and draws a new one with probability 0.1 per step
 (about what TD3's early, near-constant actor plus noise does, but livelier). Per task it
-prints, per 1,000-step episode: rewarded events (an item or the completion: a reward
-above the step and wall costs), changes of automaton state, and the episodes that ended
-in success or in a violation (the rejecting sink), with their mean length.
+prints, per episode (at most 1,000 steps; a violation ends one early): rewarded events
+(an item or the completion: a reward above the step and wall costs), changes of
+automaton state, the episodes that ended in success or in a violation (the rejecting
+sink), and the mean episode length.
 """
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ def main():
     parser.add_argument("--frame-skip", type=int, default=2)
     args = parser.parse_args()
     print(f"persistent random walk, {args.episodes} episodes per task, frame_skip {args.frame_skip}")
-    print("| task | rewarded events / episode | automaton changes / episode | successes | violations | mean length |")
+    print("| task | rewarded events / episode | automaton changes / episode | successes | violations | mean length (steps) |")
     print("|---|---|---|---|---|---|")
     for task in args.tasks:
         r = random_walk(task, args.episodes, args.frame_skip)

@@ -245,9 +245,9 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
     from .agents import AutomatonQTable
     from .agents.methods import METHODS, make_agent
 
-    method = METHODS[config.method] if config.method in METHODS else None
-    if method is None:
+    if config.method not in METHODS:
         raise KeyError(f"unknown method {config.method!r}; methods: {sorted(METHODS)}")
+    method = METHODS[config.method]
     with RunDir(Path(root) / config.run_name(), config) as run:
         if run.finished():
             return run.path

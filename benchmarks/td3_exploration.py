@@ -1,0 +1,157 @@
+"""TD3 exploration in the MuJoCo worlds: what the action noise reaches, and students with
+a persistent noise.
+
+Usage: python benchmarks/td3_exploration.py TABLE [--task T] [--steps N] [--seed S]
+       [--methods td3 td3-dynamic] [--hyper JSON] [--sigma 0.6] [--resample 0.05]
+
+First, with the actor's output held at zero (what a fresh TD3 actor roughly gives), it
+rolls out each noise process for 20 episodes of 1,000 steps and prints, per episode, the
+rewarded events (an item or the completion), the steps spent pushing the arena wall and
+the span of the agent's path (mean of its x and y extents): the package's default
+N(0, 0.3) per step, SB3's Ornstein-Uhlenbeck noise (its defaults, sigma 0.3) and a
+persistent noise that holds one N(0, sigma) draw and redraws it with probability
+``resample`` per step.
+
+Then it trains each method (one process each, one torch thread) with the persistent noise,
+the quick suite's network ([256, 256]) and ``--hyper`` (``make_agent`` keywords, e.g.
+``{"learning_rate": 1e-3}``), and prints every 10,000 steps the greedy success and return
+over 10 fresh episodes and the rewarded events per training episode since the last line:
+whether the student learns to reach items at all. TABLE is a teacher's ``table.npz``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+from stable_baselines3.common.noise import ActionNoise
+
+
+class PersistentActionNoise(ActionNoise):
+    """One N(0, sigma) draw held across steps, redrawn with probability ``resample`` per
+    step and at every reset: straight runs of about 1 / resample steps, where white noise
+    jitters the point mass in place (its 0.2 s time constant averages it out)."""
+
+    def __init__(self, sigma: float, resample: float, dim: int = 2, seed: int = 0):
+        self.sigma, self.resample, self.dim = sigma, resample, dim
+        self.rng = np.random.default_rng(seed)
+        self.reset()
+
+    def reset(self) -> None:
+        self.eps = self.rng.normal(0.0, self.sigma, self.dim)
+
+    def __call__(self) -> np.ndarray:
+        if self.rng.random() < self.resample:
+            self.eps = self.rng.normal(0.0, self.sigma, self.dim)
+        return self.eps
+
+
+def noise_processes(sigma: float, resample: float) -> dict:
+    from stable_baselines3.common.noise import NormalActionNoise, OrnsteinUhlenbeckActionNoise
+
+    z = np.zeros(2)
+    return {"N(0, 0.3) per step (package default)": lambda s: NormalActionNoise(z, 0.3 * np.ones(2)),
+            "Ornstein-Uhlenbeck (SB3 defaults, sigma 0.3)": lambda s: OrnsteinUhlenbeckActionNoise(z, 0.3 * np.ones(2)),
+            f"persistent N(0, {sigma}), redrawn w.p. {resample}": lambda s: PersistentActionNoise(sigma, resample, seed=s)}
+
+
+def coverage(task: str, make_noise, episodes: int = 20) -> dict:
+    import gymnasium as gym
+
+    import craftsuite  # noqa: F401
+
+    env = gym.make(f"CraftSuite/{task}-Cont-v0")
+    events = wall = 0
+    spans = []
+    for episode in range(episodes):
+        np.random.seed(episode)  # SB3's Normal and OU noises draw from numpy's global RNG
+        noise = make_noise(episode)
+        noise.reset()
+        env.reset(seed=episode)
+        path, done = [env.unwrapped.agent_position.copy()], False
+        while not done:
+            _, reward, terminated, truncated, _ = env.step(np.clip(noise(), -1, 1))
+            events += reward > -0.05  # more than the step and wall costs
+            wall += reward < -0.15  # the step cost and the wall cost together
+            path.append(env.unwrapped.agent_position.copy())
+            done = terminated or truncated
+        spans.append(np.ptp(np.array(path), axis=0).mean())
+    env.close()
+    return {"events": events / episodes, "wall_steps": wall / episodes, "span": float(np.mean(spans))}
+
+
+def train(method: str, args) -> list[dict]:
+    import torch
+
+    torch.set_num_threads(1)
+    import craftsuite  # noqa: F401
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    from craftsuite.agents import AutomatonQTable
+    from craftsuite.agents.methods import METHODS, make_agent
+    from craftsuite.training import evaluate
+
+    env_id = f"CraftSuite/{args.task}-Cont-v0"
+    table = AutomatonQTable.load(args.table) if method.endswith("dynamic") else None
+    hyper = {"policy_kwargs": {"net_arch": [256, 256]}, **json.loads(args.hyper)}
+    agent = make_agent(method, env_id, table=table, seed=args.seed,
+                       action_noise=PersistentActionNoise(args.sigma, args.resample, seed=args.seed), **hyper)
+    rows, start = [], time.perf_counter()
+
+    class Report(BaseCallback):
+        events = episodes = wins = 0
+
+        def _on_step(self) -> bool:
+            self.events += int((self.locals["rewards"] > -0.05).sum())
+            if self.locals["dones"][0]:
+                self.episodes += 1
+                self.wins += bool(self.locals["infos"][0].get("is_success"))
+            if self.num_timesteps % 10_000 == 0:
+                success, ret = evaluate(agent, env_id, 10, 10**6, METHODS[method].product)
+                row = {"method": method, "step": self.num_timesteps, "eval_success": success,
+                       "eval_return": round(ret, 1), "train_wins": self.wins,
+                       "events_per_episode": round(self.events / max(self.episodes, 1), 2),
+                       "seconds": round(time.perf_counter() - start)}
+                print(json.dumps(row), flush=True)
+                rows.append(row)
+                self.events = self.episodes = 0
+            return True
+
+    agent.learn(args.steps, callback=Report())
+    return rows
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("table", help="a teacher's table.npz")
+    parser.add_argument("--task", default="BlindCraftsman")
+    parser.add_argument("--steps", type=int, default=60_000)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--methods", nargs="+", default=["td3", "td3-dynamic"])
+    parser.add_argument("--hyper", default="{}", help="make_agent keywords as JSON")
+    parser.add_argument("--sigma", type=float, default=0.6)
+    parser.add_argument("--resample", type=float, default=0.05)
+    args = parser.parse_args()
+    print(f"{args.task}, actor output held at 0, 20 episodes of 1,000 steps per noise")
+    print("| noise | rewarded events / episode | steps at the wall / episode | path span (m) |")
+    print("|---|---|---|---|")
+    for name, make in noise_processes(args.sigma, args.resample).items():
+        c = coverage(args.task, make)
+        print(f"| {name} | {c['events']:.2f} | {c['wall_steps']:.0f} | {c['span']:.2f} |", flush=True)
+    with ProcessPoolExecutor(len(args.methods)) as pool:
+        results = list(pool.map(train, args.methods, [args] * len(args.methods)))
+    print(f"\n{args.task}, seed {args.seed}, persistent noise N(0, {args.sigma}) redrawn w.p. "
+          f"{args.resample}, hyper {args.hyper}")
+    print("| method | step | greedy success | greedy return | training wins | events / training episode |")
+    print("|---|---|---|---|---|---|")
+    for rows in results:
+        for r in rows:
+            print(f"| {r['method']} | {r['step']:,} | {r['eval_success']:.2f} | {r['eval_return']} "
+                  f"| {r['train_wins']} | {r['events_per_episode']} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -23,10 +23,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
+from _students import train_with_reports  # benchmarks/ is on sys.path when run as a script
 from stable_baselines3.common.noise import ActionNoise
 
 
@@ -84,44 +84,9 @@ def coverage(task: str, make_noise, episodes: int = 20) -> dict:
 
 
 def train(method: str, args) -> list[dict]:
-    import torch
-
-    torch.set_num_threads(1)
-    import craftsuite  # noqa: F401
-    from stable_baselines3.common.callbacks import BaseCallback
-
-    from craftsuite.agents import AutomatonQTable
-    from craftsuite.agents.methods import METHODS, make_agent
-    from craftsuite.training import evaluate
-
-    env_id = f"CraftSuite/{args.task}-Cont-v0"
-    table = AutomatonQTable.load(args.table) if method.endswith("dynamic") else None
-    hyper = {"policy_kwargs": {"net_arch": [256, 256]}, **json.loads(args.hyper)}
-    agent = make_agent(method, env_id, table=table, seed=args.seed,
-                       action_noise=PersistentActionNoise(args.sigma, args.resample, seed=args.seed), **hyper)
-    rows, start = [], time.perf_counter()
-
-    class Report(BaseCallback):
-        events = episodes = wins = 0
-
-        def _on_step(self) -> bool:
-            self.events += int((self.locals["rewards"] > -0.05).sum())
-            if self.locals["dones"][0]:
-                self.episodes += 1
-                self.wins += bool(self.locals["infos"][0].get("is_success"))
-            if self.num_timesteps % 10_000 == 0:
-                success, ret = evaluate(agent, env_id, 10, 10**6, METHODS[method].product)
-                row = {"method": method, "step": self.num_timesteps, "eval_success": success,
-                       "eval_return": round(ret, 1), "train_wins": self.wins,
-                       "events_per_episode": round(self.events / max(self.episodes, 1), 2),
-                       "seconds": round(time.perf_counter() - start)}
-                print(json.dumps(row), flush=True)
-                rows.append(row)
-                self.events = self.episodes = 0
-            return True
-
-    agent.learn(args.steps, callback=Report())
-    return rows
+    return train_with_reports(method, args.table, task=args.task, seed=args.seed, steps=args.steps, every=10_000,
+                              action_noise=PersistentActionNoise(args.sigma, args.resample, seed=args.seed),
+                              **{"policy_kwargs": {"net_arch": [256, 256]}, **json.loads(args.hyper)})
 
 
 def main():

@@ -18,49 +18,16 @@ per 1,000-step episode at the default (30 episodes): what exploration alone find
 from __future__ import annotations
 
 import argparse
-import json
-import time
 from concurrent.futures import ProcessPoolExecutor
 
-from random_walk import random_walk  # benchmarks/ is on sys.path when run as a script
+from _students import train_with_reports  # benchmarks/ is on sys.path when run as a script
+from random_walk import random_walk
 
 
 def run(method: str, args) -> list[dict]:
-    import torch
-
-    torch.set_num_threads(1)
-    import craftsuite  # noqa: F401
-    from stable_baselines3.common.callbacks import BaseCallback
-
-    from craftsuite.agents import AutomatonQTable
-    from craftsuite.agents.methods import METHODS, make_agent
-    from craftsuite.training import evaluate
-
-    env_id = f"CraftSuite/{args.task}-Cont-v0"
-    env_kwargs = {"frame_skip": args.frame_skip, "max_episode_steps": args.limit}
-    table = AutomatonQTable.load(args.table) if method.endswith("dynamic") else None
-    agent = make_agent(method, env_id, table=table, seed=args.seed, env_kwargs=env_kwargs,
-                       policy_kwargs={"net_arch": [256, 256]})
-    rows, start = [], time.perf_counter()
-
-    class Report(BaseCallback):
-        wins = episodes = 0
-
-        def _on_step(self) -> bool:
-            if self.locals["dones"][0]:
-                self.episodes += 1
-                self.wins += bool(self.locals["infos"][0].get("is_success"))
-            if self.num_timesteps % 5_000 == 0:
-                success, ret = evaluate(agent, env_id, 10, 10**6, METHODS[method].product, env_kwargs)
-                row = {"method": method, "step": self.num_timesteps, "eval_success": success,
-                       "eval_return": round(ret, 1), "train_episodes": self.episodes, "train_wins": self.wins,
-                       "seconds": round(time.perf_counter() - start)}
-                print(json.dumps(row), flush=True)
-                rows.append(row)
-            return True
-
-    agent.learn(args.steps, callback=Report())
-    return rows
+    return train_with_reports(method, args.table, task=args.task, seed=args.seed, steps=args.steps, every=5_000,
+                              env_kwargs={"frame_skip": args.frame_skip, "max_episode_steps": args.limit},
+                              policy_kwargs={"net_arch": [256, 256]})
 
 
 def scripted_steps(task: str, frame_skip: int, episodes: int = 10) -> float:

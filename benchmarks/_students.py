@@ -1,0 +1,52 @@
+"""A student trained in-process with a report every few thousand steps, shared by the TD3
+benchmark scripts (td3_horizon.py, td3_exploration.py)."""
+
+from __future__ import annotations
+
+import json
+import time
+
+
+def train_with_reports(method: str, table: str | None, *, task: str, seed: int, steps: int, every: int,
+                       env_kwargs: dict | None = None, **agent_kwargs) -> list[dict]:
+    """Train ``method`` on ``CraftSuite/<task>-Cont-v0`` (one torch thread) and, every
+    ``every`` steps, print and keep a row: greedy success and return over 10 fresh episodes,
+    training episodes and wins so far, and rewarded events (an item or the completion) per
+    training episode since the row before. ``agent_kwargs`` go to ``make_agent``."""
+    import torch
+
+    torch.set_num_threads(1)
+    import craftsuite  # noqa: F401
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    from craftsuite.agents import AutomatonQTable
+    from craftsuite.agents.methods import METHODS, make_agent
+    from craftsuite.training import evaluate
+
+    env_id = f"CraftSuite/{task}-Cont-v0"
+    table = AutomatonQTable.load(table) if method.endswith("dynamic") else None
+    agent = make_agent(method, env_id, table=table, seed=seed, env_kwargs=env_kwargs, **agent_kwargs)
+    rows, start = [], time.perf_counter()
+
+    class Report(BaseCallback):
+        episodes = wins = window_episodes = window_events = 0
+
+        def _on_step(self) -> bool:
+            self.window_events += int((self.locals["rewards"] > -0.05).sum())  # more than the step and wall costs
+            if self.locals["dones"][0]:
+                self.episodes += 1
+                self.window_episodes += 1
+                self.wins += bool(self.locals["infos"][0].get("is_success"))
+            if self.num_timesteps % every == 0:
+                success, ret = evaluate(agent, env_id, 10, 10**6, METHODS[method].product, env_kwargs)
+                row = {"method": method, "step": self.num_timesteps, "eval_success": success,
+                       "eval_return": round(ret, 1), "train_episodes": self.episodes, "train_wins": self.wins,
+                       "events_per_episode": round(self.window_events / max(self.window_episodes, 1), 2),
+                       "seconds": round(time.perf_counter() - start)}
+                print(json.dumps(row), flush=True)
+                rows.append(row)
+                self.window_events = self.window_episodes = 0
+            return True
+
+    agent.learn(steps, callback=Report())
+    return rows

@@ -2,7 +2,7 @@
 a persistent noise.
 
 Usage: python benchmarks/td3_exploration.py TABLE [--task T] [--steps N] [--seed S]
-       [--methods td3 td3-dynamic] [--hyper JSON] [--sigma 0.6] [--resample 0.05]
+       [--methods td3 td3-dynamic] [--hyper JSON] [--env JSON] [--sigma 0.6] [--resample 0.05]
 
 First, with the actor's output held at zero (what a fresh TD3 actor roughly gives), it
 rolls out each noise process for 20 episodes of 1,000 steps and prints, per episode, the
@@ -16,7 +16,9 @@ Then it trains each method (one process each, one torch thread) with the persist
 the quick suite's network ([256, 256]) and ``--hyper`` (``make_agent`` keywords, e.g.
 ``{"learning_rate": 1e-3}``), and prints every 10,000 steps the greedy success and return
 over 10 fresh episodes and the rewarded events per training episode since the last line:
-whether the student learns to reach items at all. TABLE is a teacher's ``table.npz``.
+whether the student learns to reach items at all. ``--env`` (``gymnasium.make`` keywords,
+e.g. ``{"frame_skip": 5, "max_episode_steps": 400}``) changes the students' world, not the
+noise rollouts. TABLE is a teacher's ``table.npz``.
 """
 
 from __future__ import annotations
@@ -85,6 +87,7 @@ def coverage(task: str, make_noise, episodes: int = 20) -> dict:
 
 def train(method: str, args) -> list[dict]:
     return train_with_reports(method, args.table, task=args.task, seed=args.seed, steps=args.steps, every=10_000,
+                              env_kwargs=json.loads(args.env) or None,
                               action_noise=PersistentActionNoise(args.sigma, args.resample, seed=args.seed),
                               **{"policy_kwargs": {"net_arch": [256, 256]}, **json.loads(args.hyper)})
 
@@ -97,6 +100,7 @@ def main():
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--methods", nargs="+", default=["td3", "td3-dynamic"])
     parser.add_argument("--hyper", default="{}", help="make_agent keywords as JSON")
+    parser.add_argument("--env", default="{}", help="gymnasium.make keywords for the students' world, as JSON")
     parser.add_argument("--sigma", type=float, default=0.6)
     parser.add_argument("--resample", type=float, default=0.05)
     args = parser.parse_args()
@@ -109,7 +113,7 @@ def main():
     with ProcessPoolExecutor(len(args.methods)) as pool:
         results = list(pool.map(train, args.methods, [args] * len(args.methods)))
     print(f"\n{args.task}, seed {args.seed}, persistent noise N(0, {args.sigma}) redrawn w.p. "
-          f"{args.resample}, hyper {args.hyper}")
+          f"{args.resample}, hyper {args.hyper}, env {args.env}")
     print("| method | step | greedy success | greedy return | training wins | events / training episode |")
     print("|---|---|---|---|---|---|")
     for rows in results:

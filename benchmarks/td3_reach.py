@@ -43,7 +43,7 @@ def register_reach() -> None:
 
 def run(setting: tuple[str, str, int], steps: int) -> list[dict]:
     horizon, noise, seed = setting
-    register_reach()  # in this worker too: spawned processes start with the built-in ids only
+    register_reach()  # here, in the worker that makes the envs (whatever the start method)
     kwargs = {"policy_kwargs": {"net_arch": [256, 256]}}
     if noise != NOISES[0]:
         kwargs["action_noise"] = PersistentActionNoise(0.6, 0.05, seed=seed)

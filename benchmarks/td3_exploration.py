@@ -28,27 +28,7 @@ import json
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
-from _students import train_with_reports  # benchmarks/ is on sys.path when run as a script
-from stable_baselines3.common.noise import ActionNoise
-
-
-class PersistentActionNoise(ActionNoise):
-    """One N(0, sigma) draw held across steps, redrawn with probability ``resample`` per
-    step and at every reset: straight runs of about 1 / resample steps, where white noise
-    jitters the point mass in place (its 0.2 s time constant averages it out)."""
-
-    def __init__(self, sigma: float, resample: float, dim: int = 2, seed: int = 0):
-        self.sigma, self.resample, self.dim = sigma, resample, dim
-        self.rng = np.random.default_rng(seed)
-        self.reset()
-
-    def reset(self) -> None:
-        self.eps = self.rng.normal(0.0, self.sigma, self.dim)
-
-    def __call__(self) -> np.ndarray:
-        if self.rng.random() < self.resample:
-            self.eps = self.rng.normal(0.0, self.sigma, self.dim)
-        return self.eps
+from _students import PersistentActionNoise, train_with_reports  # benchmarks/ is on sys.path as a script
 
 
 def noise_processes(sigma: float, resample: float) -> dict:

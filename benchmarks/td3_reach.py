@@ -10,7 +10,7 @@ package defaults otherwise) is trained under four settings, one process each:
 * control period: the registered default (frame skip 2, 0.05 s, 1,000-step episodes)
   or coarser (frame skip 5, 0.125 s, 400-step episodes);
 * exploration: the package's N(0, 0.3) drawn anew each step, or the persistent noise of
-  ``td3_exploration.py`` (one N(0, 0.6) draw held, redrawn with probability 0.05).
+  ``_students.py`` (one N(0, 0.6) draw held, redrawn with probability 0.05).
 
 Prints, per setting and seed, greedy success over 10 fresh episodes every 5,000 steps and
 the training episodes won, then a summary of greedy success at the last step.
@@ -23,8 +23,7 @@ from concurrent.futures import ProcessPoolExecutor
 from itertools import product
 
 import numpy as np
-from _students import train_with_reports  # benchmarks/ is on sys.path when run as a script
-from td3_exploration import PersistentActionNoise
+from _students import PersistentActionNoise, train_with_reports  # benchmarks/ is on sys.path as a script
 
 # The task as data, as tasks/*.toml would hold it.
 REACH = {"name": "Reach", "formula": "F wood", "propositions": {"wood": {"obtained": "wood"}},

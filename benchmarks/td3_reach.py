@@ -6,7 +6,8 @@ Usage: python benchmarks/td3_reach.py [--steps 30000] [--seeds 0 1] [--frame-ski
 ``Reach``: one wood in the 7 x 7 arena, objective ``F wood`` (+100 on touching it, which
 ends the episode; -0.1 per step), so the only skill to learn is driving to a point given
 its offset in the observation. TD3 from scratch (the quick suite's [256, 256] network,
-package defaults otherwise) is trained under four settings, one process each:
+package defaults otherwise) is trained under each chosen setting (four by default), one
+process each:
 
 * control period: the registered default (frame skip 2, 0.05 s, 1,000-step episodes),
   coarser (frame skip 5, 0.125 s, 400-step episodes) or about the grid teacher's step

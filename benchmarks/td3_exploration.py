@@ -67,9 +67,9 @@ def coverage(task: str, make_noise, episodes: int = 20) -> dict:
 
 def train(method: str, args) -> list[dict]:
     return train_with_reports(method, args.table, task=args.task, seed=args.seed, steps=args.steps, every=10_000,
-                              env_kwargs=json.loads(args.env) or None,
+                              env_kwargs=args.env or None,
                               action_noise=PersistentActionNoise(args.sigma, args.resample, seed=args.seed),
-                              **{"policy_kwargs": {"net_arch": [256, 256]}, **json.loads(args.hyper)})
+                              **{"policy_kwargs": {"net_arch": [256, 256]}, **args.hyper})
 
 
 def main():
@@ -79,8 +79,8 @@ def main():
     parser.add_argument("--steps", type=int, default=60_000)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--methods", nargs="+", default=["td3", "td3-dynamic"])
-    parser.add_argument("--hyper", default="{}", help="make_agent keywords as JSON")
-    parser.add_argument("--env", default="{}", help="gymnasium.make keywords for the students' world, as JSON")
+    parser.add_argument("--hyper", type=json.loads, default={}, help="make_agent keywords as JSON")
+    parser.add_argument("--env", type=json.loads, default={}, help="gymnasium.make keywords for the students' world, as JSON")
     parser.add_argument("--sigma", type=float, default=0.6)
     parser.add_argument("--resample", type=float, default=0.05)
     args = parser.parse_args()
@@ -93,7 +93,7 @@ def main():
     with ProcessPoolExecutor(len(args.methods)) as pool:
         results = list(pool.map(train, args.methods, [args] * len(args.methods)))
     print(f"\n{args.task}, seed {args.seed}, persistent noise N(0, {args.sigma}) redrawn w.p. "
-          f"{args.resample}, hyper {args.hyper}, env {args.env}")
+          f"{args.resample}, hyper {json.dumps(args.hyper)}, env {json.dumps(args.env)}")
     print("| method | step | greedy success | greedy return | training wins | events / training episode |")
     print("|---|---|---|---|---|---|")
     for rows in results:

@@ -1,11 +1,15 @@
 """Can a TD3 student learn to reach one object in the MuJoCo world at all? A calibration task.
 
-Usage: python benchmarks/td3_reach.py [--steps 30000] [--seeds 0 1] [--frame-skips 2 5]
+Usage: python benchmarks/td3_reach.py [--steps 30000] [--seeds 0 1] [--scenes one] [--frame-skips 2 5]
        [--noises white persistent] [--resample 0.05] [--hyper JSON] [--workers 2]
 
 ``Reach``: one wood in the 7 x 7 arena, objective ``F wood`` (+100 on touching it, which
 ends the episode; -0.1 per step), so the only skill to learn is driving to a point given
-its offset in the observation. TD3 from scratch (the quick suite's [256, 256] network,
+its offset in the observation. ``--scenes three`` puts three woods in the arena (any one
+will do), ``--scenes craftsman`` Blind Craftsman's objects (three woods, the factory, home
+in a corner) with the same objective: is choosing among object slots, or ignoring some,
+what a Blind Craftsman student cannot learn? ``--scenes tool`` is the next rung: the same
+objects, +100 for the first tool (a wood, then the factory). TD3 from scratch (the quick suite's [256, 256] network,
 package defaults otherwise) is trained under each chosen setting (four by default), one
 process each:
 
@@ -17,7 +21,8 @@ process each:
   ``--resample``).
 ``--hyper`` adds ``make_agent`` keywords, e.g. ``{"prioritized": false}``.
 
-Prints, per setting and seed, greedy success over 10 fresh episodes every 5,000 steps and
+Prints, per setting and seed, greedy success over 10 fresh episodes every 5,000 steps (so
+``--steps`` of at least 5,000) and
 the training episodes won, then a summary of greedy success at the last step.
 """
 
@@ -31,9 +36,23 @@ from itertools import product
 import numpy as np
 from _students import PersistentActionNoise, train_with_reports  # benchmarks/ is on sys.path as a script
 
-# The task as data, as tasks/*.toml would hold it.
+# The task as data, as tasks/*.toml would hold it, in three scenes: the objective stays
+# ``F wood``; the others add what a Blind Craftsman student sees besides (more woods to choose
+# from, the factory and home as object slots it must learn to ignore).
 REACH = {"name": "Reach", "formula": "F wood", "propositions": {"wood": {"obtained": "wood"}},
          "items": {"wood": {"count": 1}}, "rewards": {"step": -0.1, "completion": 100.0}}
+SCENES = {
+    "one": REACH,
+    "three": {**REACH, "name": "Reach3", "items": {"wood": {"count": 3}}},
+    "craftsman": {**REACH, "name": "ReachCraftsman", "items": {"wood": {"count": 3, "capacity": 2}},
+                  "places": {"factory": {}, "home": {"placement": "corner"}}},
+    # two stages: a wood, then the factory (Blind Craftsman's first tool), +100 on the tool
+    "tool": {**REACH, "name": "ReachTool", "formula": "F tools1",
+             "propositions": {"tools1": {"at_least": {"tools": 1}}},
+             "items": {"wood": {"count": 3, "capacity": 2}},
+             "places": {"factory": {}, "home": {"placement": "corner"}},
+             "recipes": [{"at": "factory", "consume": {"wood": 1}, "produce": {"tools": 1}, "repeat": True}]},
+}
 # frame skip -> (label, gymnasium.make keywords); every limit is 50 s of simulated time
 HORIZONS = {2: ("frame skip 2, 1,000 steps", {}),
             5: ("frame skip 5, 400 steps", {"frame_skip": 5, "max_episode_steps": 400}),
@@ -41,30 +60,35 @@ HORIZONS = {2: ("frame skip 2, 1,000 steps", {}),
 NOISES = ("white", "persistent")
 
 
-def register_reach() -> None:
+def register_reach(scene: str) -> str:
+    """Register the scene's task (in this process) and return its name."""
     import craftsuite
     from craftsuite.spec import load_spec
 
-    craftsuite.register_task(load_spec(REACH, name_hint="td3_reach.py"))
+    spec = SCENES[scene]
+    craftsuite.register_task(load_spec(spec, name_hint="td3_reach.py"))
+    return spec["name"]
 
 
 def noise_label(noise: str, resample: float) -> str:
     return "N(0, 0.3) per step" if noise == "white" else f"persistent N(0, 0.6), p {resample:g}"
 
 
-def run(setting: tuple[int, str, int], steps: int, resample: float, hyper: dict) -> list[dict]:
-    skip, noise, seed = setting
-    register_reach()  # here, in the worker that makes the envs (whatever the start method)
+def run(setting: tuple[str, int, str, int], steps: int, resample: float, hyper: dict) -> list[dict]:
+    scene, skip, noise, seed = setting
+    task = register_reach(scene)  # here, in the worker that makes the envs (whatever the start method)
     kwargs = {"policy_kwargs": {"net_arch": [256, 256]}, **hyper}
     if noise == "persistent":
         kwargs["action_noise"] = PersistentActionNoise(0.6, resample, seed=seed)
-    return train_with_reports("td3", None, task="Reach", seed=seed, steps=steps, every=5_000,
+    return train_with_reports("td3", None, task=task, seed=seed, steps=steps, every=5_000,
                               env_kwargs=HORIZONS[skip][1] or None, **kwargs)
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=30_000)
+    parser.add_argument("--scenes", nargs="+", choices=list(SCENES), default=["one"],
+                        help="one wood; three woods; three woods, factory and home (Blind Craftsman's objects)")
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1])
     parser.add_argument("--frame-skips", type=int, nargs="+", choices=sorted(HORIZONS), default=[2, 5])
     parser.add_argument("--noises", nargs="+", choices=NOISES, default=list(NOISES))
@@ -72,22 +96,25 @@ def main():
     parser.add_argument("--hyper", type=json.loads, default={}, help="make_agent keywords as JSON")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
-    settings = list(product(args.frame_skips, args.noises, args.seeds))
+    if args.steps < 5_000:
+        parser.error("--steps must be at least 5000 (one report every 5,000 steps)")
+    settings = list(product(args.scenes, args.frame_skips, args.noises, args.seeds))
     n = len(settings)
     with ProcessPoolExecutor(args.workers) as pool:
         results = list(pool.map(run, settings, [args.steps] * n, [args.resample] * n, [args.hyper] * n))
     if args.hyper:
         print(f"\nmake_agent keywords: {json.dumps(args.hyper)}")
-    print("\n| control period, episode | exploration noise | seed | greedy success every 5,000 steps | training wins / episodes |")
-    print("|---|---|---|---|---|")
-    for (skip, noise, seed), rows in zip(settings, results):
+    print("\n| scene | control period, episode | exploration noise | seed | greedy success every 5,000 steps | training wins / episodes |")
+    print("|---|---|---|---|---|---|")
+    for (scene, skip, noise, seed), rows in zip(settings, results):
         curve = " ".join(f"{r['eval_success']:.1f}" for r in rows)
-        print(f"| {HORIZONS[skip][0]} | {noise_label(noise, args.resample)} | {seed} | {curve} | {rows[-1]['train_wins']} / {rows[-1]['train_episodes']} |")
-    print(f"\n| control period, episode | exploration noise | greedy success at {args.steps:,} (mean over seeds {args.seeds}) |")
-    print("|---|---|---|")
-    for skip, noise in product(args.frame_skips, args.noises):
-        last = [rows[-1]["eval_success"] for (k, n, _), rows in zip(settings, results) if (k, n) == (skip, noise)]
-        print(f"| {HORIZONS[skip][0]} | {noise_label(noise, args.resample)} | {np.mean(last):.2f} ({', '.join(f'{x:.1f}' for x in last)}) |")
+        print(f"| {scene} | {HORIZONS[skip][0]} | {noise_label(noise, args.resample)} | {seed} | {curve} | {rows[-1]['train_wins']} / {rows[-1]['train_episodes']} |")
+    print(f"\n| scene | control period, episode | exploration noise | greedy success at {args.steps:,} (mean over seeds {args.seeds}) |")
+    print("|---|---|---|---|")
+    for setting in product(args.scenes, args.frame_skips, args.noises):
+        last = [rows[-1]["eval_success"] for s, rows in zip(settings, results) if s[:3] == setting]
+        scene, skip, noise = setting
+        print(f"| {scene} | {HORIZONS[skip][0]} | {noise_label(noise, args.resample)} | {np.mean(last):.2f} ({', '.join(f'{x:.1f}' for x in last)}) |")
 
 
 if __name__ == "__main__":

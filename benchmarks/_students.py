@@ -33,9 +33,9 @@ class PersistentActionNoise(ActionNoise):
 def train_with_reports(method: str, table: str | None, *, task: str, seed: int, steps: int, every: int,
                        env_kwargs: dict | None = None, **agent_kwargs) -> list[dict]:
     """Train ``method`` on ``CraftSuite/<task>-Cont-v0`` (one torch thread) and, every
-    ``every`` steps, print and keep a row: greedy success and return over 10 fresh episodes,
-    training episodes and wins so far, and rewarded events (an item or the completion) per
-    training episode since the row before. ``agent_kwargs`` go to ``make_agent``."""
+    ``every`` steps, print and keep a row: greedy success, return and rewarded events (an
+    item or the completion) per episode over 10 fresh episodes, training episodes and wins
+    so far, and rewarded events per training episode since the row before. ``agent_kwargs`` go to ``make_agent``."""
     import torch
 
     torch.set_num_threads(1)
@@ -61,9 +61,12 @@ def train_with_reports(method: str, table: str | None, *, task: str, seed: int, 
                 self.window_episodes += 1
                 self.wins += bool(self.locals["infos"][0].get("is_success"))
             if self.num_timesteps % every == 0:
-                success, ret = evaluate(agent, env_id, 10, 10**6, METHODS[method].product, env_kwargs)
+                greedy_events = []
+                success, ret = evaluate(agent, env_id, 10, 10**6, METHODS[method].product, env_kwargs,
+                                        on_step=lambda i, r, info: greedy_events.append(r > -0.05))
                 row = {"method": method, "step": self.num_timesteps, "eval_success": success,
-                       "eval_return": round(ret, 1), "train_episodes": self.episodes, "train_wins": self.wins,
+                       "eval_return": round(ret, 1), "eval_events": sum(greedy_events) / 10,
+                       "train_episodes": self.episodes, "train_wins": self.wins,
                        "events_per_episode": round(self.window_events / max(self.window_episodes, 1), 2),
                        "seconds": round(time.perf_counter() - start)}
                 print(json.dumps(row), flush=True)

@@ -94,12 +94,13 @@ def main():
         results = list(pool.map(train, args.methods, [args] * len(args.methods)))
     print(f"\n{args.task}, seed {args.seed}, persistent noise N(0, {args.sigma}) redrawn w.p. "
           f"{args.resample}, hyper {json.dumps(args.hyper)}, env {json.dumps(args.env)}")
-    print("| method | step | greedy success | greedy return | training wins | events / training episode |")
-    print("|---|---|---|---|---|---|")
+    print("| method | step | greedy success | greedy return | events / greedy episode | training wins "
+          "| events / training episode |")
+    print("|---|---|---|---|---|---|---|")
     for rows in results:
         for r in rows:
             print(f"| {r['method']} | {r['step']:,} | {r['eval_success']:.2f} | {r['eval_return']} "
-                  f"| {r['train_wins']} | {r['events_per_episode']} |")
+                  f"| {r['eval_events']:.1f} | {r['train_wins']} | {r['events_per_episode']} |")
 
 
 if __name__ == "__main__":

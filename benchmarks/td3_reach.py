@@ -21,8 +21,8 @@ process each:
   ``--resample``).
 ``--hyper`` adds ``make_agent`` keywords, e.g. ``{"prioritized": false}``.
 
-Prints, per setting and seed, greedy success over 10 fresh episodes every 5,000 steps (so
-``--steps`` of at least 5,000) and
+Prints, per setting and seed, greedy success and rewarded events (a wood, a completion) per
+episode over 10 fresh episodes every 5,000 steps (so ``--steps`` of at least 5,000) and
 the training episodes won, then a summary of greedy success at the last step.
 """
 
@@ -104,11 +104,14 @@ def main():
         results = list(pool.map(run, settings, [args.steps] * n, [args.resample] * n, [args.hyper] * n))
     if args.hyper:
         print(f"\nmake_agent keywords: {json.dumps(args.hyper)}")
-    print("\n| scene | control period, episode | exploration noise | seed | greedy success every 5,000 steps | training wins / episodes |")
-    print("|---|---|---|---|---|---|")
+    print("\n| scene | control period, episode | exploration noise | seed | greedy success every 5,000 steps "
+          "| events / greedy episode | training wins / episodes |")
+    print("|---|---|---|---|---|---|---|")
     for (scene, skip, noise, seed), rows in zip(settings, results):
         curve = " ".join(f"{r['eval_success']:.1f}" for r in rows)
-        print(f"| {scene} | {HORIZONS[skip][0]} | {noise_label(noise, args.resample)} | {seed} | {curve} | {rows[-1]['train_wins']} / {rows[-1]['train_episodes']} |")
+        events = " ".join(f"{r['eval_events']:.1f}" for r in rows)
+        print(f"| {scene} | {HORIZONS[skip][0]} | {noise_label(noise, args.resample)} | {seed} | {curve} | {events} "
+              f"| {rows[-1]['train_wins']} / {rows[-1]['train_episodes']} |")
     print(f"\n| scene | control period, episode | exploration noise | greedy success at {args.steps:,} (mean over seeds {args.seeds}) |")
     print("|---|---|---|---|")
     for setting in product(args.scenes, args.frame_skips, args.noises):

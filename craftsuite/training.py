@@ -77,10 +77,12 @@ class StudentConfig:
         return f"student-{self.task}-{self.world}-{self.method}-s{self.seed}-{config_key(self)}"
 
 
-def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kwargs: dict | None = None):
+def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kwargs: dict | None = None,
+             on_step=None):
     """Greedy episodes on fresh seeds, played side by side so that the policy sees one
     batch per step (an untrained policy that never finishes costs 1,000 batched calls, not
-    ``episodes`` x 1,000): (success rate, mean return)."""
+    ``episodes`` x 1,000): (success rate, mean return). ``on_step(episode, reward, info)``,
+    if given, sees every step (for measures beyond these two)."""
     envs = [gym.make(env_id, product=product, **(env_kwargs or {})) for _ in range(episodes)]
     obs = np.stack([env.reset(seed=seed + i)[0] for i, env in enumerate(envs)])
     returns, wins = np.zeros(episodes), np.zeros(episodes, dtype=bool)
@@ -91,6 +93,8 @@ def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kw
         for i, action in zip(live, actions):
             obs[i], reward, term, trunc, info = envs[i].step(action)
             returns[i] += float(reward)
+            if on_step is not None:
+                on_step(i, float(reward), info)
             if term or trunc:
                 active[i] = False
                 wins[i] = bool(info["is_success"])

@@ -66,6 +66,24 @@ def test_grid_student_keeps_one_fixed_instance(tmp_path, monkeypatch):
         StudentConfig(world="Grid7", layout_seed=-1)  # refused before a run directory is made
 
 
+def test_evaluate_reports_every_step_to_on_step():
+    import numpy as np
+
+    from craftsuite.training import evaluate
+
+    class Wanderer:  # a fixed direction per episode slot: episodes end at different steps
+        def predict(self, obs, deterministic=True):
+            return np.tile([[0.7, -0.4]], (len(obs), 1)).astype(np.float32), None
+
+    seen = {}
+    success, mean_return = evaluate(Wanderer(), "CraftSuite/BlindCraftsman-Cont-v0", 3, seed=5, product=False,
+                                    env_kwargs={"max_episode_steps": 40},
+                                    on_step=lambda i, r, info: seen.setdefault(i, []).append(r))
+    assert sorted(seen) == [0, 1, 2] and all(len(r) == 40 for r in seen.values())
+    assert success == 0.0
+    assert np.isclose(mean_return, np.mean([sum(r) for r in seen.values()]))
+
+
 _KILLABLE = """
 import sys, craftsuite
 from craftsuite.training import StudentConfig, train_student

@@ -9,9 +9,9 @@ its offset in the observation. ``--scenes three`` puts three woods in the arena 
 will do), ``--scenes craftsman`` Blind Craftsman's objects (three woods, the factory, home
 in a corner) with the same objective: is choosing among object slots, or ignoring some,
 what a Blind Craftsman student cannot learn? ``--scenes tool`` is the next rung: the same
-objects, +100 for the first tool (a wood, then the factory). TD3 from scratch (the quick suite's [256, 256] network,
-package defaults otherwise) is trained under each chosen setting (four by default), one
-process each:
+objects, +100 for the first tool (a wood, then the factory). TD3 from scratch (the quick
+suite's [256, 256] network, package defaults otherwise) is trained under each chosen
+setting (four by default), one process each:
 
 * control period: the registered default (frame skip 2, 0.05 s, 1,000-step episodes),
   coarser (frame skip 5, 0.125 s, 400-step episodes) or about the grid teacher's step
@@ -36,9 +36,9 @@ from itertools import product
 import numpy as np
 from _students import PersistentActionNoise, train_with_reports  # benchmarks/ is on sys.path as a script
 
-# The task as data, as tasks/*.toml would hold it, in three scenes: the objective stays
-# ``F wood``; the others add what a Blind Craftsman student sees besides (more woods to choose
-# from, the factory and home as object slots it must learn to ignore).
+# The task as data, as tasks/*.toml would hold it, in four scenes: "three" and "craftsman"
+# keep the objective ``F wood`` and add what a Blind Craftsman student sees besides (more woods
+# to choose from, the factory and home as object slots to ignore); "tool" adds a stage.
 REACH = {"name": "Reach", "formula": "F wood", "propositions": {"wood": {"obtained": "wood"}},
          "items": {"wood": {"count": 1}}, "rewards": {"step": -0.1, "completion": 100.0}}
 SCENES = {
@@ -88,7 +88,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=30_000)
     parser.add_argument("--scenes", nargs="+", choices=list(SCENES), default=["one"],
-                        help="one wood; three woods; three woods, factory and home (Blind Craftsman's objects)")
+                        help="one wood; three woods; Blind Craftsman's objects (three woods, factory, home); "
+                             "those objects with +100 for the first tool instead of a wood")
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1])
     parser.add_argument("--frame-skips", type=int, nargs="+", choices=sorted(HORIZONS), default=[2, 5])
     parser.add_argument("--noises", nargs="+", choices=NOISES, default=list(NOISES))

@@ -71,7 +71,7 @@ def test_evaluate_reports_every_step_to_on_step():
 
     from craftsuite.training import evaluate
 
-    class Wanderer:  # a fixed direction per episode slot: episodes end at different steps
+    class Wanderer:  # one straight line: it cannot finish Blind Craftsman, so every episode runs 40 steps
         def predict(self, obs, deterministic=True):
             return np.tile([[0.7, -0.4]], (len(obs), 1)).astype(np.float32), None
 

@@ -10,6 +10,9 @@ import time
 import numpy as np
 from stable_baselines3.common.noise import ActionNoise
 
+EVAL_EPISODES = 10
+EVENT = -0.05  # a reward above this is an item or the completion, not the step or wall cost
+
 
 class PersistentActionNoise(ActionNoise):
     """One N(0, sigma) draw held across steps, redrawn with probability ``resample`` per
@@ -35,7 +38,8 @@ def train_with_reports(method: str, table: str | None, *, task: str, seed: int, 
     """Train ``method`` on ``CraftSuite/<task>-Cont-v0`` (one torch thread) and, every
     ``every`` steps, print and keep a row: greedy success, return and rewarded events (an
     item or the completion) per episode over 10 fresh episodes, training episodes and wins
-    so far, and rewarded events per training episode since the row before. ``agent_kwargs`` go to ``make_agent``."""
+    so far, and rewarded events per training episode since the row before.
+    ``agent_kwargs`` go to ``make_agent``."""
     import torch
 
     torch.set_num_threads(1)
@@ -55,17 +59,17 @@ def train_with_reports(method: str, table: str | None, *, task: str, seed: int, 
         episodes = wins = window_episodes = window_events = 0
 
         def _on_step(self) -> bool:
-            self.window_events += int((self.locals["rewards"] > -0.05).sum())  # more than the step and wall costs
+            self.window_events += int((self.locals["rewards"] > EVENT).sum())
             if self.locals["dones"][0]:
                 self.episodes += 1
                 self.window_episodes += 1
                 self.wins += bool(self.locals["infos"][0].get("is_success"))
             if self.num_timesteps % every == 0:
                 greedy_events = []
-                success, ret = evaluate(agent, env_id, 10, 10**6, METHODS[method].product, env_kwargs,
-                                        on_step=lambda i, r, info: greedy_events.append(r > -0.05))
+                success, ret = evaluate(agent, env_id, EVAL_EPISODES, 10**6, METHODS[method].product, env_kwargs,
+                                        on_step=lambda i, r, info: greedy_events.append(r > EVENT))
                 row = {"method": method, "step": self.num_timesteps, "eval_success": success,
-                       "eval_return": round(ret, 1), "eval_events": sum(greedy_events) / 10,
+                       "eval_return": round(ret, 1), "eval_events": sum(greedy_events) / EVAL_EPISODES,
                        "train_episodes": self.episodes, "train_wins": self.wins,
                        "events_per_episode": round(self.window_events / max(self.window_episodes, 1), 2),
                        "seconds": round(time.perf_counter() - start)}

@@ -14,9 +14,9 @@ persistent noise that holds one N(0, sigma) draw and redraws it with probability
 
 Then it trains each method (one process each, one torch thread) with the persistent noise,
 the quick suite's network ([256, 256]) and ``--hyper`` (``make_agent`` keywords, e.g.
-``{"learning_rate": 1e-3}``), and prints every 10,000 steps the greedy success and return
-over 10 fresh episodes and the rewarded events per training episode since the last line:
-whether the student learns to reach items at all. ``--env`` (``gymnasium.make`` keywords,
+``{"learning_rate": 1e-3}``), and prints every 10,000 steps the greedy success, return and
+rewarded events per episode over 10 fresh episodes and the rewarded events per training
+episode since the last line: whether the student learns to reach items at all. ``--env`` (``gymnasium.make`` keywords,
 e.g. ``{"frame_skip": 5, "max_episode_steps": 400}``) changes the students' world, not the
 noise rollouts. TABLE is a teacher's ``table.npz``.
 """

@@ -36,8 +36,9 @@ class PersistentActionNoise(ActionNoise):
 def train_with_reports(method: str, table: str | None, *, task: str, seed: int, steps: int, every: int,
                        env_kwargs: dict | None = None, **agent_kwargs) -> list[dict]:
     """Train ``method`` on ``CraftSuite/<task>-Cont-v0`` (one torch thread) and, every
-    ``every`` steps, print and keep a row: greedy success, return and rewarded events (an
-    item or the completion) per episode over 10 fresh episodes, training episodes and wins
+    ``every`` steps, print and keep a row: greedy success, return, rewarded events (an
+    item or the completion) and automaton transitions that change its state (the task's
+    progress) per episode over 10 fresh episodes, training episodes and wins
     so far, and rewarded events per training episode since the row before.
     ``agent_kwargs`` go to ``make_agent``."""
     import torch
@@ -65,11 +66,18 @@ def train_with_reports(method: str, table: str | None, *, task: str, seed: int, 
                 self.window_episodes += 1
                 self.wins += bool(self.locals["infos"][0].get("is_success"))
             if self.num_timesteps % every == 0:
-                greedy_events = []
+                greedy_events, greedy_edges = [], []
+
+                def count(i, r, info):
+                    greedy_events.append(r > EVENT)
+                    edge = info["automaton_transition"]
+                    greedy_edges.append(edge is not None and edge[0] != edge[2])
+
                 success, ret = evaluate(agent, env_id, EVAL_EPISODES, 10**6, METHODS[method].product, env_kwargs,
-                                        on_step=lambda i, r, info: greedy_events.append(r > EVENT))
+                                        on_step=count)
                 row = {"method": method, "step": self.num_timesteps, "eval_success": success,
                        "eval_return": round(ret, 1), "eval_events": sum(greedy_events) / EVAL_EPISODES,
+                       "eval_edges": sum(greedy_edges) / EVAL_EPISODES,
                        "train_episodes": self.episodes, "train_wins": self.wins,
                        "events_per_episode": round(self.window_events / max(self.window_episodes, 1), 2),
                        "seconds": round(time.perf_counter() - start)}

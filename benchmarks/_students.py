@@ -70,8 +70,8 @@ def train_with_reports(method: str, table: str | None, *, task: str, seed: int, 
 
                 def count(i, r, info):
                     greedy_events.append(r > EVENT)
-                    edge = info["automaton_transition"]
-                    greedy_edges.append(edge is not None and edge[0] != edge[2])
+                    w, _, w2 = info["automaton_transition"]  # every step's info has one (only reset's is None)
+                    greedy_edges.append(w != w2)
 
                 success, ret = evaluate(agent, env_id, EVAL_EPISODES, 10**6, METHODS[method].product, env_kwargs,
                                         on_step=count)

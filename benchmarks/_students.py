@@ -1,36 +1,14 @@
 """What the TD3 benchmark scripts (td3_horizon.py, td3_exploration.py, td3_reach.py) share:
-a student trained in-process with a report every few thousand steps, and the persistent
-exploration noise."""
+a student trained in-process with a report every few thousand steps."""
 
 from __future__ import annotations
 
 import json
 import time
 
-import numpy as np
-from stable_baselines3.common.noise import ActionNoise
 
 EVAL_EPISODES = 10
 EVENT = -0.05  # a reward above this is an item or the completion, not the step or wall cost
-
-
-class PersistentActionNoise(ActionNoise):
-    """One N(0, sigma) draw held across steps, redrawn with probability ``resample`` per
-    step and at every reset: straight runs of about 1 / resample steps, where white noise
-    jitters the point mass in place (its 0.2 s time constant averages it out)."""
-
-    def __init__(self, sigma: float, resample: float, dim: int = 2, seed: int = 0):
-        self.sigma, self.resample, self.dim = sigma, resample, dim
-        self.rng = np.random.default_rng(seed)
-        self.reset()
-
-    def reset(self) -> None:
-        self.eps = self.rng.normal(0.0, self.sigma, self.dim)
-
-    def __call__(self) -> np.ndarray:
-        if self.rng.random() < self.resample:
-            self.eps = self.rng.normal(0.0, self.sigma, self.dim)
-        return self.eps
 
 
 def train_with_reports(method: str, table: str | None, *, task: str, seed: int, steps: int, every: int,

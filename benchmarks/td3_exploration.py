@@ -29,7 +29,9 @@ import json
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
-from _students import PersistentActionNoise, train_with_reports  # benchmarks/ is on sys.path as a script
+from _students import train_with_reports  # benchmarks/ is on sys.path as a script
+
+from craftsuite.agents.noise import PersistentActionNoise
 
 
 def noise_processes(sigma: float, resample: float) -> dict:
@@ -69,7 +71,7 @@ def coverage(task: str, make_noise, episodes: int = 20) -> dict:
 def train(method: str, args) -> list[dict]:
     return train_with_reports(method, args.table, task=args.task, seed=args.seed, steps=args.steps, every=10_000,
                               env_kwargs=args.env or None,
-                              action_noise=PersistentActionNoise(args.sigma, args.resample, seed=args.seed),
+                              action_noise={"type": "persistent", "sigma": args.sigma, "resample": args.resample},
                               **{"policy_kwargs": {"net_arch": [256, 256]}, **args.hyper})
 
 

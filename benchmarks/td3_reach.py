@@ -34,7 +34,7 @@ from concurrent.futures import ProcessPoolExecutor
 from itertools import product
 
 import numpy as np
-from _students import PersistentActionNoise, train_with_reports  # benchmarks/ is on sys.path as a script
+from _students import train_with_reports  # benchmarks/ is on sys.path as a script
 
 # The task as data, as tasks/*.toml would hold it, in four scenes: "three" and "craftsman"
 # keep the objective ``F wood`` and add what a Blind Craftsman student sees besides (more woods
@@ -79,7 +79,7 @@ def run(setting: tuple[str, int, str, int], steps: int, resample: float, hyper: 
     task = register_reach(scene)  # here, in the worker that makes the envs (whatever the start method)
     kwargs = {"policy_kwargs": {"net_arch": [256, 256]}, **hyper}
     if noise == "persistent":
-        kwargs["action_noise"] = PersistentActionNoise(0.6, resample, seed=seed)
+        kwargs["action_noise"] = {"type": "persistent", "sigma": 0.6, "resample": resample}
     return train_with_reports("td3", None, task=task, seed=seed, steps=steps, every=5_000,
                               env_kwargs=HORIZONS[skip][1] or None, **kwargs)
 

@@ -25,6 +25,7 @@ from stable_baselines3.common.env_util import make_vec_env
 import craftsuite  # noqa: F401
 from craftsuite.agents import static_distillation
 from craftsuite.agents.methods import DQN_DEFAULTS, TD3_DEFAULTS, make_agent
+from craftsuite.agents.noise import make_action_noise
 
 GRID, CONT = "CraftSuite/BlindCraftsman-Grid10-v0", "CraftSuite/BlindCraftsman-Cont-v0"
 
@@ -33,6 +34,13 @@ def rate(agent, steps) -> float:
     t = time.perf_counter()
     agent.learn(steps)
     return steps / (time.perf_counter() - t)
+
+
+def plain(defaults: dict) -> dict:
+    """The package's defaults as plain SB3 takes them (TD3's noise is a spec there)."""
+    if isinstance(defaults.get("action_noise"), dict):
+        return {**defaults, "action_noise": make_action_noise(defaults["action_noise"], 2)}
+    return defaults
 
 
 def main():
@@ -55,7 +63,7 @@ def main():
         same = dict(prioritized=False) | (dict(dueling=False, double=False) if name == "DQN" else {})
         builders = [
             lambda: plain_cls("MlpPolicy", make_vec_env(world, n_envs=1, seed=0, env_kwargs={"product": True}),
-                              seed=0, **defaults),
+                              seed=0, **plain(defaults)),
             lambda: make_agent(distilled, world, seed=0, table=table, **same),
             lambda: make_agent(product, world, seed=0),
             lambda: make_agent(distilled, world, seed=0, table=table),

@@ -99,13 +99,14 @@ def _video(args) -> int:
     from . import registration  # noqa: F401  (registers the ids)
     from .rollouts import record_video
 
-    rec = record_video(args.env_id, args.policy, args.episodes, args.out, args.seed, args.fps, args.product)
+    rec = record_video(args.env_id, args.policy, args.episodes, args.out, args.seed, args.fps, args.product,
+                       env_kwargs=_json_object(args.env, "--env"))
     print(f"wrote {rec.path}: {rec.frames} frames at {rec.fps} fps ({rec.codec}); "
           f"{rec.successes}/{rec.episodes} episodes completed the objective")
     return 0
 
 
-def _hyper(text: str | None) -> dict:
+def _json_object(text: str | None, flag: str = "--hyper") -> dict:
     import json
 
     if not text:
@@ -113,9 +114,9 @@ def _hyper(text: str | None) -> dict:
     try:
         value = json.loads(text)
     except json.JSONDecodeError as err:
-        raise ValueError(f"--hyper is not JSON ({err}): {text!r}") from None
+        raise ValueError(f"{flag} is not JSON ({err}): {text!r}") from None
     if not isinstance(value, dict):
-        raise ValueError(f"--hyper must be a JSON object, e.g. '{{\"learning_rate\": 1e-4}}', not {text!r}")
+        raise ValueError(f"{flag} must be a JSON object, e.g. '{{\"learning_rate\": 1e-4}}', not {text!r}")
     return value
 
 
@@ -125,7 +126,7 @@ def _teacher(args) -> int:
     config = TeacherConfig(task=args.task, size=args.size, layout_seed=None if args.layout_seed < 0 else args.layout_seed,
                            seed=args.seed, max_steps=args.max_steps, target_success=args.target_success,
                            eval_every=args.eval_every, eval_episodes=args.eval_episodes,
-                           hyperparameters=_hyper(args.hyper))
+                           hyperparameters=_json_object(args.hyper))
     path = train_teacher(config, args.out)
     print((path / "result.json").read_text().strip())
     print(f"teacher run: {path}\n  teacher: {path / 'teacher.zip'}\n  dynamic table: {path / 'table.npz'}")
@@ -190,7 +191,8 @@ def _student(args) -> int:
 
     config = StudentConfig(task=args.task, method=args.method, world=args.world, seed=args.seed, steps=args.steps,
                            table=str(Path(args.table).resolve()) if args.table else None, eval_every=args.eval_every, eval_episodes=args.eval_episodes,
-                           hyperparameters=_hyper(args.hyper), layout_seed=args.layout_seed)
+                           hyperparameters=_json_object(args.hyper), layout_seed=args.layout_seed,
+                           world_kwargs=_json_object(args.env, "--env"))
     if args.method.endswith("dynamic") and not args.table:
         raise ValueError(f"method {args.method!r} needs --table (a teacher's table.npz: craftsuite teacher)")
     path = train_student(config, args.out)
@@ -303,7 +305,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--steps", type=_positive, default=20_000)
     p.add_argument("--eval-every", type=_positive, default=2_000)
     p.add_argument("--eval-episodes", type=_positive, default=10)
-    p.add_argument("--hyper", help="JSON overrides of the algorithm's settings")
+    p.add_argument("--hyper", help="JSON overrides of the algorithm's settings, e.g. "
+                   "'{\"action_noise\": {\"type\": \"persistent\", \"sigma\": 0.6, \"resample\": 0.1}}'")
+    p.add_argument("--env", help="JSON gymnasium.make keywords of the world, e.g. "
+                   "'{\"frame_skip\": 10, \"max_episode_steps\": 200}'")
     p.add_argument("--layout-seed", type=int, help="grid worlds: one fixed instance (default: a new one per episode)")
     p.set_defaults(run=_student)
 
@@ -338,6 +343,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--fps", type=float, help="frames per second (default: the env's render_fps)")
     p.add_argument("--product", action="store_true",
                    help="make the env with product=True (for checkpoints trained on the product MDP)")
+    p.add_argument("--env", help="JSON gymnasium.make keywords, e.g. '{\"frame_skip\": 10}' "
+                   "(the world the checkpoint was trained in)")
     p.set_defaults(run=_video)
     return parser
 

@@ -23,9 +23,10 @@ class Recording:
 
 def record_video(env_id: str, policy: str = "scripted", episodes: int = 1, out: str = "rollout.mp4",
                  seed: int = 0, fps: float | None = None, product: bool = False,
-                 progress: bool = True) -> Recording:
-    """Roll out ``policy`` (see ``load_policy``) for ``episodes`` and write every frame to ``out``."""
-    env = gym.make(env_id, render_mode="rgb_array", product=product)
+                 progress: bool = True, env_kwargs: dict | None = None) -> Recording:
+    """Roll out ``policy`` (see ``load_policy``) for ``episodes`` and write every frame to
+    ``out``. ``env_kwargs`` go to ``gymnasium.make`` (the world a student was trained in)."""
+    env = gym.make(env_id, render_mode="rgb_array", product=product, **(env_kwargs or {}))
     try:
         act = load_policy(policy, env, seed=seed)
         fps = fps or env.metadata.get("render_fps", 20)

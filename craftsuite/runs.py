@@ -49,9 +49,22 @@ def atomic_write(path: Path, text: str) -> None:
         tmp.unlink(missing_ok=True)
 
 
+def config_dict(config) -> dict:
+    """A config dataclass as saved and hashed. A field added after runs existed carries
+    ``metadata={"omit_if_default": True}``: at its default it is left out, so the runs made
+    before it keep their directories."""
+    out = dataclasses.asdict(config)
+    for f in dataclasses.fields(config):
+        if f.metadata.get("omit_if_default"):
+            default = f.default_factory() if f.default_factory is not dataclasses.MISSING else f.default
+            if out[f.name] == default:
+                del out[f.name]
+    return out
+
+
 def config_key(config) -> str:
     """A short stable hash of a config dataclass: equal configs share a run directory."""
-    text = json.dumps(dataclasses.asdict(config), sort_keys=True)
+    text = json.dumps(config_dict(config), sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:10]
 
 
@@ -68,7 +81,7 @@ class RunDir:
         self.path.mkdir(parents=True, exist_ok=True)
         self._acquire()
         saved = self.path / "config.json"
-        mine = json.dumps(dataclasses.asdict(self.config), indent=2, sort_keys=True)
+        mine = json.dumps(config_dict(self.config), indent=2, sort_keys=True)
         if saved.exists() and json.loads(saved.read_text()) != json.loads(mine):
             self._release()
             raise RunError(f"{self.path} holds a run with another configuration ({saved}); "

@@ -48,6 +48,8 @@ class Suite:
     # grid students learn one fixed instance, generated independently of the teacher's (layout 0),
     # as the paper's did; None gives them a new layout every episode
     grid_layout_seed: int | None = 1
+    # gymnasium.make keywords of the MuJoCo students' world, e.g. {"frame_skip": 10, "max_episode_steps": 200}
+    cont_world_kwargs: dict = field(default_factory=dict)
 
     def student_configs(self, tables: dict[str, str]) -> list[StudentConfig]:
         unknown = [m for m in self.methods if m not in GRID_METHODS + CONT_METHODS]
@@ -65,7 +67,8 @@ class Suite:
                             eval_every=self.eval_every, eval_episodes=self.eval_episodes,
                             hyperparameters=dict(self.td3_hyperparameters if world == "Cont"
                                                  else self.dqn_hyperparameters),
-                            layout_seed=self.grid_layout_seed if world.startswith("Grid") else None))
+                            layout_seed=self.grid_layout_seed if world.startswith("Grid") else None,
+                            world_kwargs=dict(self.cont_world_kwargs) if world == "Cont" else {}))
         if not out:
             raise ValueError(f"no method of {list(self.methods)} runs in the worlds {list(self.worlds)} "
                              f"(grid: {list(GRID_METHODS)}; Cont: {list(CONT_METHODS)})")
@@ -236,5 +239,5 @@ def _best_student_video(students_root: Path, out: Path) -> Path | None:
     _, _, run, r = max(runs, key=lambda x: (x[0], x[1]))
     name = f"best-{r['env_id'].split('/')[1]}-{r['method']}-s{r['seed']}.mp4"
     rec = record_video(r["env_id"], str(run / r["model"]), 1, str(out / name), seed=10**8,
-                       product=r["product"], progress=False)
+                       product=r["product"], progress=False, env_kwargs=r.get("env_kwargs"))
     return Path(rec.path)

@@ -59,11 +59,18 @@ class StudentConfig:
     eval_episodes: int = 10
     hyperparameters: dict = field(default_factory=dict)
     layout_seed: int | None = None  # grid worlds: one fixed instance (None: a new one per episode)
+    # more gymnasium.make keywords for the student's world, e.g. {"frame_skip": 10, "max_episode_steps": 200}
+    world_kwargs: dict = field(default_factory=dict, metadata={"omit_if_default": True})
 
     def __post_init__(self):
-        if self.env_kwargs and not self.world.startswith("Grid"):  # env_kwargs also checks the seed
+        if layout_kwargs(self.layout_seed) and not self.world.startswith("Grid"):  # also checks the seed
             raise ValueError(f"layout_seed fixes a grid instance; the {self.world} world has none "
                              "(its objects are placed anew every episode)")
+        if not isinstance(self.world_kwargs, dict):
+            raise ValueError(f"world_kwargs must be a dict of gymnasium.make keywords, got {self.world_kwargs!r}")
+        owned = sorted({"product", "layout_seed"} & set(self.world_kwargs))
+        if owned:
+            raise ValueError(f"world_kwargs may not set {owned}: the method sets product, layout_seed its own field")
 
     @property
     def env_id(self) -> str:
@@ -71,7 +78,7 @@ class StudentConfig:
 
     @property
     def env_kwargs(self) -> dict:
-        return layout_kwargs(self.layout_seed)
+        return {**layout_kwargs(self.layout_seed), **self.world_kwargs}
 
     def run_name(self) -> str:
         return f"student-{self.task}-{self.world}-{self.method}-s{self.seed}-{config_key(self)}"
@@ -272,7 +279,7 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
         agent.save(run.path / "model.zip")
         run.write_result({"kind": "student", "env_id": config.env_id, "method": config.method,
                           "task": config.task, "seed": config.seed, "steps": int(agent.num_timesteps),
-                          "product": method.product, "model": "model.zip",
+                          "product": method.product, "env_kwargs": config.env_kwargs, "model": "model.zip",
                           "seconds_this_session": round(time.perf_counter() - start, 1)})
         return run.path
 

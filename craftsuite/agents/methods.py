@@ -18,6 +18,7 @@ from stable_baselines3.common.env_util import make_vec_env
 from .crm import CRMReplayBuffer
 from .distillation import AutomatonQTable, DistilledTarget, dynamic_distillation, static_distillation
 from .dqn import AutomatonDQN
+from .noise import make_action_noise
 from .td3 import AutomatonTD3
 
 
@@ -54,6 +55,7 @@ DQN_DEFAULTS = dict(learning_rate=5e-4, buffer_size=150_000, batch_size=64, lear
                     policy_kwargs=dict(net_arch=[64, 64]))
 TD3_DEFAULTS = dict(learning_rate=1e-4, buffer_size=1_000_000, batch_size=64, learning_starts=1_000,
                     gamma=0.99, tau=0.005, target_policy_noise=0.2, target_noise_clip=0.5,
+                    action_noise={"type": "normal", "sigma": 0.3},  # a spec (agents/noise.py)
                     policy_kwargs=dict(net_arch=[400, 300]))
 
 
@@ -64,7 +66,8 @@ def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None
 
     ``env_kwargs`` go to ``gymnasium.make`` (e.g. ``{"layout_seed": 0}`` for a fixed grid
     instance); ``rho`` and ``self_loops`` to the distilled target (``DistilledTarget``);
-    ``overrides`` to the algorithm."""
+    ``overrides`` to the algorithm (TD3's ``action_noise`` may be a spec such as
+    ``{"type": "persistent", "sigma": 0.6, "resample": 0.1}``: ``agents/noise.py``)."""
     if method not in METHODS:
         raise KeyError(f"unknown method {method!r}; methods: {sorted(METHODS)}")
     m = METHODS[method]
@@ -77,10 +80,8 @@ def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None
     automaton = base.automaton
     kwargs = dict(TD3_DEFAULTS if continuous else DQN_DEFAULTS)
     kwargs.update(overrides)
-    if m.algorithm is AutomatonTD3:
-        from stable_baselines3.common.noise import NormalActionNoise
-        n = env.action_space.shape[0]
-        kwargs.setdefault("action_noise", NormalActionNoise(np.zeros(n), 0.3 * np.ones(n)))
+    if isinstance(kwargs.get("action_noise"), dict):
+        kwargs["action_noise"] = make_action_noise(kwargs["action_noise"], env.action_space.shape[0], seed)
     if m.crm:
         kwargs["replay_buffer_class"] = CRMReplayBuffer
         kwargs["replay_buffer_kwargs"] = {"automaton": automaton, "completion_reward": base.task.completion_reward,

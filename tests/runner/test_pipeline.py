@@ -52,6 +52,8 @@ def test_cli_errors_name_the_problem(tmp_path, capsys):
     assert "needs --table" in capsys.readouterr().err
     assert main(["student", "BlindCraftsman", "--method", "td3", "--hyper", "{oops", "--out", str(tmp_path)]) == 2
     assert "--hyper is not JSON" in capsys.readouterr().err
+    assert main(["student", "BlindCraftsman", "--method", "td3", "--env", "[10]", "--out", str(tmp_path)]) == 2
+    assert "--env must be a JSON object" in capsys.readouterr().err
     assert main(["transfer", "--suite", "huge", "--out", str(tmp_path)]) == 2
     assert "unknown suite 'huge'" in capsys.readouterr().err
     assert main(["leaderboard", str(tmp_path / "nothing")]) == 2
@@ -86,6 +88,11 @@ def test_suites_are_well_formed():
     # grid students learn one instance of their own, as the paper's did; MuJoCo layouts vary
     assert {c.layout_seed for c in paper if c.world == "Grid10"} == {SUITES["paper"].grid_layout_seed} != {0}
     assert {c.layout_seed for c in paper if c.world == "Cont"} == {None}
+    # the MuJoCo world's settings reach the MuJoCo students only
+    skipped = dataclasses.replace(SUITES["quick"], worlds=("Cont", "Grid10"), methods=("td3", "dqn"),
+                                  cont_world_kwargs={"frame_skip": 10})
+    assert {c.world: c.env_kwargs for c in skipped.student_configs({})} == \
+        {"Cont": {"frame_skip": 10}, "Grid10": {"layout_seed": 1}}
 
 
 def test_students_on_a_local_ray_instance(tmp_path):

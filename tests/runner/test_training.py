@@ -1,5 +1,6 @@
 """Teacher and student runs: reuse, resume after a kill, evaluation logs."""
 
+import dataclasses
 import json
 import signal
 import subprocess
@@ -127,3 +128,42 @@ def test_a_killed_run_resumes_from_its_checkpoint(tmp_path):
     assert [k for k in kept if int(k[0]) <= checkpoint_step] == \
         [(r["step"], r["return"]) for r in episodes if int(r["step"]) <= checkpoint_step]
     assert json.loads((run / "result.json").read_text())["steps"] == 3_000
+
+
+def test_a_student_trains_and_is_evaluated_in_the_world_its_config_names(tmp_path, monkeypatch):
+    import craftsuite.training as training
+
+    seen = []
+    real_evaluate = training.evaluate
+
+    def evaluate(*args, env_kwargs=None, **kwargs):
+        seen.append(env_kwargs)
+        return real_evaluate(*args, env_kwargs=env_kwargs, **kwargs)
+
+    monkeypatch.setattr(training, "evaluate", evaluate)
+    world = {"frame_skip": 10, "max_episode_steps": 40}
+    config = StudentConfig(method="td3", steps=200, eval_every=200, eval_episodes=1, world_kwargs=world,
+                           hyperparameters={"learning_starts": 100, "policy_kwargs": {"net_arch": [16]},
+                                            "action_noise": {"type": "persistent", "sigma": 0.6, "resample": 0.1}})
+    path = train_student(config, tmp_path, progress=False)
+    assert {int(e["length"]) for e in read_csv(path / "episodes.csv")} == {40}  # 200 steps: 5 truncated episodes
+    assert seen == [world]
+    assert json.loads((path / "result.json").read_text())["env_kwargs"] == world  # for its video
+    with pytest.raises(ValueError, match=r"may not set \['product'\]"):
+        StudentConfig(world_kwargs={"product": False})
+
+
+def test_runs_made_before_world_kwargs_existed_keep_their_directories(tmp_path):
+    import hashlib
+
+    plain, skipped = StudentConfig(), StudentConfig(world_kwargs={"frame_skip": 10})
+    assert plain.run_name() != skipped.run_name()
+    saved = {k: v for k, v in dataclasses.asdict(plain).items() if k != "world_kwargs"}
+    before = hashlib.sha256(json.dumps(saved, sort_keys=True).encode()).hexdigest()[:10]  # the old key
+    assert plain.run_name().endswith(before)
+    old = tmp_path / plain.run_name()  # as an older version wrote it: no world_kwargs field
+    old.mkdir()
+    (old / "config.json").write_text(json.dumps(saved))
+    with RunDir(old, plain):  # the same configuration: taken, not refused
+        pass
+    assert StudentConfig(**json.loads((old / "config.json").read_text())) == plain

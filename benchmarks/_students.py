@@ -15,9 +15,9 @@ def train_with_reports(method: str, table: str | None, *, task: str, seed: int, 
                        env_kwargs: dict | None = None, **agent_kwargs) -> list[dict]:
     """Train ``method`` on ``CraftSuite/<task>-Cont-v0`` (one torch thread) and, every
     ``every`` steps, print and keep a row: greedy success, return, rewarded events (an
-    item or the completion) and automaton transitions that change its state (the task's
-    progress) per episode over 10 fresh episodes, training episodes and wins
-    so far, and rewarded events per training episode since the row before.
+    item or the completion), automaton transitions that change its state (the task's
+    progress) and violations per episode over 10 fresh episodes, training episodes, wins
+    and violations so far, and rewarded events per training episode since the row before.
     ``agent_kwargs`` go to ``make_agent``."""
     import torch
 
@@ -35,7 +35,7 @@ def train_with_reports(method: str, table: str | None, *, task: str, seed: int, 
     rows, start = [], time.perf_counter()
 
     class Report(BaseCallback):
-        episodes = wins = window_episodes = window_events = 0
+        episodes = wins = violations = window_episodes = window_events = 0
 
         def _on_step(self) -> bool:
             self.window_events += int((self.locals["rewards"] > EVENT).sum())
@@ -43,20 +43,23 @@ def train_with_reports(method: str, table: str | None, *, task: str, seed: int, 
                 self.episodes += 1
                 self.window_episodes += 1
                 self.wins += bool(self.locals["infos"][0].get("is_success"))
+                self.violations += bool(self.locals["infos"][0].get("violation"))
             if self.num_timesteps % every == 0:
-                greedy_events, greedy_edges = [], []
+                greedy_events, greedy_edges, greedy_violations = [], [], []
 
                 def count(i, r, info):
                     greedy_events.append(r > EVENT)
                     w, _, w2 = info["automaton_transition"]  # every step's info has one (only reset's is None)
                     greedy_edges.append(w != w2)
+                    greedy_violations.append(info["violation"])
 
                 success, ret = evaluate(agent, env_id, EVAL_EPISODES, 10**6, METHODS[method].product, env_kwargs,
                                         on_step=count)
                 row = {"method": method, "step": self.num_timesteps, "eval_success": success,
                        "eval_return": round(ret, 1), "eval_events": sum(greedy_events) / EVAL_EPISODES,
                        "eval_edges": sum(greedy_edges) / EVAL_EPISODES,
-                       "train_episodes": self.episodes, "train_wins": self.wins,
+                       "eval_violations": sum(greedy_violations) / EVAL_EPISODES,
+                       "train_episodes": self.episodes, "train_wins": self.wins, "train_violations": self.violations,
                        "events_per_episode": round(self.window_events / max(self.window_episodes, 1), 2),
                        "seconds": round(time.perf_counter() - start)}
                 print(json.dumps(row), flush=True)

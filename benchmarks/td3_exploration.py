@@ -14,10 +14,11 @@ persistent noise that holds one N(0, sigma) draw and redraws it with probability
 
 Then it trains each method (one process each, one torch thread) with the persistent noise,
 the quick suite's network ([256, 256]) and ``--hyper`` (``make_agent`` keywords, e.g.
-``{"learning_rate": 1e-3}``), and prints every 10,000 steps the greedy success, return and
-rewarded events and automaton steps (transitions that change its state: the task's
-progress) per episode over 10 fresh episodes and the rewarded events per training
-episode since the last line: whether the student learns to reach items at all. ``--env`` (``gymnasium.make`` keywords,
+``{"learning_rate": 1e-3}``), and prints every 10,000 steps, over 10 fresh greedy episodes,
+the success, return, rewarded events and automaton steps (transitions that change its
+state: the task's progress) per episode and the violations (the objective broken, which
+ends the episode); then the training episodes won and violated so far and the rewarded
+events per training episode since the last line. ``--env`` (``gymnasium.make`` keywords,
 e.g. ``{"frame_skip": 5, "max_episode_steps": 400}``) changes the students' world, not the
 noise rollouts. TABLE is a teacher's ``table.npz``.
 """
@@ -98,12 +99,13 @@ def main():
     print(f"\n{args.task}, seed {args.seed}, persistent noise N(0, {args.sigma}) redrawn w.p. "
           f"{args.resample}, hyper {json.dumps(args.hyper)}, env {json.dumps(args.env)}")
     print("| method | step | greedy success | greedy return | events / greedy episode | automaton steps / greedy episode "
-          "| training wins | events / training episode |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| violations / 10 greedy episodes | training wins | training violations | events / training episode |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for rows in results:
         for r in rows:
             print(f"| {r['method']} | {r['step']:,} | {r['eval_success']:.2f} | {r['eval_return']} "
-                  f"| {r['eval_events']:.1f} | {r['eval_edges']:.1f} | {r['train_wins']} | {r['events_per_episode']} |")
+                  f"| {r['eval_events']:.1f} | {r['eval_edges']:.1f} | {r['eval_violations'] * 10:.0f} | {r['train_wins']} "
+                  f"| {r['train_violations']} | {r['events_per_episode']} |")
 
 
 if __name__ == "__main__":

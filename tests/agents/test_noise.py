@@ -46,7 +46,9 @@ def test_bad_specs_name_the_problem(spec, message):
 
 
 def test_make_agent_takes_a_spec_and_keeps_the_white_default():
-    assert isinstance(make_agent("td3", CONT).action_noise, NormalActionNoise)
-    agent = make_agent("td3", CONT, seed=3, action_noise={"type": "persistent", "sigma": 0.6, "resample": 0.1})
+    small = dict(buffer_size=1_000, policy_kwargs={"net_arch": [16]})
+    assert isinstance(make_agent("td3", CONT, **small).action_noise, NormalActionNoise)
+    agent = make_agent("td3", CONT, seed=3, action_noise={"type": "persistent", "sigma": 0.6, "resample": 0.1},
+                       **small)
     assert isinstance(agent.action_noise, PersistentActionNoise) and agent.action_noise.resample == 0.1
     agent.learn(20)  # the noise drives SB3's collection

@@ -30,7 +30,7 @@ import json
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
-from _students import train_with_reports  # benchmarks/ is on sys.path as a script
+from _students import EVAL_EPISODES, train_with_reports  # benchmarks/ is on sys.path as a script
 
 from craftsuite.agents.noise import PersistentActionNoise
 
@@ -99,12 +99,12 @@ def main():
     print(f"\n{args.task}, seed {args.seed}, persistent noise N(0, {args.sigma}) redrawn w.p. "
           f"{args.resample}, hyper {json.dumps(args.hyper)}, env {json.dumps(args.env)}")
     print("| method | step | greedy success | greedy return | events / greedy episode | automaton steps / greedy episode "
-          "| violations / 10 greedy episodes | training wins | training violations | events / training episode |")
+          f"| violations / {EVAL_EPISODES} greedy episodes | training wins | training violations | events / training episode |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     for rows in results:
         for r in rows:
             print(f"| {r['method']} | {r['step']:,} | {r['eval_success']:.2f} | {r['eval_return']} "
-                  f"| {r['eval_events']:.1f} | {r['eval_edges']:.1f} | {r['eval_violations'] * 10:.0f} | {r['train_wins']} "
+                  f"| {r['eval_events']:.1f} | {r['eval_edges']:.1f} | {r['eval_violations'] * EVAL_EPISODES:.0f} | {r['train_wins']} "
                   f"| {r['train_violations']} | {r['events_per_episode']} |")
 
 

@@ -53,10 +53,13 @@ def make_action_noise(spec: dict, dim: int, seed: int = 0) -> ActionNoise:
     if missing or unknown:
         raise ValueError(f"action_noise {kind!r} takes {list(NOISES[kind])}; "
                          f"missing {missing}, unknown {unknown}: {spec!r}")
+    try:
+        params = {k: float(v) for k, v in params.items()}
+    except (TypeError, ValueError):
+        raise ValueError(f"action_noise {kind!r} takes numbers: {spec!r}") from None
+    if not params["sigma"] >= 0:
+        raise ValueError(f"sigma must be >= 0, got {params['sigma']!r}")
     if kind == "persistent":
-        return PersistentActionNoise(float(params["sigma"]), float(params["resample"]), dim, seed)
-    sigma = float(params["sigma"])
-    if not sigma >= 0:
-        raise ValueError(f"sigma must be >= 0, got {sigma!r}")
+        return PersistentActionNoise(params["sigma"], params["resample"], dim, seed)
     noise = NormalActionNoise if kind == "normal" else OrnsteinUhlenbeckActionNoise
-    return noise(np.zeros(dim), sigma * np.ones(dim))
+    return noise(np.zeros(dim), params["sigma"] * np.ones(dim))

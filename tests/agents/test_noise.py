@@ -39,6 +39,7 @@ def test_specs_build_their_noise(spec, kind):
     ({"type": "normal", "sigma": 0.3, "theta": 0.1}, r"unknown \['theta'\]"),
     ({"type": "persistent", "sigma": 0.6, "resample": 0}, "resample is a probability"),
     ({"type": "normal", "sigma": float("nan")}, "sigma must be >= 0"),
+    ({"type": "normal", "sigma": "big"}, "takes numbers"),
 ])
 def test_bad_specs_name_the_problem(spec, message):
     with pytest.raises(ValueError, match=message):

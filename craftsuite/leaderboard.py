@@ -10,7 +10,9 @@ Per run (``run_metrics``):
 * ``steps_to_80``: env steps at the first evaluation with success >= 0.8 (None: never).
 
 Per task, world and method (``build``): the mean over seeds with a 95% bootstrap
-confidence interval (percentile, 2,000 resamples of the seeds). A run that never reached
+confidence interval (percentile, 2,000 resamples of the seeds). The world is its kind and
+its settings (``world_label``): runs in a fixed grid instance or at another frame skip
+are another benchmark, so they get a row and a plot of their own. A run that never reached
 80% counts as its budget, and the entry reads ">= ...": a lower bound.
 """
 
@@ -19,6 +21,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -35,6 +38,22 @@ PAPER_REFERENCE = {
     "DungeonQuest": {"td3-dynamic": 90.45, "td3": 87.97},
     "DiamondMine": {"td3-dynamic": 29.59, "td3": 8.58},
 }
+
+
+def world_label(config: dict) -> str:
+    """A student's world as a leaderboard shows it: ``Cont``, ``Grid10``, or with the
+    settings that change it, e.g. ``Cont: frame_skip=10, max_episode_steps=200``."""
+    settings = dict(config.get("world_kwargs") or {})  # absent from configs older than the field
+    if config.get("layout_seed") is not None:
+        settings = {"layout_seed": config["layout_seed"], **settings}
+    if not settings:
+        return config["world"]
+    return f"{config['world']}: " + ", ".join(f"{k}={json.dumps(v)}" for k, v in sorted(settings.items()))
+
+
+def _file_part(label: str) -> str:
+    """``label`` as part of a file name: ``Cont: frame_skip=10`` -> ``Cont-frame_skip-10``."""
+    return re.sub(r"[^\w.]+", "-", label).strip("-")
 
 
 def run_metrics(run: Path) -> dict | None:
@@ -55,7 +74,7 @@ def run_metrics(run: Path) -> dict | None:
     success = [float(e["success"]) for e in evals]
     reached = next((int(e["step"]) for e in evals if float(e["success"]) >= 0.8), None)
     return {
-        "task": config["task"], "world": config["world"], "method": config["method"], "seed": config["seed"],
+        "task": config["task"], "world": world_label(config), "method": config["method"], "seed": config["seed"],
         "budget": budget, "steps": result["steps"],
         "success": success[-1] if success else float("nan"),
         "return": float(np.mean(tail)) if tail else float("nan"),
@@ -176,7 +195,7 @@ def plot_curves(students_root, out) -> list[Path]:
         config = json.loads((run / "config.json").read_text())
         episodes = read_csv(run / "episodes.csv")
         evals = read_csv(run / "evals.csv")
-        key = (config["task"], config["world"])
+        key = (config["task"], world_label(config))
         runs.setdefault(key, []).append((config, episodes, evals, int(config["steps"])))
     paths = []
     for (task, world), group in sorted(runs.items()):
@@ -204,7 +223,7 @@ def plot_curves(students_root, out) -> list[Path]:
         axes[1].set(title="greedy success (evaluation)", xlabel="env steps", ylabel="success rate", ylim=(-0.02, 1.02))
         axes[1].legend(loc="upper left", fontsize=8)
         fig.tight_layout()
-        path = Path(out) / f"curves-{task}-{world}.png"
+        path = Path(out) / f"curves-{task}-{_file_part(world)}.png"
         tmp = path.with_name(f".{path.name}.tmp.png")
         fig.savefig(tmp, dpi=110)
         tmp.replace(path)

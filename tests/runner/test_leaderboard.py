@@ -10,11 +10,11 @@ from craftsuite import leaderboard
 from craftsuite.runs import EPISODE_FIELDS, EVAL_FIELDS, write_csv
 
 
-def fake_run(root, method, seed, evals, episodes, budget=1_000, task="BlindCraftsman", world="Cont"):
-    run = root / f"student-{task}-{world}-{method}-s{seed}"
+def fake_run(root, method, seed, evals, episodes, budget=1_000, task="BlindCraftsman", world="Cont", **config):
+    run = root / f"student-{task}-{world}-{method}-s{seed}{''.join('-' + k for k in config)}"
     run.mkdir(parents=True)
     (run / "config.json").write_text(json.dumps({"task": task, "world": world, "method": method, "seed": seed,
-                                                 "steps": budget}))
+                                                 "steps": budget, **config}))
     (run / "result.json").write_text(json.dumps({"kind": "student", "steps": budget}))
     write_csv(run / "evals.csv", EVAL_FIELDS,
               [{"step": s, "success": v, "return": 0.0, "episodes": 10} for s, v in evals])
@@ -88,3 +88,19 @@ def test_markdown_csv_and_plot(runs, tmp_path):
     assert rows["td3"]["steps_to_80_censored"] == "1"
     [png] = leaderboard.plot_curves(runs, tmp_path)
     assert png.name == "curves-BlindCraftsman-Cont.png" and png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_runs_in_another_world_setting_get_their_own_row_and_plot(runs, tmp_path):
+    fake_run(runs, "td3", 0, [(1000, 1.0)], [(995, 50.0)], world_kwargs={"frame_skip": 10, "max_episode_steps": 200})
+    fake_run(runs, "dqn", 0, [(1000, 0.5)], [(995, 5.0)], world="Grid10", layout_seed=1)
+    entries = {(e.world, e.method): e for e in leaderboard.build(runs)}
+    assert entries[("Cont", "td3")].seeds == 2  # the registered world's runs are not mixed with the others
+    other = entries[("Cont: frame_skip=10, max_episode_steps=200", "td3")]
+    assert other.seeds == 1 and other.stats["success"][0] == 1.0
+    assert entries[("Grid10: layout_seed=1", "dqn")].stats["return"][0] == 5.0
+    md = leaderboard.to_markdown(list(entries.values()))
+    section = md.split("## BlindCraftsman (Cont: frame_skip=10")[1].split("##")[0]
+    assert "reference" not in section  # the authors' numbers are for the registered world only
+    names = {p.name for p in leaderboard.plot_curves(runs, tmp_path)}
+    assert names == {"curves-BlindCraftsman-Cont.png", "curves-BlindCraftsman-Cont-frame_skip-10-max_episode_steps-200.png",
+                     "curves-BlindCraftsman-Grid10-layout_seed-1.png"}

@@ -214,6 +214,10 @@ def _transfer(args) -> int:
                                  ("student_steps", args.steps), ("methods", tuple(args.methods) if args.methods else None),
                                  ("teacher_max_steps", args.teacher_steps), ("eval_every", args.eval_every))
                if v is not None}
+    if args.env is not None:
+        changes["cont_world_kwargs"] = _json_object(args.env, "--env")
+    if args.td3_hyper is not None:
+        changes["td3_hyperparameters"] = {**suite.td3_hyperparameters, **_json_object(args.td3_hyper, "--td3-hyper")}
     suite = dataclasses.replace(suite, **changes)
     print(f"suite {suite.name}: {suite.description}")
     result = transfer(suite, args.out, workers=args.workers, ray=args.ray, video=not args.no_video)
@@ -323,6 +327,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--steps", type=_positive, help="override the student budget (env steps)")
     p.add_argument("--teacher-steps", type=_positive, help="override the teacher's step limit")
     p.add_argument("--eval-every", type=_positive, help="override the evaluation interval")
+    p.add_argument("--env", help="JSON gymnasium.make keywords of the MuJoCo students' world (replaces the suite's), "
+                   "e.g. '{\"frame_skip\": 10, \"max_episode_steps\": 200}'")
+    p.add_argument("--td3-hyper", help="JSON overrides of the TD3 students' settings, merged over the suite's, e.g. "
+                   "'{\"action_noise\": {\"type\": \"persistent\", \"sigma\": 0.6, \"resample\": 0.1}}'")
     p.add_argument("--workers", type=_positive, help="parallel local processes (default: one per core)")
     p.add_argument("--ray", metavar="ADDRESS", help="run the students on Ray ('local' starts one here)")
     p.add_argument("--no-video", action="store_true", help="skip the rollout video of the best student")

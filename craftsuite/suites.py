@@ -196,7 +196,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     """The suite end to end: teachers, distillation, students, leaderboard, plots, video."""
     from . import leaderboard
 
-    suite.student_configs({task: "" for task in suite.tasks})  # a bad suite fails before any training
+    _check_worlds(suite.student_configs({task: "" for task in suite.tasks}))  # a bad suite fails before any training
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     atomic_write(out / "suite.json", json.dumps(dataclasses.asdict(suite), indent=2) + "\n")
@@ -219,6 +219,17 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     if video:
         movie = _best_student_video(out / "students", out)
     return TransferResult(out, teachers, students, board_md, plots, movie)
+
+
+def _check_worlds(configs: list[StudentConfig]) -> None:
+    """Make every students' world once: a bad world setting (``--env``) is named now, not
+    in a worker after the teachers have trained."""
+    import gymnasium as gym
+
+    import craftsuite  # noqa: F401  (registers the ids)
+
+    for env_id, kwargs in {(c.env_id, json.dumps(c.env_kwargs, sort_keys=True)) for c in configs}:
+        gym.make(env_id, **json.loads(kwargs)).close()
 
 
 def _best_student_video(students_root: Path, out: Path) -> Path | None:

@@ -70,6 +70,27 @@ def test_cli_errors_name_the_problem(tmp_path, capsys):
     assert "no method of ['td3'] runs in the worlds ['Grid10']" in capsys.readouterr().err
     assert main(["distill", str(tmp_path), "--out", str(tmp_path / "t.npz")]) == 2
     assert "not a teacher run directory" in capsys.readouterr().err
+    # a misspelt world setting is named before the teacher trains, and nothing is written
+    assert main(["transfer", "--env", '{"frame_skp": 10}', "--out", str(tmp_path / "t")]) == 2
+    assert "frame_skp" in capsys.readouterr().err and not (tmp_path / "t").exists()
+
+
+def test_transfer_flags_reach_the_suite(tmp_path, monkeypatch):
+    import craftsuite.suites
+
+    seen = []
+
+    def fake_transfer(suite, out, **_):
+        seen.append(suite)
+        return craftsuite.suites.TransferResult(Path(out), {}, [], Path(out) / "leaderboard.md", [], None)
+
+    monkeypatch.setattr(craftsuite.suites, "transfer", fake_transfer)
+    assert main(["transfer", "--out", str(tmp_path), "--env", '{"frame_skip": 10}',
+                 "--td3-hyper", '{"learning_rate": 0.001}']) == 0
+    [suite] = seen
+    assert suite.cont_world_kwargs == {"frame_skip": 10}
+    # merged over the suite's own TD3 settings, not replacing them
+    assert suite.td3_hyperparameters == {**SUITES["quick"].td3_hyperparameters, "learning_rate": 0.001}
 
 
 def test_suites_are_well_formed():

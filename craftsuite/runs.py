@@ -78,6 +78,7 @@ class RunDir:
 
     # -- ownership -------------------------------------------------------------------------------
     def __enter__(self) -> "RunDir":
+        self._created = not self.path.exists()
         self.path.mkdir(parents=True, exist_ok=True)
         self._acquire()
         saved = self.path / "config.json"
@@ -89,8 +90,21 @@ class RunDir:
         atomic_write(saved, mine + "\n")
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, exc_type, *exc) -> None:
+        if exc_type is not None and self._created:
+            self._remove_if_unused()
         self._release()
+
+    def _remove_if_unused(self) -> None:
+        """A run that failed before it wrote anything but its config (an agent that could not
+        be built: a bad ``--hyper``) leaves no directory behind to be mistaken for a run."""
+        if {p.name for p in self.path.iterdir()} <= {"config.json", ".lock"}:
+            for name in ("config.json", ".lock"):
+                (self.path / name).unlink(missing_ok=True)
+            try:
+                self.path.rmdir()
+            except OSError:  # something arrived meanwhile: leave it
+                pass
 
     def _acquire(self) -> None:
         # An advisory lock held on an open file: the kernel drops it when its owner dies, so a

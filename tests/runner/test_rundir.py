@@ -68,3 +68,25 @@ def test_atomic_write_leaves_no_temporary_files(tmp_path):
     atomic_write(tmp_path / "a.json", "[]")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json"]
     assert (tmp_path / "a.json").read_text() == "[]"
+
+
+def test_a_run_that_fails_before_training_leaves_no_directory(tmp_path):
+    from craftsuite.training import train_student
+
+    bad = StudentConfig(method="td3", steps=100, hyperparameters={"learning_rat": 1e-3})  # misspelt
+    with pytest.raises(TypeError, match="learning_rat"):
+        train_student(bad, tmp_path)
+    assert list(tmp_path.iterdir()) == []
+    # a directory that held something before is left as it was
+    run = tmp_path / "kept"
+    run.mkdir()
+    (run / "notes.txt").write_text("mine")
+    with pytest.raises(RuntimeError), RunDir(run, StudentConfig()):
+        raise RuntimeError("boom")
+    assert (run / "notes.txt").read_text() == "mine" and (run / "config.json").exists()
+    # as is one that the failed run had begun to fill
+    fresh = tmp_path / "fresh"
+    with pytest.raises(RuntimeError), RunDir(fresh, StudentConfig()) as r:
+        r.append("episodes.csv", EPISODE_FIELDS, [{"step": 1, "return": 0, "length": 1, "success": 0}])
+        raise RuntimeError("boom")
+    assert len(read_csv(fresh / "episodes.csv")) == 1

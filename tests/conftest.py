@@ -1,8 +1,15 @@
+import atexit
 import os
+import shutil
 import tempfile
 
-# Tests must not touch the user's automaton cache: one fresh directory per test session.
-os.environ.setdefault("CRAFTSUITE_CACHE_DIR", tempfile.mkdtemp(prefix="craftsuite-test-cache-"))
+# One scratch directory per test session, removed at its end. Tests must not touch the
+# user's automaton cache; and SB3 makes an empty /tmp/SB3-<time> folder for every learn()
+# without a log directory (hundreds per run of the tests) unless SB3_LOGDIR names one.
+_SCRATCH = tempfile.mkdtemp(prefix="craftsuite-tests-")
+atexit.register(shutil.rmtree, _SCRATCH, ignore_errors=True)
+os.environ.setdefault("CRAFTSUITE_CACHE_DIR", os.path.join(_SCRATCH, "cache"))
+os.environ.setdefault("SB3_LOGDIR", os.path.join(_SCRATCH, "sb3"))
 
 
 import pytest  # noqa: E402

@@ -149,7 +149,8 @@ def to_markdown(entries: list[Entry]) -> str:
                 steps += f" ({e.seeds - e.censored}/{e.seeds} reached)"
             lines.append(f"| {e.method} | {e.seeds} | {_fmt(e.stats['success'])} | {_fmt(e.stats['return'], 1)} "
                          f"| {_fmt(e.stats['auc'])} | {steps} |")
-        ref = PAPER_REFERENCE.get(key[0]) if key[1] == "Cont" else None
+        # in any MuJoCo setting: the authors' continuous world was a kinematic 2-D toy, none of ours
+        ref = PAPER_REFERENCE.get(key[0]) if key[1].split(":")[0] == "Cont" else None
         if ref:
             for method, value in ref.items():
                 lines.append(f"| *reference: authors' {method}, 1 run, 2M steps (return over the last 5%)* "

@@ -99,8 +99,9 @@ def test_runs_in_another_world_setting_get_their_own_row_and_plot(runs, tmp_path
     assert other.seeds == 1 and other.stats["success"][0] == 1.0
     assert entries[("Grid10: layout_seed=1", "dqn")].stats["return"][0] == 5.0
     md = leaderboard.to_markdown(list(entries.values()))
-    section = md.split("## BlindCraftsman (Cont: frame_skip=10")[1].split("##")[0]
-    assert "reference" not in section  # the authors' numbers are for the registered world only
+    sections = {part.split(")")[0]: part for part in md.split("## BlindCraftsman (")[1:]}
+    assert "reference" in sections["Cont: frame_skip=10, max_episode_steps=200"]  # theirs was a 2-D toy
+    assert "reference" not in sections["Grid10: layout_seed=1"]  # their numbers are continuous ones
     names = {p.name for p in leaderboard.plot_curves(runs, tmp_path)}
-    assert names == {"curves-BlindCraftsman-Cont.png", "curves-BlindCraftsman-Cont-frame_skip-10-max_episode_steps-200.png",
-                     "curves-BlindCraftsman-Grid10-layout_seed-1.png"}
+    assert names == {"curves-BlindCraftsman-Cont.png", "curves-BlindCraftsman-Grid10-layout_seed-1.png",
+                     "curves-BlindCraftsman-Cont-frame_skip-10-max_episode_steps-200.png"}

@@ -317,7 +317,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_student)
 
     p = sub.add_parser("transfer", help="a suite end to end: teacher, distillation, students, leaderboard, video")
-    p.add_argument("--suite", default="quick", help="quick (default, ~15 min), standard or paper")
+    p.add_argument("--suite", default="quick", help="quick (default, ~12 min), standard or paper")
     p.add_argument("--out", default="runs/quick", help="output directory (default: runs/quick)")
     p.add_argument("--tasks", nargs="+", help="override the suite's tasks")
     p.add_argument("--worlds", nargs="+", choices=("Cont", "Grid10", "Grid7"),

@@ -220,7 +220,8 @@ def plot_curves(students_root, out) -> list[Path]:
                 lo, hi = np.array(band).T
                 line, = ax.plot(grid, mean, label=f"{method} ({len(mine)} seeds)")
                 ax.fill_between(grid, lo, hi, color=line.get_color(), alpha=0.2)
-        axes[0].set(title=f"{task} ({world}): training episode return", xlabel="env steps", ylabel="return")
+        fig.suptitle(f"{task} ({world})")  # a world with settings is too long for a panel's title
+        axes[0].set(title="training episode return", xlabel="env steps", ylabel="return")
         axes[1].set(title="greedy success (evaluation)", xlabel="env steps", ylabel="success rate", ylim=(-0.02, 1.02))
         axes[1].legend(loc="upper left", fontsize=8)
         fig.tight_layout()

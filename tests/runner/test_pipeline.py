@@ -102,7 +102,7 @@ def test_suites_are_well_formed():
     # quick's TD3 network stays with its TD3 students when the worlds are overridden
     both = dataclasses.replace(SUITES["quick"], worlds=("Cont", "Grid10"), methods=("td3", "dqn"))
     nets = {c.world: c.hyperparameters.get("policy_kwargs") for c in both.student_configs({})}
-    assert nets == {"Cont": {"net_arch": [256, 256]}, "Grid10": None}
+    assert nets == {"Cont": {"net_arch": [64, 64]}, "Grid10": None}
     paper = SUITES["paper"].student_configs({t: "t.npz" for t in SUITES["paper"].tasks})
     assert {(c.world, c.method) for c in paper} >= {("Grid10", "crm"), ("Cont", "td3-static")}
     assert not any(c.world == "Cont" and c.method == "dqn" for c in paper)

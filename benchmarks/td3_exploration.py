@@ -13,7 +13,7 @@ persistent noise that holds one N(0, sigma) draw and redraws it with probability
 ``resample`` per step.
 
 Then it trains each method (one process each, one torch thread) with the persistent noise,
-the quick suite's network ([256, 256]) and ``--hyper`` (``make_agent`` keywords, e.g.
+a [256, 256] network (the quick suite's before 2026-11-22) and ``--hyper`` (``make_agent`` keywords, e.g.
 ``{"learning_rate": 1e-3}``), and prints every 10,000 steps, over 10 fresh greedy episodes,
 the success, return, rewarded events and automaton steps (transitions that change its
 state: the task's progress) per episode and the violations (the objective broken, which

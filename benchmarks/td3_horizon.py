@@ -5,8 +5,8 @@ Usage: python benchmarks/td3_horizon.py TABLE [--task T] [--frame-skip K] [--lim
 
 Trains each method (one process per method, one torch thread each) on
 ``CraftSuite/<task>-Cont-v0`` made with ``frame_skip=K`` (physics steps of 0.025 s per
-action; the world's default is 2) and a time limit of N steps, with the quick suite's
-network ([256, 256]) and otherwise the package defaults. Every 5,000 steps it prints the
+action; the world's default is 2) and a time limit of N steps, with a [256, 256]
+network (the quick suite's before 2026-11-22) and otherwise the package defaults. Every 5,000 steps it prints the
 greedy success and return over 10 fresh episodes and the training episodes completed so
 far. TABLE is a teacher's ``table.npz`` (``craftsuite teacher``) for the dynamic method.
 First it prints how many steps the scripted policy needs at this frame skip and at the

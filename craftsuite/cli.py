@@ -214,6 +214,9 @@ def _transfer(args) -> int:
                                  ("student_steps", args.steps), ("methods", tuple(args.methods) if args.methods else None),
                                  ("teacher_max_steps", args.teacher_steps), ("eval_every", args.eval_every))
                if v is not None}
+    if (args.env or args.td3_hyper) and "Cont" not in changes.get("worlds", suite.worlds):
+        raise ValueError("--env and --td3-hyper set the MuJoCo students; these worlds have none: "
+                         f"{list(changes.get('worlds', suite.worlds))}")
     if args.env is not None:
         changes["cont_world_kwargs"] = _json_object(args.env, "--env")
     if args.td3_hyper is not None:

@@ -19,6 +19,7 @@ are another benchmark, so they get a row and a plot of their own. A run that nev
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import json
 import re
@@ -104,22 +105,29 @@ class Entry:
     seeds: int
     stats: dict  # metric -> (mean, lo, hi)
     censored: int  # runs that never reached 80% (counted at their budget)
+    differs: tuple[str, ...] = ()  # config fields, other than the seed, in which the pooled runs differ
 
 
 def build(students_root) -> list[Entry]:
     """One entry per (task, world, method) over the finished runs under ``students_root``."""
     groups: dict[tuple, list[dict]] = {}
+    configs: dict[tuple, list[dict]] = {}
     for run in sorted(Path(students_root).iterdir()) if Path(students_root).is_dir() else []:
         m = run_metrics(run)
         if m is not None:
-            groups.setdefault((m["task"], m["world"], m["method"]), []).append(m)
+            key = (m["task"], m["world"], m["method"])
+            groups.setdefault(key, []).append(m)
+            configs.setdefault(key, []).append(json.loads((run / "config.json").read_text()))
     entries = []
     for (task, world, method), runs in sorted(groups.items()):
         stats = {k: bootstrap_ci([r[k] for r in runs]) for k in ("success", "return", "auc")}
         steps = [r["steps_to_80"] if r["steps_to_80"] is not None else r["budget"] for r in runs]
         stats["steps_to_80"] = bootstrap_ci(steps)
+        mine = configs[(task, world, method)]
+        differs = tuple(sorted(k for k in {k for c in mine for k in c} - {"seed"}
+                               if len({json.dumps(c.get(k), sort_keys=True) for c in mine}) > 1))
         entries.append(Entry(task, world, method, len(runs), stats,
-                             sum(r["steps_to_80"] is None for r in runs)))
+                             sum(r["steps_to_80"] is None for r in runs), differs))
     return entries
 
 
@@ -149,12 +157,16 @@ def to_markdown(entries: list[Entry]) -> str:
                 steps += f" ({e.seeds - e.censored}/{e.seeds} reached)"
             lines.append(f"| {e.method} | {e.seeds} | {_fmt(e.stats['success'])} | {_fmt(e.stats['return'], 1)} "
                          f"| {_fmt(e.stats['auc'])} | {steps} |")
+        notes = [f"*{e.method}: its {e.seeds} runs differ in {', '.join(e.differs)}, not only in the seed; "
+                 "they are pooled here (put runs of another setting in another directory)*"
+                 for e in rows if e.differs]
         # in any MuJoCo setting: the authors' continuous world was a kinematic 2-D toy, none of ours
         ref = PAPER_REFERENCE.get(key[0]) if key[1].split(":")[0] == "Cont" else None
         if ref:
             for method, value in ref.items():
                 lines.append(f"| *reference: authors' {method}, 1 run, 2M steps (return over the last 5%)* "
                              f"| 1 | | {value:.2f} | | |")
+        lines += ["", *notes] if notes else []
         lines.append("")
     return "\n".join(lines)
 
@@ -163,9 +175,10 @@ def to_csv(entries: list[Entry]) -> str:
     buf = io.StringIO()
     writer = csv.writer(buf)
     writer.writerow(["task", "world", "method", "seeds", *(f"{m}{s}" for m in METRICS for s in ("", "_lo", "_hi")),
-                     "steps_to_80_censored"])
+                     "steps_to_80_censored", "pooled_runs_differ_in"])
     for e in entries:
-        writer.writerow([e.task, e.world, e.method, e.seeds, *(v for m in METRICS for v in e.stats[m]), e.censored])
+        writer.writerow([e.task, e.world, e.method, e.seeds, *(v for m in METRICS for v in e.stats[m]), e.censored,
+                         " ".join(e.differs)])
     return buf.getvalue()
 
 
@@ -225,7 +238,10 @@ def plot_curves(students_root, out) -> list[Path]:
         axes[1].set(title="greedy success (evaluation)", xlabel="env steps", ylabel="success rate", ylim=(-0.02, 1.02))
         axes[1].legend(loc="upper left", fontsize=8)
         fig.tight_layout()
-        path = Path(out) / f"curves-{task}-{_file_part(world)}.png"
+        name = f"curves-{task}-{_file_part(world)}"
+        if any(p.stem == name for p in paths):  # two settings that read alike once in a file name
+            name += "-" + hashlib.sha256(world.encode()).hexdigest()[:6]
+        path = Path(out) / f"{name}.png"
         tmp = path.with_name(f".{path.name}.tmp.png")
         fig.savefig(tmp, dpi=110)
         tmp.replace(path)

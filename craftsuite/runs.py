@@ -91,9 +91,11 @@ class RunDir:
         return self
 
     def __exit__(self, exc_type, *exc) -> None:
-        if exc_type is not None and self._created:
-            self._remove_if_unused()
-        self._release()
+        try:
+            if exc_type is not None and self._created:
+                self._remove_if_unused()
+        finally:
+            self._release()
 
     def _remove_if_unused(self) -> None:
         """A run that failed before it wrote anything but its config (an agent that could not
@@ -109,7 +111,11 @@ class RunDir:
     def _acquire(self) -> None:
         # An advisory lock held on an open file: the kernel drops it when its owner dies, so a
         # killed run's directory is free again at once, and two live runs can never both hold it.
-        self._fd = os.open(self._lock, os.O_CREAT | os.O_RDWR)
+        try:
+            self._fd = os.open(self._lock, os.O_CREAT | os.O_RDWR)
+        except FileNotFoundError:  # a run that failed at once removed the directory meanwhile
+            self.path.mkdir(parents=True, exist_ok=True)
+            self._fd = os.open(self._lock, os.O_CREAT | os.O_RDWR)
         try:
             fcntl.flock(self._fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:

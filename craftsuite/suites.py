@@ -5,7 +5,7 @@ one end to end under an output directory::
 
     <out>/teachers/teacher-<Task>-Grid7-s0-<key>/     teacher.zip, table.npz, evals.csv
     <out>/students/student-<Task>-Cont-<method>-s<seed>-<key>/
-    <out>/leaderboard.md, leaderboard.csv, curves-<Task>-<world>.png, best-<...>.mp4
+    <out>/leaderboard.md, leaderboard.csv, curves-<Task>-<world>[-<settings>].png, best-<...>.mp4
 
 Student runs go to local processes (``workers`` at a time) or, with ``ray``, to a Ray
 cluster (``"local"`` starts one in-process; a real cluster needs ``out`` on a filesystem
@@ -203,7 +203,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     """The suite end to end: teachers, distillation, students, leaderboard, plots, video."""
     from . import leaderboard
 
-    _check_worlds(suite.student_configs({task: "" for task in suite.tasks}))  # a bad suite fails before any training
+    _check_students(suite.student_configs({task: "" for task in suite.tasks}))  # fail before any training
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     atomic_write(out / "suite.json", json.dumps(dataclasses.asdict(suite), indent=2) + "\n")
@@ -224,28 +224,34 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     log(board_md.read_text())
     movie = None
     if video:
-        movie = _best_student_video(out / "students", out)
+        movie = _best_student_video(students, out)
     return TransferResult(out, teachers, students, board_md, plots, movie)
 
 
-def _check_worlds(configs: list[StudentConfig]) -> None:
-    """Make every students' world once: a bad world setting (``--env``) is named now, not
-    in a worker after the teachers have trained."""
-    import gymnasium as gym
-
+def _check_students(configs: list[StudentConfig]) -> None:
+    """Build each kind of student once, untrained, from scratch (the teachers' tables do not
+    exist yet): a misspelt world setting or algorithm setting (``--env``, ``--td3-hyper``) is
+    named now, not in a worker after the teachers have trained."""
     import craftsuite  # noqa: F401  (registers the ids)
 
-    for env_id, kwargs in {(c.env_id, json.dumps(c.env_kwargs, sort_keys=True)) for c in configs}:
-        gym.make(env_id, **json.loads(kwargs)).close()
+    from .agents.methods import make_agent
+
+    kinds = {(c.env_id, c.world, json.dumps(c.env_kwargs, sort_keys=True), json.dumps(c.hyperparameters, sort_keys=True))
+             for c in configs}
+    for env_id, world, env_kwargs, hyper in kinds:
+        agent = make_agent("td3" if world == "Cont" else "dqn", env_id, env_kwargs=json.loads(env_kwargs),
+                           **{**json.loads(hyper), "buffer_size": 16})
+        agent.get_env().close()
 
 
-def _best_student_video(students_root: Path, out: Path) -> Path | None:
-    """A rollout of the best student run of the suite (highest final success, then return)."""
+def _best_student_video(students: list[Path], out: Path) -> Path | None:
+    """A rollout of the best of this suite's student runs (highest final success, then
+    return); runs of another config in the same directory are not candidates."""
     from .rollouts import record_video
     from .runs import read_csv
 
     runs = []
-    for run in Path(students_root).iterdir():
+    for run in students:
         result = run / "result.json"
         if result.exists():
             r = json.loads(result.read_text())

@@ -1,6 +1,7 @@
 """Leaderboard numbers on synthetic run directories with known answers."""
 
 import csv
+import hashlib
 import json
 
 import numpy as np
@@ -11,7 +12,9 @@ from craftsuite.runs import EPISODE_FIELDS, EVAL_FIELDS, write_csv
 
 
 def fake_run(root, method, seed, evals, episodes, budget=1_000, task="BlindCraftsman", world="Cont", **config):
-    run = root / f"student-{task}-{world}-{method}-s{seed}{''.join('-' + k for k in config)}"
+    run = root / f"student-{task}-{world}-{method}-s{seed}"
+    if config or budget != 1_000:  # another setting: another directory, as config_key gives
+        run = run.with_name(f"{run.name}-{hashlib.sha256(json.dumps([budget, config]).encode()).hexdigest()[:8]}")
     run.mkdir(parents=True)
     (run / "config.json").write_text(json.dumps({"task": task, "world": world, "method": method, "seed": seed,
                                                  "steps": budget, **config}))
@@ -105,3 +108,17 @@ def test_runs_in_another_world_setting_get_their_own_row_and_plot(runs, tmp_path
     names = {p.name for p in leaderboard.plot_curves(runs, tmp_path)}
     assert names == {"curves-BlindCraftsman-Cont.png", "curves-BlindCraftsman-Grid10-layout_seed-1.png",
                      "curves-BlindCraftsman-Cont-frame_skip-10-max_episode_steps-200.png"}
+    # settings that read alike in a file name do not overwrite each other's plot
+    fake_run(runs, "td3", 0, [(1000, 0.0)], [(995, 0.0)], world_kwargs={"x": -1})
+    fake_run(runs, "td3", 0, [(1000, 0.0)], [(995, 0.0)], world_kwargs={"x": 1})
+    assert len({p.name for p in leaderboard.plot_curves(runs, tmp_path)}) == 5
+
+
+def test_runs_pooled_in_one_row_that_differ_beyond_the_seed_are_flagged(runs, tmp_path):
+    fake_run(runs, "td3", 2, [(2000, 0.0)], [(1995, 0.0)], budget=2_000)  # another budget, same world
+    entries = {e.method: e for e in leaderboard.build(runs)}
+    assert entries["td3"].differs == ("steps",) and entries["td3-dynamic"].differs == ()
+    md = leaderboard.to_markdown(list(entries.values()))
+    assert "*td3: its 3 runs differ in steps, not only in the seed" in md and "td3-dynamic: its" not in md
+    with open(leaderboard.write(list(entries.values()), tmp_path).with_suffix(".csv")) as f:
+        assert {r["method"]: r["pooled_runs_differ_in"] for r in csv.DictReader(f)} == {"td3": "steps", "td3-dynamic": ""}

@@ -73,6 +73,11 @@ def test_cli_errors_name_the_problem(tmp_path, capsys):
     # a misspelt world setting is named before the teacher trains, and nothing is written
     assert main(["transfer", "--env", '{"frame_skp": 10}', "--out", str(tmp_path / "t")]) == 2
     assert "frame_skp" in capsys.readouterr().err and not (tmp_path / "t").exists()
+    assert main(["transfer", "--td3-hyper", '{"learning_rat": 0.001}', "--out", str(tmp_path / "t")]) == 2
+    assert "learning_rat" in capsys.readouterr().err and not (tmp_path / "t").exists()
+    assert main(["transfer", "--worlds", "Grid10", "--methods", "dqn", "--env", '{"frame_skip": 10}',
+                 "--out", str(tmp_path / "t")]) == 2
+    assert "these worlds have none: ['Grid10']" in capsys.readouterr().err
 
 
 def test_transfer_flags_reach_the_suite(tmp_path, monkeypatch):

@@ -77,6 +77,13 @@ def test_a_run_that_fails_before_training_leaves_no_directory(tmp_path):
     with pytest.raises(TypeError, match="learning_rat"):
         train_student(bad, tmp_path)
     assert list(tmp_path.iterdir()) == []
+    # a killed run's directory (its config only, nothing trained yet) is not this run's to remove
+    killed = tmp_path / "killed"
+    with RunDir(killed, StudentConfig()):
+        pass
+    with pytest.raises(RuntimeError), RunDir(killed, StudentConfig()):
+        raise RuntimeError("boom")
+    assert (killed / "config.json").exists()
     # a directory that held something before is left as it was
     run = tmp_path / "kept"
     run.mkdir()

@@ -44,9 +44,9 @@ PAPER_REFERENCE = {
 def world_label(config: dict) -> str:
     """A student's world as a leaderboard shows it: ``Cont``, ``Grid10``, or with the
     settings that change it, e.g. ``Cont: frame_skip=10, max_episode_steps=200``."""
-    settings = dict(config.get("world_kwargs") or {})  # absent from configs older than the field
-    if config.get("layout_seed") is not None:
-        settings = {"layout_seed": config["layout_seed"], **settings}
+    from .training import StudentConfig  # the owner of a student's world settings
+
+    settings = StudentConfig(**config).env_kwargs  # world_kwargs is absent from configs older than the field
     if not settings:
         return config["world"]
     return f"{config['world']}: " + ", ".join(f"{k}={json.dumps(v)}" for k, v in sorted(settings.items()))

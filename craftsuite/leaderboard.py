@@ -4,6 +4,9 @@ Per run (``run_metrics``):
 
 * ``success``: greedy success rate at the last evaluation;
 * ``return``: mean training-episode return over the last 10% of the run's steps;
+* ``train_success``: the share of training episodes won over the same window, with the
+  exploration noise on (what SB3 logs as ``rollout/success_rate``); a policy can win
+  there and still stall when evaluated greedily, so both are shown;
 * ``auc``: area under the evaluation success curve, as a fraction of the budget (the mean
   of the evaluations, every ``eval_every`` steps and at the end): 1.0 means solved from the
   first one;
@@ -30,7 +33,7 @@ import numpy as np
 
 from .runs import atomic_write, read_csv
 
-METRICS = ("success", "return", "auc", "steps_to_80")
+METRICS = ("success", "return", "train_success", "auc", "steps_to_80")
 
 # REFERENCE.md section 5: the authors' shipped continuous results, one run each, mean
 # episode reward over the last 5% of 2e6 steps (not the same metric window as ours).
@@ -69,16 +72,17 @@ def run_metrics(run: Path) -> dict | None:
     budget = int(config["steps"])
     episodes = read_csv(run / "episodes.csv")
     evals = read_csv(run / "evals.csv")
-    tail = [float(e["return"]) for e in episodes if int(e["step"]) > 0.9 * budget]
+    tail = [e for e in episodes if int(e["step"]) > 0.9 * budget]
     if not tail and episodes:  # fewer episodes than the window: the last one
-        tail = [float(episodes[-1]["return"])]
+        tail = episodes[-1:]
     success = [float(e["success"]) for e in evals]
     reached = next((int(e["step"]) for e in evals if float(e["success"]) >= 0.8), None)
     return {
         "task": config["task"], "world": world_label(config), "method": config["method"], "seed": config["seed"],
         "budget": budget, "steps": result["steps"],
         "success": success[-1] if success else float("nan"),
-        "return": float(np.mean(tail)) if tail else float("nan"),
+        "return": float(np.mean([float(e["return"]) for e in tail])) if tail else float("nan"),
+        "train_success": float(np.mean([int(e["success"]) for e in tail])) if tail else float("nan"),
         "auc": float(np.mean(success)) if success else float("nan"),
         "steps_to_80": reached,
     }
@@ -120,7 +124,7 @@ def build(students_root) -> list[Entry]:
             configs.setdefault(key, []).append(json.loads((run / "config.json").read_text()))
     entries = []
     for (task, world, method), runs in sorted(groups.items()):
-        stats = {k: bootstrap_ci([r[k] for r in runs]) for k in ("success", "return", "auc")}
+        stats = {k: bootstrap_ci([r[k] for r in runs]) for k in ("success", "return", "train_success", "auc")}
         steps = [r["steps_to_80"] if r["steps_to_80"] is not None else r["budget"] for r in runs]
         stats["steps_to_80"] = bootstrap_ci(steps)
         mine = configs[(task, world, method)]
@@ -142,13 +146,15 @@ def _fmt(stat, digits=2, integer=False, prefix="") -> str:
 
 def to_markdown(entries: list[Entry]) -> str:
     lines = ["# Leaderboard", "",
-             "Mean over seeds [95% bootstrap interval]. success: greedy, last evaluation; return: training "
-             "episodes, last 10% of steps; AUC: mean evaluation success over training; steps to 80%: "
-             "'>=' when some seeds never got there (counted at their budget).", ""]
+             "Mean over seeds [95% bootstrap interval]. success: greedy, last evaluation; return and "
+             "training success: training episodes (exploration noise on), last 10% of steps; AUC: mean "
+             "evaluation success over training; steps to 80% (greedy) success: '>=' when some seeds never "
+             "got there (counted at their budget).", ""]
     for key in sorted({(e.task, e.world) for e in entries}):
         lines += [f"## {key[0]} ({key[1]})", "",
-                  "| method | seeds | success | return (last 10%) | AUC | steps to 80% success |",
-                  "|---|---|---|---|---|---|"]
+                  "| method | seeds | success | return (last 10%) | training success (last 10%) | AUC "
+                  "| steps to 80% success |",
+                  "|---|---|---|---|---|---|---|"]
         rows = sorted((e for e in entries if (e.task, e.world) == key),
                       key=lambda e: (-e.stats["auc"][0], -e.stats["return"][0]))
         for e in rows:
@@ -156,7 +162,7 @@ def to_markdown(entries: list[Entry]) -> str:
             if e.censored:
                 steps += f" ({e.seeds - e.censored}/{e.seeds} reached)"
             lines.append(f"| {e.method} | {e.seeds} | {_fmt(e.stats['success'])} | {_fmt(e.stats['return'], 1)} "
-                         f"| {_fmt(e.stats['auc'])} | {steps} |")
+                         f"| {_fmt(e.stats['train_success'])} | {_fmt(e.stats['auc'])} | {steps} |")
         notes = [f"*{e.method}: its {e.seeds} runs differ in {', '.join(e.differs)}, not only in the seed; "
                  "they are pooled here (put runs of another setting in another directory)*"
                  for e in rows if e.differs]
@@ -165,7 +171,7 @@ def to_markdown(entries: list[Entry]) -> str:
         if ref:
             for method, value in ref.items():
                 lines.append(f"| *reference: authors' {method}, 1 run, 2M steps (return over the last 5%)* "
-                             f"| 1 | | {value:.2f} | | |")
+                             f"| 1 | | {value:.2f} | | | |")
         lines += ["", *notes] if notes else []
         lines.append("")
     return "\n".join(lines)
@@ -219,10 +225,12 @@ def plot_curves(students_root, out) -> list[Path]:
         axes = fig.subplots(1, 2)
         for method in sorted({g[0]["method"] for g in group}):
             mine = [g for g in group if g[0]["method"] == method]
-            for ax, series in zip(axes, (
-                [_smoothed([(int(e["step"]), float(e["return"])) for e in g[1]], grid) for g in mine],
-                [_curve([(int(e["step"]), float(e["success"])) for e in g[2]], grid) for g in mine],
-            )):
+            color = None
+            for ax, style, series in (
+                (axes[0], "-", [_smoothed([(int(e["step"]), float(e["return"])) for e in g[1]], grid) for g in mine]),
+                (axes[1], "-", [_curve([(int(e["step"]), float(e["success"])) for e in g[2]], grid) for g in mine]),
+                (axes[1], "--", [_smoothed([(int(e["step"]), int(e["success"])) for e in g[1]], grid) for g in mine]),
+            ):
                 data = np.array(series)
                 if data.size == 0:
                     continue
@@ -231,11 +239,15 @@ def plot_curves(students_root, out) -> list[Path]:
                 mean[valid] = np.nanmean(data[:, valid], axis=0)
                 band = [bootstrap_ci(col[~np.isnan(col)])[1:] for col in data.T]
                 lo, hi = np.array(band).T
-                line, = ax.plot(grid, mean, label=f"{method} ({len(mine)} seeds)")
-                ax.fill_between(grid, lo, hi, color=line.get_color(), alpha=0.2)
+                line, = ax.plot(grid, mean, style, color=color,
+                                label=f"{method} ({len(mine)} seeds)" if style == "-" else None)
+                color = line.get_color()  # one colour per method across panels and styles
+                if style == "-":
+                    ax.fill_between(grid, lo, hi, color=color, alpha=0.2)
         fig.suptitle(f"{task} ({world})")  # a world with settings is too long for a panel's title
         axes[0].set(title="training episode return", xlabel="env steps", ylabel="return")
-        axes[1].set(title="greedy success (evaluation)", xlabel="env steps", ylabel="success rate", ylim=(-0.02, 1.02))
+        axes[1].set(xlabel="env steps", ylabel="success rate", ylim=(-0.02, 1.02))
+        axes[1].set_title("success: greedy evaluation (solid), training episodes (dashed)", fontsize=9)
         axes[1].legend(loc="upper left", fontsize=8)
         fig.tight_layout()
         name = f"curves-{task}-{_file_part(world)}"

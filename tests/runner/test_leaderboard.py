@@ -22,7 +22,8 @@ def fake_run(root, method, seed, evals, episodes, budget=1_000, task="BlindCraft
     write_csv(run / "evals.csv", EVAL_FIELDS,
               [{"step": s, "success": v, "return": 0.0, "episodes": 10} for s, v in evals])
     write_csv(run / "episodes.csv", EPISODE_FIELDS,
-              [{"step": s, "return": r, "length": 10, "success": 0} for s, r in episodes])
+              [{"step": s, "return": r, "length": 10, "success": won}  # (step, return[, won]): lost by default
+               for s, r, won in (tuple(e) + (0,) * (3 - len(e)) for e in episodes)])
     return run
 
 
@@ -31,7 +32,7 @@ def runs(tmp_path):
     root = tmp_path / "students"
     # fast: 80% at step 500 on both seeds; returns in the last 10% (step > 900): 10 and 20
     fake_run(root, "td3-dynamic", 0, [(250, 0.2), (500, 0.8), (750, 1.0), (1000, 1.0)],
-             [(100, -50.0), (950, 10.0), (1000, 10.0)])
+             [(100, -50.0, 1), (920, 10.0, 1), (950, 10.0, 0), (980, 10.0, 1), (1000, 10.0, 1)])
     fake_run(root, "td3-dynamic", 1, [(250, 0.4), (500, 0.8), (750, 0.8), (1000, 0.6)],
              [(900, -99.0), (990, 20.0)])
     # slow: one seed reaches 80% at 1000, the other never does
@@ -51,6 +52,7 @@ def test_run_metrics_known_answers(runs):
     assert m["auc"] == pytest.approx((0.2 + 0.8 + 1.0 + 1.0) / 4)
     assert m["steps_to_80"] == 500
     assert m["return"] == 10.0  # only the episodes after step 900
+    assert m["train_success"] == 0.75  # three of the four training episodes after step 900 won
     m = leaderboard.run_metrics(runs / "student-BlindCraftsman-Cont-td3-s1")
     assert m["steps_to_80"] is None and m["success"] == 0.0 and m["return"] == -100.0
 
@@ -63,6 +65,7 @@ def test_entries_average_seeds_with_bootstrap_intervals(runs):
     mean, lo, hi = dyn.stats["success"]
     assert mean == pytest.approx(0.8) and lo == pytest.approx(0.6) and hi == pytest.approx(1.0)
     assert dyn.stats["return"][0] == pytest.approx(15.0)
+    assert dyn.stats["train_success"][0] == pytest.approx((0.75 + 0.0) / 2)
     assert dyn.stats["steps_to_80"] == (500.0, 500.0, 500.0)  # both seeds agree: a point interval
     assert td3.censored == 1
     assert td3.stats["steps_to_80"][0] == 1000.0  # the censored seed counts at its budget
@@ -88,6 +91,8 @@ def test_markdown_csv_and_plot(runs, tmp_path):
     with open(tmp_path / "leaderboard.csv") as f:
         rows = {r["method"]: r for r in csv.DictReader(f)}
     assert float(rows["td3-dynamic"]["success"]) == pytest.approx(0.8)
+    assert float(rows["td3-dynamic"]["train_success"]) == pytest.approx(0.375)
+    assert "| training success (last 10%) |" in md and "| 0.38 [0.00, 0.75] |" in md
     assert rows["td3"]["steps_to_80_censored"] == "1"
     [png] = leaderboard.plot_curves(runs, tmp_path)
     assert png.name == "curves-BlindCraftsman-Cont.png" and png.read_bytes()[:4] == b"\x89PNG"

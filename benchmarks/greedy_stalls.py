@@ -1,0 +1,122 @@
+"""Why a TD3 student that wins its noisy training episodes fails greedy ones.
+
+Usage: python benchmarks/greedy_stalls.py RUN_DIR [RUN_DIR ...] [--episodes N]
+
+For each finished (or checkpointed) MuJoCo student run, its last checkpoint plays the same
+fresh episodes four ways: greedy (the leaderboard's success), and with N(0, 0.1) or
+N(0, 0.3) added per step, or with the run's own training noise (its ``action_noise``
+spec). Then, for the greedy episodes that failed, it says how they ended: *stalled* (the
+agent stood or chattered within a 0.3 m box for its last 30 steps), with the distance from the stall to
+the nearest object of each kind, the actor's action there, and the critic's best action
+over a 21 x 21 grid of thrusts with the spread of its values.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+
+def _load(run: Path):
+    """A run's config, its last checkpoint's model, and whether it sees the automaton state."""
+    from craftsuite.agents.methods import METHODS, load_agent
+    from craftsuite.runs import RunDir
+    from craftsuite.training import StudentConfig, checkpoint_dir
+
+    config = StudentConfig(**json.loads((run / "config.json").read_text()))
+    saved = checkpoint_dir(RunDir(run, config))
+    if saved is None:
+        raise FileNotFoundError(f"{run} has no checkpoint yet")
+    return config, load_agent(saved / "model.zip"), METHODS[config.method].product
+
+
+def play(model, config, product: bool, episodes: int, noise=None, seed: int = 7000) -> list[dict]:
+    """Episodes on seeds ``seed``, ``seed + 1``, ...; ``noise()`` (if given) is added to each action."""
+    import gymnasium as gym
+
+    out = []
+    for e in range(episodes):
+        env = gym.make(config.env_id, product=product, **config.env_kwargs)
+        obs, _ = env.reset(seed=seed + e)
+        if noise is not None:
+            noise.reset()
+        path = []
+        while True:
+            action = model.predict(obs, deterministic=True)[0]
+            if noise is not None:
+                action = np.clip(action + noise(), -1, 1)
+            obs, _, terminated, truncated, info = env.step(action)
+            path.append(env.unwrapped.data.qpos[:2].copy())
+            if terminated or truncated:
+                break
+        out.append({"success": bool(info["is_success"]), "obs": obs, "path": np.array(path), "env": env})
+    return out
+
+
+def stall_report(model, episode: dict) -> dict | None:
+    """How a failed greedy episode ended, if it stalled (None if the agent was still moving)."""
+    import torch as th
+
+    last = episode["path"][-30:]
+    if np.ptp(last, axis=0).max() > 0.3:
+        return None
+    env, here = episode["env"].unwrapped, episode["path"][-1]
+    nearest = {kind: min(float(np.hypot(*(np.array(p) - here))) for p in points)
+               for kind, points in env.object_positions().items() if points}
+    grid = np.linspace(-1, 1, 21)
+    actions = th.as_tensor(np.array([(x, y) for x in grid for y in grid], dtype=np.float32))
+    obs = th.as_tensor(episode["obs"][None])
+    with th.no_grad():
+        q = model.critic.q1_forward(obs.repeat(len(actions), 1), actions)[:, 0].numpy()
+        actor = model.actor(obs)[0].numpy()
+    return {"nearest": nearest, "actor": actor, "critic_best": actions[int(q.argmax())].numpy(),
+            "q_spread": float(q.max() - q.min()), "inventory": tuple(int(c) for c in env.inventory_counts),
+            "at_wall": bool(np.abs(here).max() >= env._wall_limit - 0.01)}
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("runs", nargs="+", type=Path, help="student run directories (MuJoCo, TD3)")
+    parser.add_argument("--episodes", type=int, default=40)
+    args = parser.parse_args(argv)
+
+    import torch as th
+    from stable_baselines3.common.noise import NormalActionNoise
+
+    from craftsuite.agents.noise import make_action_noise
+
+    th.set_num_threads(1)
+    for run in args.runs:
+        config, model, product = _load(run)
+        spec = config.hyperparameters.get("action_noise", {"type": "normal", "sigma": 0.3})
+        ways = {"greedy": None,
+                "+ N(0, 0.1) per step": NormalActionNoise(np.zeros(2), np.full(2, 0.1)),
+                "+ N(0, 0.3) per step": NormalActionNoise(np.zeros(2), np.full(2, 0.3)),
+                f"+ its training noise {json.dumps(spec)}": make_action_noise(spec, 2, seed=0)}
+        print(f"\n## {run.name}\n\n| actions | success ({args.episodes} episodes) |\n|---|---|")
+        greedy = []
+        for name, noise in ways.items():
+            np.random.seed(0)  # NormalActionNoise draws from numpy's global generator
+            episodes = play(model, config, product, args.episodes, noise)
+            greedy = greedy or episodes  # the first way is greedy
+            print(f"| {name} | {np.mean([e['success'] for e in episodes]):.2f} |")
+        failed = [e for e in greedy if not e["success"]]
+        stalls = [r for r in (stall_report(model, e) for e in failed) if r is not None]
+        print(f"\nGreedy failures: {len(failed)}, of which stuck (within 0.3 m for the last 30 steps): {len(stalls)}\n")
+        if stalls:
+            print("| inventory | nearest objects (m) | at the wall | actor's action | critic's best action "
+                  "| critic's value spread |")
+            print("|---|---|---|---|---|---|")
+            for r in stalls:
+                near = ", ".join(f"{k} {d:.2f}" for k, d in sorted(r["nearest"].items(), key=lambda kv: kv[1]))
+                print(f"| {r['inventory']} | {near} | {'yes' if r['at_wall'] else ''} | ({r['actor'][0]:+.2f}, {r['actor'][1]:+.2f}) "
+                      f"| ({r['critic_best'][0]:+.1f}, {r['critic_best'][1]:+.1f}) | {r['q_spread']:.1f} |")
+            close = np.mean([min(r["nearest"].values()) < 1.0 for r in stalls])
+            print(f"\nStalls within 1 m of an object (the pickup radius is 0.4 m): {close:.0%}")
+
+
+if __name__ == "__main__":
+    main()

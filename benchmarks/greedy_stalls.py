@@ -5,10 +5,10 @@ Usage: python benchmarks/greedy_stalls.py RUN_DIR [RUN_DIR ...] [--episodes N]
 For each finished (or checkpointed) MuJoCo student run, its last checkpoint plays the same
 fresh episodes four ways: greedy (the leaderboard's success), and with N(0, 0.1) or
 N(0, 0.3) added per step, or with the run's own training noise (its ``action_noise``
-spec). Then, for the greedy episodes that failed, it says how they ended: *stalled* (the
-agent stood or chattered within a 0.3 m box for its last 30 steps), with the distance from the stall to
-the nearest object of each kind, the actor's action there, and the critic's best action
-over a 21 x 21 grid of thrusts with the spread of its values.
+spec). Then, for the greedy episodes that failed, it says how they ended: *stuck* (the
+agent stood or chattered within a 0.3 m box for its last 30 steps), with the distance from
+there to the nearest object of each kind, the actor's action there, and the critic's best
+action over a 21 x 21 grid of thrusts with the spread of its values.
 """
 
 from __future__ import annotations
@@ -57,7 +57,7 @@ def play(model, config, product: bool, episodes: int, noise=None, seed: int = 70
 
 
 def stall_report(model, episode: dict) -> dict | None:
-    """How a failed greedy episode ended, if it stalled (None if the agent was still moving)."""
+    """How a failed greedy episode ended, if it got stuck (None if the agent was still moving)."""
     import torch as th
 
     last = episode["path"][-30:]
@@ -101,10 +101,16 @@ def main(argv=None) -> None:
         for name, noise in ways.items():
             np.random.seed(0)  # NormalActionNoise draws from numpy's global generator
             episodes = play(model, config, product, args.episodes, noise)
-            greedy = greedy or episodes  # the first way is greedy
+            if not greedy:
+                greedy = episodes  # the first way; its envs stay open for the stall reports
+            else:
+                for e in episodes:
+                    e["env"].close()
             print(f"| {name} | {np.mean([e['success'] for e in episodes]):.2f} |")
         failed = [e for e in greedy if not e["success"]]
         stalls = [r for r in (stall_report(model, e) for e in failed) if r is not None]
+        for e in greedy:
+            e["env"].close()
         print(f"\nGreedy failures: {len(failed)}, of which stuck (within 0.3 m for the last 30 steps): {len(stalls)}\n")
         if stalls:
             print("| inventory | nearest objects (m) | at the wall | actor's action | critic's best action "
@@ -115,7 +121,7 @@ def main(argv=None) -> None:
                 print(f"| {r['inventory']} | {near} | {'yes' if r['at_wall'] else ''} | ({r['actor'][0]:+.2f}, {r['actor'][1]:+.2f}) "
                       f"| ({r['critic_best'][0]:+.1f}, {r['critic_best'][1]:+.1f}) | {r['q_spread']:.1f} |")
             close = np.mean([min(r["nearest"].values()) < 1.0 for r in stalls])
-            print(f"\nStalls within 1 m of an object (the pickup radius is 0.4 m): {close:.0%}")
+            print(f"\nStuck within 1 m of an object (the pickup radius is 0.4 m): {close:.0%}")
 
 
 if __name__ == "__main__":

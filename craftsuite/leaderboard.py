@@ -237,12 +237,11 @@ def plot_curves(students_root, out) -> list[Path]:
                 valid = ~np.isnan(data).all(axis=0)  # before a run's first episode: no value yet
                 mean = np.full(len(grid), np.nan)
                 mean[valid] = np.nanmean(data[:, valid], axis=0)
-                band = [bootstrap_ci(col[~np.isnan(col)])[1:] for col in data.T]
-                lo, hi = np.array(band).T
                 line, = ax.plot(grid, mean, style, color=color,
                                 label=f"{method} ({len(mine)} seeds)" if style == "-" else None)
                 color = line.get_color()  # one colour per method across panels and styles
-                if style == "-":
+                if style == "-":  # the dashed training success goes without a band, for legibility
+                    lo, hi = np.array([bootstrap_ci(col[~np.isnan(col)])[1:] for col in data.T]).T
                     ax.fill_between(grid, lo, hi, color=color, alpha=0.2)
         fig.suptitle(f"{task} ({world})")  # a world with settings is too long for a panel's title
         axes[0].set(title="training episode return", xlabel="env steps", ylabel="return")

@@ -52,14 +52,16 @@ def cont_id(task: str) -> str:
 
 
 def make_continuous(task: str | TaskSpec, product: bool = False, render_mode: str | None = None,
-                    width: int = 240, height: int = 240, frame_skip: int | None = None) -> gym.Env:
+                    width: int = 240, height: int = 240, frame_skip: int | None = None,
+                    offsets: str = "linear") -> gym.Env:
     """Entry point of the MuJoCo ids; ``product=True`` adds the automaton one-hot,
-    ``frame_skip`` sets the physics steps per action (None: the world's default)."""
+    ``frame_skip`` sets the physics steps per action (None: the world's default),
+    ``offsets`` how object offsets are scaled (see ``ContinuousWorldEnv``)."""
     from .envs.continuous import ContinuousWorldEnv
     from .wrappers import AutomatonObservation
 
     skip = {} if frame_skip is None else {"frame_skip": frame_skip}
-    env = ContinuousWorldEnv(task, render_mode=render_mode, width=width, height=height, **skip)
+    env = ContinuousWorldEnv(task, render_mode=render_mode, width=width, height=height, offsets=offsets, **skip)
     return AutomatonObservation(env) if product else env
 
 

@@ -118,6 +118,25 @@ def test_frame_skip_sets_the_control_period():
         ContinuousWorldEnv(frame_skip=0)
 
 
+def test_sqrt_offsets_keep_sign_and_order_and_read_zero_once_consumed():
+    linear = gym.make("CraftSuite/BlindCraftsman-Cont-v0").unwrapped
+    rooted = gym.make("CraftSuite/BlindCraftsman-Cont-v0", offsets="sqrt").unwrapped
+    (a, _), (b, _) = linear.reset(seed=3), rooted.reset(seed=3)
+    objects = linear.observation_layout["objects"]
+    lin, root = a[objects].reshape(-1, 3)[:, :2], b[objects].reshape(-1, 3)[:, :2]
+    np.testing.assert_allclose(root, np.sign(lin) * np.sqrt(np.abs(lin)), atol=1e-6)
+    np.testing.assert_array_equal(a[:4], b[:4])  # the agent's own state is not rescaled
+    # the pickup radius reads sqrt(0.4 / 7) = 0.24 rather than 0.06
+    place_agent(rooted, rooted._positions[0] + np.array([-0.4, 0.0]))
+    rooted._write_observation(rooted._positions - rooted.data.qpos[:2])
+    assert rooted._obs_objects[0, 0] == pytest.approx(np.sqrt(0.4 / rooted.arena), rel=1e-5)
+    rooted._remove(0)
+    rooted._write_observation(rooted._positions - rooted.data.qpos[:2])
+    assert rooted._obs_objects[0].tolist() == [0.0, 0.0, 0.0]
+    with pytest.raises(ValueError, match="offsets must be one of"):
+        ContinuousWorldEnv(offsets="log")
+
+
 def test_boundary_push_costs_and_walls_hold():
     env = make()
     env.reset(seed=0)

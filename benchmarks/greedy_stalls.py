@@ -5,7 +5,8 @@ Usage: python benchmarks/greedy_stalls.py RUN_DIR [RUN_DIR ...] [--episodes N]
 For each finished (or checkpointed) MuJoCo student run, its last checkpoint plays the same
 fresh episodes four ways: greedy (the leaderboard's success), and with N(0, 0.1) or
 N(0, 0.3) added per step, or with the run's own training noise (its ``action_noise``
-spec). Then, for the greedy episodes that failed, it says how they ended: *stuck* (the
+spec), and a fifth way that asks the critic instead of the actor: each step the thrust of
+a 21 x 21 grid with the highest Q1 (is the actor, or the critic, what fails?). Then, for the greedy episodes that failed, it says how they ended: *stuck* (the
 agent stood or chattered within a 0.3 m box for its last 30 steps), with the distance from
 there to the nearest object of each kind, the actor's action there, and the critic's best
 action over a 21 x 21 grid of thrusts with the spread of its values.
@@ -33,8 +34,32 @@ def _load(run: Path):
     return config, load_agent(saved / "model.zip"), METHODS[config.method].product
 
 
-def play(model, config, product: bool, episodes: int, noise=None, seed: int = 7000) -> list[dict]:
-    """Episodes on seeds ``seed``, ``seed + 1``, ...; ``noise()`` (if given) is added to each action."""
+def _thrust_grid():
+    import torch as th
+
+    grid = np.linspace(-1, 1, 21)
+    return th.as_tensor(np.array([(x, y) for x in grid for y in grid], dtype=np.float32))
+
+
+def critic_values(model, obs: np.ndarray):
+    """Q1 of ``obs`` for every thrust of the grid: (thrusts, values)."""
+    import torch as th
+
+    actions = _thrust_grid()
+    obs = th.as_tensor(np.asarray(obs, dtype=np.float32)[None])
+    with th.no_grad():
+        q = model.critic.q1_forward(obs.repeat(len(actions), 1), actions)[:, 0].numpy()
+    return actions.numpy(), q
+
+
+def critic_greedy(model, obs: np.ndarray) -> np.ndarray:
+    actions, q = critic_values(model, obs)
+    return actions[int(q.argmax())]
+
+
+def play(model, config, product: bool, episodes: int, noise=None, seed: int = 7000, act=None) -> list[dict]:
+    """Episodes on seeds ``seed``, ``seed + 1``, ...; ``noise()`` (if given) is added to each
+    action; ``act(model, obs)`` (if given) replaces the actor."""
     import gymnasium as gym
 
     out = []
@@ -45,7 +70,7 @@ def play(model, config, product: bool, episodes: int, noise=None, seed: int = 70
             noise.reset()
         path = []
         while True:
-            action = model.predict(obs, deterministic=True)[0]
+            action = model.predict(obs, deterministic=True)[0] if act is None else act(model, obs)
             if noise is not None:
                 action = np.clip(action + noise(), -1, 1)
             obs, _, terminated, truncated, info = env.step(action)
@@ -66,13 +91,10 @@ def stall_report(model, episode: dict) -> dict | None:
     env, here = episode["env"].unwrapped, episode["path"][-1]
     nearest = {kind: min(float(np.hypot(*(np.array(p) - here))) for p in points)
                for kind, points in env.object_positions().items() if points}
-    grid = np.linspace(-1, 1, 21)
-    actions = th.as_tensor(np.array([(x, y) for x in grid for y in grid], dtype=np.float32))
-    obs = th.as_tensor(episode["obs"][None])
+    actions, q = critic_values(model, episode["obs"])
     with th.no_grad():
-        q = model.critic.q1_forward(obs.repeat(len(actions), 1), actions)[:, 0].numpy()
-        actor = model.actor(obs)[0].numpy()
-    return {"nearest": nearest, "actor": actor, "critic_best": actions[int(q.argmax())].numpy(),
+        actor = model.actor(th.as_tensor(episode["obs"][None]))[0].numpy()
+    return {"nearest": nearest, "actor": actor, "critic_best": actions[int(q.argmax())],
             "q_spread": float(q.max() - q.min()), "inventory": tuple(int(c) for c in env.inventory_counts),
             "at_wall": bool(np.abs(here).max() >= env._wall_limit - 0.01)}
 
@@ -95,12 +117,16 @@ def main(argv=None) -> None:
         ways = {"greedy": None,
                 "+ N(0, 0.1) per step": NormalActionNoise(np.zeros(2), np.full(2, 0.1)),
                 "+ N(0, 0.3) per step": NormalActionNoise(np.zeros(2), np.full(2, 0.3)),
-                f"+ its training noise {json.dumps(spec)}": make_action_noise(spec, 2, seed=0)}
+                f"+ its training noise {json.dumps(spec)}": make_action_noise(spec, 2, seed=0),
+                "the critic's best of 21 x 21 thrusts": "critic"}
         print(f"\n## {run.name}\n\n| actions | success ({args.episodes} episodes) |\n|---|---|")
         greedy = []
         for name, noise in ways.items():
             np.random.seed(0)  # NormalActionNoise draws from numpy's global generator
-            episodes = play(model, config, product, args.episodes, noise)
+            if noise == "critic":
+                episodes = play(model, config, product, args.episodes, act=critic_greedy)
+            else:
+                episodes = play(model, config, product, args.episodes, noise)
             if not greedy:
                 greedy = episodes  # the first way; its envs stay open for the stall reports
             else:

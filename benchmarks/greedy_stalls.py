@@ -3,13 +3,14 @@
 Usage: python benchmarks/greedy_stalls.py RUN_DIR [RUN_DIR ...] [--episodes N]
 
 For each finished (or checkpointed) MuJoCo student run, its last checkpoint plays the same
-fresh episodes four ways: greedy (the leaderboard's success), and with N(0, 0.1) or
-N(0, 0.3) added per step, or with the run's own training noise (its ``action_noise``
-spec), and a fifth way that asks the critic instead of the actor: each step the thrust of
-a 21 x 21 grid with the highest Q1 (is the actor, or the critic, what fails?). Then, for the greedy episodes that failed, it says how they ended: *stuck* (the
-agent stood or chattered within a 0.3 m box for its last 30 steps), with the distance from
-there to the nearest object of each kind, the actor's action there, and the critic's best
-action over a 21 x 21 grid of thrusts with the spread of its values.
+fresh episodes five ways: greedy (the leaderboard's success); with N(0, 0.1) or N(0, 0.3)
+added per step, or with the run's own training noise (its ``action_noise`` spec); and on
+the critic instead of the actor, each step the thrust of a 21 x 21 grid with the highest
+Q1 (is it the actor, or the critic, that fails?). Then, for the greedy episodes that
+failed, it says how they ended: *stuck* (the agent stood or chattered within a 0.3 m box
+for its last 30 steps), with the distance from there to the nearest object of each kind,
+the actor's action there, and the critic's best thrust on that grid with the spread of
+its values.
 """
 
 from __future__ import annotations
@@ -114,19 +115,16 @@ def main(argv=None) -> None:
     for run in args.runs:
         config, model, product = _load(run)
         spec = config.hyperparameters.get("action_noise", {"type": "normal", "sigma": 0.3})
-        ways = {"greedy": None,
-                "+ N(0, 0.1) per step": NormalActionNoise(np.zeros(2), np.full(2, 0.1)),
-                "+ N(0, 0.3) per step": NormalActionNoise(np.zeros(2), np.full(2, 0.3)),
-                f"+ its training noise {json.dumps(spec)}": make_action_noise(spec, 2, seed=0),
-                "the critic's best of 21 x 21 thrusts": "critic"}
+        ways = {"greedy": {},  # play() keywords
+                "+ N(0, 0.1) per step": {"noise": NormalActionNoise(np.zeros(2), np.full(2, 0.1))},
+                "+ N(0, 0.3) per step": {"noise": NormalActionNoise(np.zeros(2), np.full(2, 0.3))},
+                f"+ its training noise {json.dumps(spec)}": {"noise": make_action_noise(spec, 2, seed=0)},
+                "the critic's best of 21 x 21 thrusts": {"act": critic_greedy}}
         print(f"\n## {run.name}\n\n| actions | success ({args.episodes} episodes) |\n|---|---|")
         greedy = []
-        for name, noise in ways.items():
+        for name, how in ways.items():
             np.random.seed(0)  # NormalActionNoise draws from numpy's global generator
-            if noise == "critic":
-                episodes = play(model, config, product, args.episodes, act=critic_greedy)
-            else:
-                episodes = play(model, config, product, args.episodes, noise)
+            episodes = play(model, config, product, args.episodes, **how)
             if not greedy:
                 greedy = episodes  # the first way; its envs stay open for the stall reports
             else:

@@ -53,15 +53,15 @@ def cont_id(task: str) -> str:
 
 def make_continuous(task: str | TaskSpec, product: bool = False, render_mode: str | None = None,
                     width: int = 240, height: int = 240, frame_skip: int | None = None,
-                    offsets: str = "linear") -> gym.Env:
+                    offsets: str | None = None) -> gym.Env:
     """Entry point of the MuJoCo ids; ``product=True`` adds the automaton one-hot,
     ``frame_skip`` sets the physics steps per action (None: the world's default),
-    ``offsets`` how object offsets are scaled (see ``ContinuousWorldEnv``)."""
+    ``offsets`` how object offsets are scaled (None: the world's default; see ``ContinuousWorldEnv``)."""
     from .envs.continuous import ContinuousWorldEnv
     from .wrappers import AutomatonObservation
 
-    skip = {} if frame_skip is None else {"frame_skip": frame_skip}
-    env = ContinuousWorldEnv(task, render_mode=render_mode, width=width, height=height, offsets=offsets, **skip)
+    world = {k: v for k, v in {"frame_skip": frame_skip, "offsets": offsets}.items() if v is not None}
+    env = ContinuousWorldEnv(task, render_mode=render_mode, width=width, height=height, **world)
     return AutomatonObservation(env) if product else env
 
 

@@ -6,7 +6,8 @@ A run directory holds
 * ``episodes.csv``: one row per finished training episode (step, return, length, success);
 * ``evals.csv``: one row per evaluation (step, success rate, mean return, episodes);
 * ``checkpoint/``: the last model and replay buffer, written together at each evaluation;
-* ``tb/``: TensorBoard logs;
+* ``tb/``: TensorBoard logs (on resume, what the killed run logged after its checkpoint is
+  purged, as from the CSV logs);
 * ``result.json``: written last; its presence means the run is finished and reusable.
 
 Every whole-file write goes through a temporary file and ``os.replace``, so a killed run

@@ -154,6 +154,7 @@ class RunCallback(BaseCallback):
                                                      "return": round(ret, 4), "episodes": self.eval_episodes}])
         self.logger.record("eval/success", success)
         self.logger.record("eval/return", ret)
+        self.logger.dump(self.num_timesteps)  # at the evaluation's step, as SB3's EvalCallback does
         save_checkpoint(self.model, self.run)
         if self.bar is not None:
             self.bar.set_postfix(success=f"{success:.2f}")
@@ -182,6 +183,21 @@ def checkpoint_dir(run: RunDir) -> Path | None:
     return None
 
 
+# SB3 logs into tb/run_0: with reset_num_timesteps=False a resumed run reuses that directory.
+_TB_RUN = "run"
+
+
+def _purge_tensorboard(log_dir: Path, step: int) -> None:
+    """Have TensorBoard drop what a killed run logged after ``step``, the checkpoint resumed
+    from, as trim_logs does for the CSV logs: TensorBoard's own purge marker (a session
+    start, which drops every earlier event at or past its step) in a file of its own that
+    sorts before the resumed run's."""
+    from torch.utils.tensorboard import SummaryWriter
+
+    if log_dir.is_dir():
+        SummaryWriter(log_dir=str(log_dir), purge_step=step + 1).close()
+
+
 def _learn(run: RunDir, fresh, total: int, eval_every: int, eval_episodes: int, evaluate_fn, stop_at=None,
            progress=True, desc: str = ""):
     """Train ``fresh`` (or the run's checkpoint, if there is one) up to ``total`` steps."""
@@ -194,6 +210,7 @@ def _learn(run: RunDir, fresh, total: int, eval_every: int, eval_episodes: int, 
         agent.load_replay_buffer(saved / "replay.pkl")
         agent.replay_buffer.device = agent.device
         run.trim_logs(agent.num_timesteps)
+        _purge_tensorboard(run.path / "tb" / f"{_TB_RUN}_0", agent.num_timesteps)
     else:
         run.trim_logs(0)
     agent.tensorboard_log = str(run.path / "tb")
@@ -213,7 +230,7 @@ def _learn_loop(run, agent, total, eval_every, eval_episodes, evaluate_fn, stop_
         callback = RunCallback(run, total, eval_every, eval_episodes, evaluate_fn, stop_at, bar)
         if agent.num_timesteps < total and not _stopped(run, stop_at):
             agent.learn(total - agent.num_timesteps, callback=callback, reset_num_timesteps=False,
-                        tb_log_name="run")
+                        tb_log_name=_TB_RUN)
     return agent
 
 

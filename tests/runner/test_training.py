@@ -130,6 +130,41 @@ def test_a_killed_run_resumes_from_its_checkpoint(tmp_path):
     assert json.loads((run / "result.json").read_text())["steps"] == 3_000
 
 
+def _scalar_steps(log_dir) -> dict[str, list[int]]:
+    """Each TensorBoard scalar's steps, as TensorBoard shows them (purges applied)."""
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    events = EventAccumulator(str(log_dir))
+    events.Reload()
+    return {tag: [e.step for e in events.Scalars(tag)] for tag in events.Tags()["scalars"]}
+
+
+def test_a_resumed_run_drops_what_tensorboard_logged_after_its_checkpoint(tmp_path, monkeypatch):
+    import craftsuite.training as training
+
+    config = StudentConfig(method="td3", steps=600, eval_every=200, eval_episodes=1,
+                           world_kwargs={"frame_skip": 10, "max_episode_steps": 40},
+                           hyperparameters={"learning_starts": 100, "policy_kwargs": {"net_arch": [16]}})
+    on_step = training.RunCallback._on_step
+
+    def dies_at_350(self):  # after the checkpoint at 200 and a rollout log at 320 (every 4 episodes of 40)
+        if self.num_timesteps >= 350:
+            raise KeyboardInterrupt
+        return on_step(self)
+
+    monkeypatch.setattr(training.RunCallback, "_on_step", dies_at_350)
+    with pytest.raises(KeyboardInterrupt):
+        train_student(config, tmp_path, progress=False)
+    (log_dir,) = tmp_path.glob("*/tb/run_0")
+    assert 320 in _scalar_steps(log_dir)["rollout/ep_rew_mean"]  # logged, then lost with the kill
+    monkeypatch.setattr(training.RunCallback, "_on_step", on_step)
+    train_student(config, tmp_path, progress=False)  # resumes from step 200
+    steps = _scalar_steps(log_dir)
+    assert steps["eval/success"] == [200, 400, 600]  # each at its evaluation's step, none twice
+    assert steps["rollout/ep_rew_mean"] == [160, 360, 520]  # the killed run's 320 is gone
+    assert all(s == sorted(set(s)) for s in steps.values())
+
+
 def test_a_student_trains_and_is_evaluated_in_the_world_its_config_names(tmp_path, monkeypatch):
     import craftsuite.training as training
 

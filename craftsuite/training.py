@@ -121,6 +121,8 @@ class RunCallback(BaseCallback):
         self.pending: list[dict] = []
 
     def _on_training_start(self) -> None:
+        if self.num_timesteps > 0:  # resumed from a checkpoint
+            _purge_tensorboard(self.logger, self.num_timesteps)
         self.next_eval = (self.num_timesteps // self.eval_every + 1) * self.eval_every
         self.next_flush = self.num_timesteps + 1_000
         if self.bar is not None:
@@ -161,6 +163,19 @@ class RunCallback(BaseCallback):
         return self.stop_at is None or success < self.stop_at
 
 
+def _purge_tensorboard(logger, step: int) -> None:
+    """Have TensorBoard drop what a killed run logged after ``step``, the checkpoint resumed
+    from, as trim_logs does for the CSV logs. SB3 resumes into the same TensorBoard
+    directory; a session start (TensorBoard's purge marker, SummaryWriter's ``purge_step``)
+    at the head of its new event file drops every earlier event at or past the marker's step."""
+    from stable_baselines3.common.logger import TensorBoardOutputFormat
+    from tensorboard.compat.proto.event_pb2 import Event, SessionLog
+
+    for output in logger.output_formats:
+        if isinstance(output, TensorBoardOutputFormat):
+            output.writer.file_writer.add_event(Event(step=step + 1, session_log=SessionLog(status=SessionLog.START)))
+
+
 def save_checkpoint(agent, run: RunDir) -> None:
     """Model and replay buffer together: written beside, then swapped in."""
     new, final, old = run.path / "checkpoint-new", run.checkpoint.parent, run.path / "checkpoint-old"
@@ -183,21 +198,6 @@ def checkpoint_dir(run: RunDir) -> Path | None:
     return None
 
 
-# SB3 logs into tb/run_0: with reset_num_timesteps=False a resumed run reuses that directory.
-_TB_RUN = "run"
-
-
-def _purge_tensorboard(log_dir: Path, step: int) -> None:
-    """Have TensorBoard drop what a killed run logged after ``step``, the checkpoint resumed
-    from, as trim_logs does for the CSV logs: TensorBoard's own purge marker (a session
-    start, which drops every earlier event at or past its step) in a file of its own that
-    sorts before the resumed run's."""
-    from torch.utils.tensorboard import SummaryWriter
-
-    if log_dir.is_dir():
-        SummaryWriter(log_dir=str(log_dir), purge_step=step + 1).close()
-
-
 def _learn(run: RunDir, fresh, total: int, eval_every: int, eval_episodes: int, evaluate_fn, stop_at=None,
            progress=True, desc: str = ""):
     """Train ``fresh`` (or the run's checkpoint, if there is one) up to ``total`` steps."""
@@ -210,7 +210,6 @@ def _learn(run: RunDir, fresh, total: int, eval_every: int, eval_episodes: int, 
         agent.load_replay_buffer(saved / "replay.pkl")
         agent.replay_buffer.device = agent.device
         run.trim_logs(agent.num_timesteps)
-        _purge_tensorboard(run.path / "tb" / f"{_TB_RUN}_0", agent.num_timesteps)
     else:
         run.trim_logs(0)
     agent.tensorboard_log = str(run.path / "tb")
@@ -230,7 +229,7 @@ def _learn_loop(run, agent, total, eval_every, eval_episodes, evaluate_fn, stop_
         callback = RunCallback(run, total, eval_every, eval_episodes, evaluate_fn, stop_at, bar)
         if agent.num_timesteps < total and not _stopped(run, stop_at):
             agent.learn(total - agent.num_timesteps, callback=callback, reset_num_timesteps=False,
-                        tb_log_name=_TB_RUN)
+                        tb_log_name="run")
     return agent
 
 

@@ -48,6 +48,8 @@ class CRMReplayBuffer(AutomatonReplayBuffer):
 
     def __init__(self, buffer_size, observation_space, action_space, device="auto", n_envs: int = 1, *,
                  automaton: Automaton, completion_reward: float, **kwargs):
+        if kwargs.get("n_steps", 1) != 1:  # its columns are counterfactual states, not trajectories
+            raise ValueError("CRM stores one-step counterfactual experiences: n_steps must be 1")
         self.automaton, self.completion_reward = automaton, completion_reward
         self.n_real_envs = n_envs
         self.n_live = int((~(automaton.accepting | automaton.rejecting)).sum())

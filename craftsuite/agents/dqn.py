@@ -59,14 +59,17 @@ class AutomatonDQN(DQN):
         dueling: with ``policy="MlpPolicy"``, use ``DuelingDQNPolicy``.
         prioritized: prioritized replay (``AutomatonReplayBuffer``), else uniform.
         distill: a ``DistilledTarget`` for students; None for teachers and baselines.
+        n_steps: n-step returns from the replay buffer (1: the one-step target).
     """
 
     def __init__(self, policy, env, *, double: bool = True, dueling: bool = True, prioritized: bool = True,
-                 distill: DistilledTarget | None = None, replay_buffer_kwargs: dict | None = None, **kwargs):
+                 distill: DistilledTarget | None = None, n_steps: int = 1,
+                 replay_buffer_kwargs: dict | None = None, **kwargs):
         if dueling and policy == "MlpPolicy":
             policy = DuelingDQNPolicy
         kwargs.setdefault("replay_buffer_class", AutomatonReplayBuffer)
-        replay_buffer_kwargs = {"prioritized": prioritized, **(replay_buffer_kwargs or {})}
+        replay_buffer_kwargs = {"prioritized": prioritized, "n_steps": n_steps, "gamma": kwargs.get("gamma", 0.99),
+                                **(replay_buffer_kwargs or {})}
         self.double = double
         self.distill = distill
         super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, **kwargs)
@@ -80,7 +83,8 @@ class AutomatonDQN(DQN):
                 next_q = th.gather(next_q, dim=1, index=best)
             else:
                 next_q = next_q.max(dim=1, keepdim=True)[0]
-            target = data.rewards + (1 - data.dones) * self.gamma * next_q
+            discount = self.gamma if data.discounts is None else data.discounts  # gamma ** k after k rewards
+            target = data.rewards + (1 - data.dones) * discount * next_q
             if self.distill is not None:
                 target = self.distill(data.w, data.sigma, target)
         return target

@@ -5,6 +5,10 @@ automaton transition ``(w, sigma, w')`` that the world put in ``info["automaton_
 (SB3 hands ``add`` the infos of the step, including the terminal step of an episode under
 autoreset), and samples by priority: P(i) ~ p_i ** alpha, importance weights
 (N P(i)) ** -beta normalised by their maximum, new transitions at the maximum priority.
+With ``n_steps`` > 1 it samples n-step returns as SB3's ``NStepReplayBuffer`` does: the
+discounted rewards up to n steps or the episode's end, the observation there, and the
+discount ``gamma ** k`` for its bootstrap, in ``discounts``; the automaton fields and
+priorities stay those of the first transition.
 """
 
 from __future__ import annotations
@@ -77,15 +81,22 @@ class AutomatonReplayBuffer(ReplayBuffer):
         alpha: priority exponent (0.7 in the paper's code).
         beta: importance-weight exponent.
         epsilon: added to |TD error| when priorities are updated (0.1 in the paper's code).
+        n_steps: return length (1: one-step samples, ``discounts`` None).
+        gamma: the discount of n-step returns (the algorithm's).
     """
 
     def __init__(self, buffer_size: int, observation_space: spaces.Space, action_space: spaces.Space,
                  device: th.device | str = "auto", n_envs: int = 1, optimize_memory_usage: bool = False,
                  handle_timeout_termination: bool = True, prioritized: bool = True,
-                 alpha: float = 0.7, beta: float = 0.4, epsilon: float = 0.1):
+                 alpha: float = 0.7, beta: float = 0.4, epsilon: float = 0.1, n_steps: int = 1, gamma: float = 0.99):
+        if not isinstance(n_steps, int) or isinstance(n_steps, bool) or n_steps < 1:
+            raise ValueError(f"n_steps must be a positive integer, got {n_steps!r}")
+        if n_steps > 1 and optimize_memory_usage:
+            raise ValueError("n-step returns need next_observations: n_steps > 1 with optimize_memory_usage=True")
         super().__init__(buffer_size, observation_space, action_space, device, n_envs,
                          optimize_memory_usage=optimize_memory_usage,
                          handle_timeout_termination=handle_timeout_termination)
+        self.n_steps, self.gamma = n_steps, gamma
         self.w = np.zeros((self.buffer_size, self.n_envs), dtype=np.int32)
         self.sigma = np.zeros((self.buffer_size, self.n_envs), dtype=np.int32)
         self.w_next = np.zeros((self.buffer_size, self.n_envs), dtype=np.int32)
@@ -108,6 +119,7 @@ class AutomatonReplayBuffer(ReplayBuffer):
         return state
 
     def __setstate__(self, state: dict) -> None:
+        state = {"n_steps": 1, "gamma": 0.99, **state}  # checkpoints from before n-step returns
         self.__dict__.update(state)
         for name in self._ROWS:
             rows = getattr(self, name, None)
@@ -150,20 +162,39 @@ class AutomatonReplayBuffer(ReplayBuffer):
 
     def _samples(self, flat: np.ndarray, weights: np.ndarray, env=None) -> AutomatonSamples:
         batch, envs = np.divmod(flat, self.n_envs)
+        if self.n_steps > 1:
+            last, rewards, discounts = self._n_step(batch, envs, env)
+        else:
+            last, discounts = batch, None
+            rewards = self._normalize_reward(self.rewards[batch, envs], env)
         if self.optimize_memory_usage:
             next_obs = self.observations[(batch + 1) % self.buffer_size, envs, :]
         else:
-            next_obs = self.next_observations[batch, envs, :]
-        dones = self.dones[batch, envs] * (1 - self.timeouts[batch, envs])
+            next_obs = self.next_observations[last, envs, :]
+        dones = self.dones[last, envs] * (1 - self.timeouts[last, envs])
         tensors = tuple(map(self.to_torch, (
             self._normalize_obs(self.observations[batch, envs, :], env),
             self.actions[batch, envs, :],
             self._normalize_obs(next_obs, env),
             dones.reshape(-1, 1),
-            self._normalize_reward(self.rewards[batch, envs].reshape(-1, 1), env),
+            rewards.reshape(-1, 1),
         )))
-        return AutomatonSamples(*tensors, None, self.to_torch(weights.reshape(-1, 1)), flat,
+        return AutomatonSamples(*tensors, None if discounts is None else self.to_torch(discounts.reshape(-1, 1)),
+                                self.to_torch(weights.reshape(-1, 1)), flat,
                                 self.w[batch, envs], self.sigma[batch, envs], self.w_next[batch, envs])
+
+    def _n_step(self, batch: np.ndarray, envs: np.ndarray, env=None):
+        """For each sampled row: the row that ends its n-step window (at an episode's end, or
+        at the newest row, whose successor is not written yet), the discounted rewards up
+        to it, and ``gamma ** k`` for the bootstrap after its k rows."""
+        rows = (batch[:, None] + np.arange(self.n_steps)) % self.buffer_size
+        ends = (self.dones[rows, envs[:, None]] > 0) | (self.timeouts[rows, envs[:, None]] > 0)
+        ends |= rows == (self.pos - 1) % self.buffer_size
+        k = np.where(ends.any(axis=1), ends.argmax(axis=1), self.n_steps - 1) + 1
+        inside = np.arange(self.n_steps) < k[:, None]
+        rewards = self._normalize_reward(self.rewards[rows, envs[:, None]], env)
+        returns = (rewards * inside * self.gamma ** np.arange(self.n_steps)).sum(axis=1)
+        return rows[np.arange(len(batch)), k - 1], returns.astype(np.float32), (self.gamma ** k).astype(np.float32)
 
     def update_priorities(self, indices: np.ndarray, td_errors: np.ndarray) -> None:
         """New priorities |TD error| + epsilon for the sampled transitions."""

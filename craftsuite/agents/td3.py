@@ -3,7 +3,8 @@ delay schedule and, for distilled students, the distilled target.
 
 Where this differs from SB3's TD3, and nowhere else:
 * ``AutomatonTD3._td_target``: the one seam for the target (clipped double-Q with target
-  policy smoothing, as SB3; then the distilled mix when a ``DistilledTarget`` is given).
+  policy smoothing, as SB3, after n rewards when ``n_steps`` > 1; then the distilled mix
+  when a ``DistilledTarget`` is given).
 * ``AutomatonTD3.train``: SB3's loop, with the critic loss weighted by importance weights,
   priorities updated from the first critic's TD errors, and the actor delayed by
   ``policy_delay_at(num_timesteps)`` (4 for the first 20,000 steps, 2 afterwards).
@@ -28,12 +29,15 @@ class AutomatonTD3(TD3):
         prioritized: prioritized replay (``AutomatonReplayBuffer``), else uniform.
         distill: a ``DistilledTarget``; None for TD3 from scratch and product TD3.
         delay_schedule: ``((until_step, delay), ..., (None, delay))``.
+        n_steps: n-step returns from the replay buffer (1: SB3's one-step target).
     """
 
     def __init__(self, policy, env, *, prioritized: bool = True, distill: DistilledTarget | None = None,
-                 delay_schedule=((20_000, 4), (None, 2)), replay_buffer_kwargs: dict | None = None, **kwargs):
+                 delay_schedule=((20_000, 4), (None, 2)), n_steps: int = 1,
+                 replay_buffer_kwargs: dict | None = None, **kwargs):
         kwargs.setdefault("replay_buffer_class", AutomatonReplayBuffer)
-        replay_buffer_kwargs = {"prioritized": prioritized, **(replay_buffer_kwargs or {})}
+        replay_buffer_kwargs = {"prioritized": prioritized, "n_steps": n_steps, "gamma": kwargs.get("gamma", 0.99),
+                                **(replay_buffer_kwargs or {})}
         self.distill = distill
         self.delay_schedule = tuple(delay_schedule)
         super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, **kwargs)
@@ -51,7 +55,8 @@ class AutomatonTD3(TD3):
             next_actions = (self.actor_target(data.next_observations) + noise).clamp(-1, 1)
             next_q = th.cat(self.critic_target(data.next_observations, next_actions), dim=1)
             next_q = th.min(next_q, dim=1, keepdim=True)[0]
-            target = data.rewards + (1 - data.dones) * self.gamma * next_q
+            discount = self.gamma if data.discounts is None else data.discounts  # gamma ** k after k rewards
+            target = data.rewards + (1 - data.dones) * discount * next_q
             if self.distill is not None:
                 target = self.distill(data.w, data.sigma, target)
         return target

@@ -53,6 +53,36 @@ def test_cont_methods_train(method, table):
     assert agent.policy_delay_at(100) == 4 and agent.policy_delay_at(25_000) == 2
 
 
+@pytest.mark.parametrize("method", ["td3-dynamic", "product-dqn"])
+def test_n_step_targets_bootstrap_with_the_buffers_discounts(method, table):
+    import torch as th
+
+    world = CONT if method.startswith("td3") else GRID
+    small = dict(SMALL_TD3, target_policy_noise=0.0) if method.startswith("td3") else SMALL_DQN
+    agent = make_agent(method, world, table=table, seed=2, n_steps=4, gamma=0.9, **small)
+    agent.learn(150)
+    buf = agent.replay_buffer
+    assert (buf.n_steps, buf.gamma) == (4, 0.9)
+    data = buf.sample(64)
+    k = np.log(data.discounts.numpy().ravel()) / np.log(0.9)  # gamma ** k after k rewards
+    assert np.allclose(k, np.round(k)) and set(np.round(k)) <= {1, 2, 3, 4}
+    assert (data.discounts.numpy() < 0.7).any()  # most windows run all four steps
+    with th.no_grad():
+        if method.startswith("td3"):
+            nxt = agent.critic_target(data.next_observations, agent.actor_target(data.next_observations))
+            next_q = th.min(th.cat(nxt, dim=1), dim=1, keepdim=True)[0]
+        else:
+            best = agent.q_net(data.next_observations).argmax(dim=1, keepdim=True)
+            next_q = th.gather(agent.q_net_target(data.next_observations), 1, best)
+        expected = data.rewards + (1 - data.dones) * data.discounts * next_q
+        if agent.distill is not None:
+            agent.distill.student_counts[:] = 10**6  # beta = 0: the student's own target alone
+            expected = agent.distill(data.w, data.sigma, expected)
+        assert th.allclose(agent._td_target(data), expected)
+    with pytest.raises(ValueError, match="CRM stores one-step"):
+        make_agent("crm", GRID, n_steps=3, **SMALL_DQN)
+
+
 def test_method_and_world_must_match(table):
     with pytest.raises(ValueError, match="for MuJoCo"):
         make_agent("td3", GRID)

@@ -94,3 +94,74 @@ def test_uniform_sampling_has_unit_weights():
     s = buf.sample(32)
     assert (s.weights.numpy() == 1).all() and s.indices.max() < 20
     buf.update_priorities(s.indices, np.ones(32))  # a no-op, not an error
+
+
+def _chain(buffer_size, rewards, ends=(), truncated=(), n_steps=3, gamma=0.5):
+    """A one-env buffer holding transitions t = 0, 1, ... with observation t, next observation
+    t + 0.5 and the given rewards; episodes end (terminated) after the steps in ``ends``,
+    by the time limit after those in ``truncated``."""
+    space = gym.spaces.Box(-100, 100, (1,), np.float32)
+    buf = AutomatonReplayBuffer(buffer_size, space, space, prioritized=False, n_steps=n_steps, gamma=gamma)
+    for t, r in enumerate(rewards):
+        info = {"automaton_transition": (0, 0, 0), "TimeLimit.truncated": t in truncated}
+        buf.add(np.array([[t]]), np.array([[t + 0.5]]), np.zeros((1, 1)), np.array([r]),
+                np.array([t in ends or t in truncated]), [info])
+    return buf
+
+
+def _sampled(buf, expected):
+    """Every row of ``expected`` ({row: (return, discount, done, next obs)}) as sampled."""
+    s = buf.sample(256)
+    got = {int(i): (float(r), float(d), float(done), float(nxt))
+           for i, r, d, done, nxt in zip(s.indices, s.rewards[:, 0], s.discounts[:, 0], s.dones[:, 0],
+                                         s.next_observations[:, 0])}
+    assert got == expected
+
+
+def test_n_step_returns_stop_at_episode_ends_and_bootstrap_after_truncation():
+    # t:       0  1  2 (terminated)  3  4 (time limit)  5 (the newest)
+    buf = _chain(10, [1, 2, 4, 8, 16, 32], ends={2}, truncated={4})
+    _sampled(buf, {
+        0: (1 + 0.5 * 2 + 0.25 * 4, 0.125, 1.0, 2.5),  # three rewards, the last one terminal: no bootstrap
+        1: (2 + 0.5 * 4, 0.25, 1.0, 2.5),
+        2: (4, 0.5, 1.0, 2.5),
+        3: (8 + 0.5 * 16, 0.25, 0.0, 4.5),  # cut by the time limit: bootstrapped from its last observation
+        4: (16, 0.5, 0.0, 4.5),
+        5: (32, 0.5, 0.0, 5.5),  # its successor is not stored yet
+    })
+
+
+def test_n_step_windows_never_run_from_the_newest_row_into_the_oldest():
+    # four rows, six transitions: rows hold t = 4, 5, 2, 3; row 1 (t = 5) is the newest
+    buf = _chain(4, [1, 2, 4, 8, 16, 32])
+    _sampled(buf, {
+        2: (4 + 0.5 * 8 + 0.25 * 16, 0.125, 0.0, 4.5),  # t = 2, 3, 4 across the wrap
+        3: (8 + 0.5 * 16 + 0.25 * 32, 0.125, 0.0, 5.5),
+        0: (16 + 0.5 * 32, 0.25, 0.0, 5.5),  # stops at the newest row, not on into t = 2
+        1: (32, 0.5, 0.0, 5.5),
+    })
+
+
+def test_one_step_samples_are_unchanged_and_bad_n_steps_are_refused():
+    buf = _chain(10, [1, 2, 4], ends={2}, n_steps=1)
+    s = buf.sample(64)
+    assert s.discounts is None
+    assert np.allclose(s.rewards[:, 0].numpy(), np.array([1, 2, 4])[s.indices])
+    space = gym.spaces.Box(-1, 1, (1,), np.float32)
+    for bad in (0, 2.5, True):
+        with pytest.raises(ValueError, match="n_steps must be a positive integer"):
+            AutomatonReplayBuffer(10, space, space, n_steps=bad)
+    with pytest.raises(ValueError, match="optimize_memory_usage"):
+        AutomatonReplayBuffer(10, space, space, n_steps=3, optimize_memory_usage=True)
+
+
+def test_checkpoints_keep_n_steps_and_old_ones_load_as_one_step():
+    import pickle
+
+    buf = pickle.loads(pickle.dumps(_chain(10, [1, 2, 4], n_steps=3)))
+    assert (buf.n_steps, buf.gamma) == (3, 0.5) and buf.sample(8).discounts is not None
+    state = _chain(10, [1, 2, 4], n_steps=1).__getstate__()
+    del state["n_steps"], state["gamma"]  # as pickled before n-step returns existed
+    old = AutomatonReplayBuffer.__new__(AutomatonReplayBuffer)
+    old.__setstate__(state)
+    assert old.sample(8).discounts is None

@@ -66,7 +66,7 @@ def test_n_step_targets_bootstrap_with_the_buffers_discounts(method, table):
     data = buf.sample(64)
     k = np.log(data.discounts.numpy().ravel()) / np.log(0.9)  # gamma ** k after k rewards
     assert np.allclose(k, np.round(k)) and set(np.round(k)) <= {1, 2, 3, 4}
-    assert (data.discounts.numpy() < 0.7).any()  # most windows run all four steps
+    assert (data.discounts.numpy() < 0.7).any()  # some windows run all four steps
     with th.no_grad():
         if method.startswith("td3"):
             nxt = agent.critic_target(data.next_observations, agent.actor_target(data.next_observations))

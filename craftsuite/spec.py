@@ -9,6 +9,7 @@ Format (see ``tasks/blind_craftsman.toml`` for a full example)::
 
     name = "BlindCraftsman"          # CamelCase; ids are CraftSuite/<name>-Grid<size>-v0
     formula = "G(wood -> F factory) & F(tools3 & home)"
+    tags = ["paper", "hard"]         # optional: rungs of the ladder (craftsuite tasks --tag hard)
     extends = "other_spec"           # optional: start from tasks/other_spec.toml
 
     [propositions]                   # bit order = order written here
@@ -47,7 +48,8 @@ Format (see ``tasks/blind_craftsman.toml`` for a full example)::
     arena = 7.0                      # side of the square arena
     pickup_radius = 0.4              # an object is touched within this distance
     boundary_reward = -0.1           # per step of pushing against the boundary
-    max_steps = 1000
+    control_period = 0.25            # seconds each action is held (whole physics steps of 0.025 s)
+    max_steps = 200                  # decisions per episode
 """
 
 from __future__ import annotations
@@ -64,9 +66,14 @@ from .automata.ltlf import atoms
 from .paths import tasks_dir
 
 __all__ = [
-    "SpecError", "TaskSpec", "Item", "Place", "Recipe", "Proposition", "GridConfig", "ContinuousConfig",
+    "LEVELS", "SpecError", "TaskSpec", "Item", "Place", "Recipe", "Proposition", "GridConfig", "ContinuousConfig",
     "load_spec", "builtin_specs",
 ]
+
+
+# Difficulty tags, easiest first: the ladder's order. "calibration" marks the rung every
+# algorithm should pass before its results above mean anything; "paper", the paper's tasks.
+LEVELS = ("easy", "medium", "hard")
 
 
 class SpecError(ValueError):
@@ -126,12 +133,18 @@ class GridConfig:
 
 @dataclass(frozen=True)
 class ContinuousConfig:
-    """The MuJoCo world of a task; obstacles come from ``GridConfig`` (scaled to the arena)."""
+    """The MuJoCo world of a task; obstacles come from ``GridConfig`` (scaled to the arena).
+
+    The default control period, 0.25 s, puts a decision on the grid teacher's time scale
+    (about 14 decisions to cross the arena, as a 7x7 grid is crossed in 6 moves): every
+    TD3 student that learned a task here learned it at this period, none at 0.05 s.
+    """
 
     arena: float = 7.0
     pickup_radius: float = 0.4
     boundary_reward: float = -0.1
-    max_steps: int = 1000
+    control_period: float = 0.25  # seconds each action is held
+    max_steps: int = 200  # decisions per episode: 50 s at the default period
 
 
 @dataclass(frozen=True)
@@ -147,7 +160,19 @@ class TaskSpec:
     grid: GridConfig
     continuous: ContinuousConfig = ContinuousConfig()
     description: str = ""
+    tags: tuple[str, ...] = ()  # rungs of the ladder: difficulty ("easy", ...), "paper", ...
     path: Path | None = None
+
+    @property
+    def level(self) -> str | None:
+        """The spec's difficulty: the first of its tags among ``LEVELS`` (None: untagged)."""
+        return next((t for t in self.tags if t in LEVELS), None)
+
+    @property
+    def rung(self) -> tuple:
+        """Sort key of the ladder: by level, calibration tasks first within one, then by name."""
+        level = LEVELS.index(self.level) if self.level else len(LEVELS)
+        return level, "calibration" not in self.tags, self.name
 
     @property
     def proposition_names(self) -> tuple[str, ...]:
@@ -177,7 +202,7 @@ _PALETTE = ["#8b5a2b", "#d9822b", "#3d7dd8", "#7b4fb5", "#2ca58d", "#d64550", "#
 _NAME = re.compile(r"[a-z_][a-z0-9_]*\Z")
 _TASK_NAME = re.compile(r"[A-Z][A-Za-z0-9]*\Z")
 _COLOR = re.compile(r"#[0-9a-fA-F]{6}\Z")
-_TOP_KEYS = {"name", "formula", "description", "extends", "propositions", "items", "places",
+_TOP_KEYS = {"name", "formula", "description", "tags", "extends", "propositions", "items", "places",
              "recipes", "rewards", "grid", "continuous"}
 
 
@@ -449,16 +474,19 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
             r.fail("grid.obstacles", "the corner cell (0, 0) is taken by a 'corner' place")
 
     raw_cont = r.table(data.get("continuous", {}), "continuous")
-    r.keys(raw_cont, {"arena", "pickup_radius", "boundary_reward", "max_steps"}, "continuous")
+    r.keys(raw_cont, {"arena", "pickup_radius", "boundary_reward", "control_period", "max_steps"}, "continuous")
     default = ContinuousConfig()
     continuous = ContinuousConfig(
         arena=r.float(raw_cont, "arena", "continuous", default.arena),
         pickup_radius=r.float(raw_cont, "pickup_radius", "continuous", default.pickup_radius),
         boundary_reward=r.float(raw_cont, "boundary_reward", "continuous", default.boundary_reward),
+        control_period=r.float(raw_cont, "control_period", "continuous", default.control_period),
         max_steps=r.int(raw_cont, "max_steps", "continuous", default=default.max_steps, minimum=1),
     )
     if continuous.arena <= 0 or continuous.pickup_radius <= 0:
         r.fail("continuous", "arena and pickup_radius must be positive")
+    if not continuous.control_period > 0:
+        r.fail("continuous.control_period", f"must be > 0 seconds, got {continuous.control_period!r}")
     spacing = 2 * continuous.pickup_radius
     per_side = int((continuous.arena - spacing) // spacing)
     if n_objects + 1 > per_side * per_side:
@@ -468,12 +496,17 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
     description = data.get("description", "")
     if not isinstance(description, str):
         r.fail("description", "must be a string")
+    tags = data.get("tags", [])
+    if not isinstance(tags, list) or any(not isinstance(t, str) or not _NAME.match(t) for t in tags):
+        r.fail("tags", f"must be a list of lower-case identifiers, e.g. [\"easy\", \"paper\"], got {tags!r}")
+    if len(set(tags)) != len(tags):
+        r.fail("tags", f"lists a tag twice: {tags!r}")
     return TaskSpec(
         name=name, formula=formula, propositions=tuple(props), items=tuple(items),
         places=tuple(places), recipes=tuple(recipes),
         step_reward=r.float(rewards, "step", "rewards", -0.1),
         completion_reward=r.float(rewards, "completion", "rewards", 100.0),
-        grid=grid, continuous=continuous, description=description.strip(), path=path,
+        grid=grid, continuous=continuous, description=description.strip(), tags=tuple(tags), path=path,
     )
 
 

@@ -39,7 +39,8 @@ def write(tmp_path, text, name="treasure.toml"):
 
 def test_builtin_specs():
     specs = builtin_specs()
-    assert set(specs) == {"BlindCraftsman", "BlindCraftsmanObstacles", "DungeonQuest", "DiamondMine"}
+    assert set(specs) == {"Reach", "FirstWood", "FirstTool",
+                          "BlindCraftsman", "BlindCraftsmanObstacles", "DungeonQuest", "DiamondMine"}
     bc = specs["BlindCraftsman"]
     assert bc.proposition_names == ("wood", "factory", "tools3", "home")
     assert bc.inventory == ("wood", "tools")
@@ -54,7 +55,7 @@ def test_extends_merges_the_base_spec():
     specs = builtin_specs()
     obstacles, base = specs["BlindCraftsmanObstacles"], specs["BlindCraftsman"]
     assert obstacles.formula == base.formula and obstacles.items == base.items
-    assert obstacles.grid.sizes == (10,)
+    assert obstacles.grid.sizes == (7, 10)
     assert (3, 5) in obstacles.grid.obstacles
     assert obstacles.grid.max_steps == base.grid.max_steps
 
@@ -78,6 +79,11 @@ BAD = [
     (('name = "Treasure"', 'name = "treasure hunt"'), "name", "CamelCase"),
     (("max_steps = 50", "max_steps = 50\nobstacles = [[9, 9]]"), "grid.obstacles", "outside the 5x5 grid"),
     (("[places.trap]", "[places.trap]\nplacement = \"middle\""), "places.trap.placement", "'random' or 'corner'"),
+    (('name = "Treasure"', 'name = "Treasure"\ntags = "easy"'), "tags", "must be a list of lower-case identifiers"),
+    (('name = "Treasure"', 'name = "Treasure"\ntags = ["Easy"]'), "tags", "must be a list of lower-case identifiers"),
+    (('name = "Treasure"', 'name = "Treasure"\ntags = ["easy", "easy"]'), "tags", "lists a tag twice"),
+    (("[grid]", "[continuous]\ncontrol_period = 0\n[grid]"), "continuous.control_period", "must be > 0 seconds"),
+    (("[grid]", "[continuous]\ncontrol_period = -0.25\n[grid]"), "continuous.control_period", "must be > 0"),
 ]
 
 

@@ -9,6 +9,9 @@ import gymnasium as gym
 from .spec import TaskSpec, builtin_specs, load_spec
 
 NAMESPACE = "CraftSuite"
+# The kinds of world every task is registered in: grids (one id per size, ``Grid7``,
+# ``Grid10``) and the MuJoCo world (``Cont``).
+WORLD_KINDS = ("Grid", "Cont")
 _TASKS: dict[str, TaskSpec] = {}
 
 
@@ -19,6 +22,22 @@ def tasks() -> dict[str, TaskSpec]:
     return _TASKS
 
 
+def ladder(*tags: str) -> list[TaskSpec]:
+    """The known tasks as rungs of a ladder, easiest first (``TaskSpec.rung``); with
+    ``tags``, only those that carry any of them.
+
+    Raises:
+        KeyError: a tag that no task spec carries, naming the tags in use.
+    """
+    known = tasks().values()
+    in_use = sorted({t for spec in known for t in spec.tags})
+    unknown = [t for t in tags if t not in in_use]
+    if unknown:
+        raise KeyError(f"no task spec has {'tag' if len(unknown) == 1 else 'tags'} {unknown} in its 'tags' field; "
+                       f"tags in use: {in_use}")
+    return sorted((s for s in known if not tags or set(tags) & set(s.tags)), key=lambda s: s.rung)
+
+
 def resolve_task(task: str | TaskSpec) -> TaskSpec:
     if isinstance(task, TaskSpec):
         return task
@@ -27,6 +46,25 @@ def resolve_task(task: str | TaskSpec) -> TaskSpec:
         raise KeyError(f"unknown task {task!r}; known tasks: {sorted(known)} "
                        "(add one with craftsuite.register_task)")
     return known[task]
+
+
+def world_kind(world: str) -> str:
+    """The kind of a student world: ``Grid10`` -> ``Grid``, ``Cont`` -> ``Cont``."""
+    if world == "Cont":
+        return "Cont"
+    if world.startswith("Grid") and world[4:].isdigit():
+        return "Grid"
+    raise ValueError(f"unknown world {world!r}: use Cont (MuJoCo) or Grid<size>, e.g. Grid10")
+
+
+def parse_id(env_id: str) -> tuple[str, str]:
+    """``CraftSuite/<Task>-<World>-v0`` -> (task, world), e.g. ("Reach", "Grid10")."""
+    namespace, _, rest = env_id.partition("/")
+    parts = rest.split("-")
+    if namespace != NAMESPACE or len(parts) != 3 or parts[2] != "v0":
+        raise ValueError(f"{env_id!r} is not a CraftSuite id ({NAMESPACE}/<Task>-<World>-v0, "
+                         f"e.g. {cont_id('Reach')})")
+    return parts[0], parts[1]
 
 
 def grid_id(task: str, size: int) -> str:

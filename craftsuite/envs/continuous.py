@@ -12,7 +12,6 @@ from ..spec import TaskSpec
 from .base import CraftWorld
 from .scene import AGENT_HALF, build_scene
 
-FRAME_SKIP = 2  # default physics steps of 0.025 s per action: control period 0.05 s
 TOP_SPEED = 2.0  # m/s at full thrust (gear 10 / damping 5 in assets/arena.xml)
 _PLACEMENT_TRIES = 200
 _FAR = 1e6  # where consumed objects are parked: never within reach
@@ -32,11 +31,13 @@ class ContinuousWorldEnv(CraftWorld):
     ## Action Space
     ``Box(-1, 1, (2,), float32)``: thrust along x and y. Out-of-range values are clipped;
     NaN, infinite or wrongly shaped actions raise ``ValueError``. Each action is held for
-    ``frame_skip`` physics steps of 0.025 s (default 2: a control period ``dt`` of 0.05 s);
-    full thrust reaches the top speed of 2 m/s (0.1 m per default step) with a 0.2 s time
-    constant, so crossing the arena takes about 70 steps and a good Blind Craftsman episode
-    a few hundred. ``gymnasium.make(id, frame_skip=5)`` makes coarser steps (the scripted
-    policy then needs about 2.4 times fewer).
+    the spec's ``continuous.control_period`` (default 0.25 s: ``frame_skip`` 10 physics
+    steps of 0.025 s); full thrust reaches the top speed of 2 m/s (0.5 m per decision)
+    with a 0.2 s time constant, so crossing the arena takes about 14 decisions, as a 7x7
+    grid teacher crosses its grid in 6 moves, and the scripted policy completes Blind
+    Craftsman in about 38. The fine-control world of earlier releases is
+    ``gymnasium.make(id, frame_skip=2, max_episode_steps=1000)`` (0.05 s, the same 50 s
+    of simulated time); no TD3 student has learned a task there.
 
     ## Observation Space
     ``Box(-1, 1, (4 + 3 * n_objects + n_inventory,), float32)``: agent position divided
@@ -59,23 +60,23 @@ class ContinuousWorldEnv(CraftWorld):
 
     ## Episode End
     Terminated on acceptance (``is_success``) or on reaching the rejecting sink
-    (``violation``); truncated at ``continuous.max_steps`` (1000) by TimeLimit.
+    (``violation``); truncated at ``continuous.max_steps`` decisions (200) by TimeLimit.
 
     ## Registered Configurations
-    ``CraftSuite/<Task>-Cont-v0`` for every task spec: BlindCraftsman,
-    BlindCraftsmanObstacles, DungeonQuest, DiamondMine.
+    ``CraftSuite/<Task>-Cont-v0`` for every task spec in ``tasks/``, the rungs of the
+    ladder and the paper's tasks (``craftsuite tasks`` lists them).
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
 
     def __init__(self, task: str | TaskSpec = "BlindCraftsman", render_mode: str | None = None,
-                 width: int = 240, height: int = 240, frame_skip: int = FRAME_SKIP, offsets: str = "linear"):
-        if not isinstance(frame_skip, int) or isinstance(frame_skip, bool) or frame_skip < 1:
+                 width: int = 240, height: int = 240, frame_skip: int | None = None, offsets: str = "linear"):
+        if frame_skip is not None and (not isinstance(frame_skip, int) or isinstance(frame_skip, bool)
+                                       or frame_skip < 1):
             raise ValueError(f"frame_skip must be a positive integer (physics steps per action), got {frame_skip!r}")
         if offsets not in OFFSETS:
             raise ValueError(f"offsets must be one of {OFFSETS}, got {offsets!r}")
         super().__init__(task, render_mode)
-        self.frame_skip = frame_skip
         self.offsets = offsets
         self._sqrt_offsets = offsets == "sqrt"
         spec = self.task
@@ -87,6 +88,7 @@ class ContinuousWorldEnv(CraftWorld):
         self.scene = scene = build_scene(spec)
         self.model = mujoco.MjModel.from_xml_string(scene.xml)
         self.data = mujoco.MjData(self.model)
+        self.frame_skip = frame_skip = frame_skip or self._spec_frame_skip()
         self.dt = self.model.opt.timestep * frame_skip  # the control period
         self.metadata = {**self.metadata, "render_fps": round(1 / self.dt)}
         # An orthographic fovy is the vertical extent in metres; widen it for tall frames so
@@ -118,6 +120,15 @@ class ContinuousWorldEnv(CraftWorld):
         self._renderer = None
         self._started = False
         self.inventory_counts = self.rules.new_inventory()
+
+    def _spec_frame_skip(self) -> int:
+        """Physics steps per action for the spec's control period (a whole number of them)."""
+        period, step = self.task.continuous.control_period, self.model.opt.timestep
+        skip = round(period / step)
+        if skip < 1 or abs(skip * step - period) > 1e-9:
+            raise ValueError(f"{self.task.path or self.task.name}: continuous.control_period: {period} s is not a "
+                             f"whole number of physics steps of {step} s (e.g. {max(1, skip) * step:g})")
+        return skip
 
     def _object_view(self) -> np.ndarray:
         """(dx, dy, present) rows of the observation buffer, as a writable view."""

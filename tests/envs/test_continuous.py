@@ -102,20 +102,38 @@ def test_top_speed_and_control_period():
     env.reset(seed=0)
     place_agent(env, np.array([-3.0, 0.0]))
     env._positions[:] = 1e6  # nothing to touch on the way
-    for _ in range(40):
+    for _ in range(8):
         env.step(np.array([1.0, 0.0]))
     assert env.data.qvel[0] == pytest.approx(TOP_SPEED, rel=0.02)
-    assert env.data.time == pytest.approx(40 * 0.05)
+    assert env.data.time == pytest.approx(8 * 0.25)  # the spec's control period: 10 physics steps
 
 
-def test_frame_skip_sets_the_control_period():
-    coarse = gym.make("CraftSuite/BlindCraftsman-Cont-v0", frame_skip=5).unwrapped
-    coarse.reset(seed=0)
-    coarse.step(np.zeros(2))
-    assert coarse.data.time == pytest.approx(5 * 0.025) and coarse.dt == pytest.approx(0.125)
-    assert coarse.metadata["render_fps"] == 8 and ContinuousWorldEnv.metadata["render_fps"] == 20
+@pytest.mark.parametrize("env_id", CONT)
+def test_registered_world_is_the_teachers_time_scale(env_id):
+    env = gym.make(env_id)
+    assert env.unwrapped.frame_skip == 10 and env.unwrapped.dt == pytest.approx(0.25)
+    assert env.spec.max_episode_steps == 200  # 50 s of simulated time
+
+
+def test_frame_skip_keyword_gives_the_fine_control_world():
+    fine = gym.make("CraftSuite/BlindCraftsman-Cont-v0", frame_skip=2, max_episode_steps=1000)
+    fine.reset(seed=0)
+    fine.step(np.zeros(2))
+    u = fine.unwrapped
+    assert u.data.time == pytest.approx(2 * 0.025) and u.dt == pytest.approx(0.05)
+    assert u.metadata["render_fps"] == 20 and fine.spec.max_episode_steps == 1000
     with pytest.raises(ValueError, match="frame_skip must be a positive integer"):
         ContinuousWorldEnv(frame_skip=0)
+
+
+def test_a_control_period_off_the_physics_step_is_named(tmp_path):
+    from craftsuite.spec import load_spec
+
+    path = tmp_path / "odd.toml"
+    path.write_text('name = "Odd"\nformula = "F coin"\n[propositions]\ncoin = { obtained = "coin" }\n'
+                    '[items.coin]\ncount = 1\n[continuous]\ncontrol_period = 0.26\n')
+    with pytest.raises(ValueError, match=r"odd.toml: continuous.control_period: 0.26 s is not a whole number"):
+        ContinuousWorldEnv(load_spec(path))
 
 
 def test_sqrt_offsets_keep_sign_and_order_and_read_zero_once_consumed():

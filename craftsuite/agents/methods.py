@@ -1,48 +1,28 @@
-"""Every method of the paper under one interface: ``make_agent(method, env_id, ...)``.
+"""Every method of ``craftsuite.methods.METHODS`` built into an agent: ``make_agent(method, env_id, ...)``.
 
-Grid (DQN): ``dqn`` (vanilla, no automaton state), ``product-dqn``, ``crm``,
-``static`` and ``dynamic`` (distilled students; ``dynamic`` needs a teacher's table).
-MuJoCo (TD3): ``td3`` (from scratch), ``product-td3``, ``td3-static``, ``td3-dynamic``.
-A teacher is ``product-dqn`` on a 7x7 grid; ``distill_from_replay`` turns it into a table.
+Grid methods are DQN (``AutomatonDQN``), MuJoCo methods TD3 (``AutomatonTD3``); the table
+says which sees the automaton state and how it uses the automaton. A teacher is
+``product-dqn`` on a 7x7 grid; ``distill_from_replay`` turns it into a table.
 """
 
 from __future__ import annotations
 
 import zipfile
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from stable_baselines3.common.env_util import make_vec_env
 
+from ..methods import ALGORITHMS, METHODS, Method, check_methods  # noqa: F401  (METHODS re-exported)
+from ..registration import parse_id, world_kind
 from .crm import CRMReplayBuffer
 from .distillation import AutomatonQTable, DistilledTarget, dynamic_distillation, static_distillation
 from .dqn import AutomatonDQN
 from .noise import make_action_noise
 from .td3 import AutomatonTD3
 
-
-@dataclass(frozen=True)
-class Method:
-    name: str
-    algorithm: type
-    product: bool  # the automaton one-hot in the observation
-    distill: str | None = None  # "static" or "dynamic"
-    crm: bool = False
-    description: str = ""
-
-
-METHODS = {m.name: m for m in (
-    Method("dqn", AutomatonDQN, False, description="DQN without the automaton state"),
-    Method("product-dqn", AutomatonDQN, True, description="DQN over the product MDP (also the teacher)"),
-    Method("crm", AutomatonDQN, True, crm=True, description="product DQN with counterfactual experiences"),
-    Method("static", AutomatonDQN, True, "static", description="DQN student, statically distilled automaton"),
-    Method("dynamic", AutomatonDQN, True, "dynamic", description="DQN student, teacher distilled into the automaton"),
-    Method("td3", AutomatonTD3, False, description="TD3 from scratch"),
-    Method("product-td3", AutomatonTD3, True, description="TD3 over the product MDP"),
-    Method("td3-static", AutomatonTD3, True, "static", description="TD3 student, statically distilled automaton"),
-    Method("td3-dynamic", AutomatonTD3, True, "dynamic", description="TD3 student, teacher distilled into the automaton"),
-)}
+CLASSES = {"dqn": AutomatonDQN, "td3": AutomatonTD3}
+assert set(CLASSES) == set(ALGORITHMS), "every algorithm of the methods table needs its class here"
 
 # The authors' settings (REFERENCE.md section 5), changed where a small MLP on one env needs
 # it (measured, docs/benchmarks.md "Teachers"): a hard target update every 100 steps instead
@@ -60,40 +40,44 @@ TD3_DEFAULTS = dict(learning_rate=1e-4, buffer_size=1_000_000, batch_size=64, le
 
 
 def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None, seed: int = 0,
-               n_envs: int = 1, rho: float = 0.999, self_loops: bool = True, verbose: int = 0,
+               n_envs: int = 1, rho: float | None = None, self_loops: bool | None = None, verbose: int = 0,
                env_kwargs: dict | None = None, **overrides):
-    """An untrained agent of ``method`` on ``n_envs`` copies of ``env_id``.
+    """An untrained agent of ``method`` on ``n_envs`` copies of ``env_id``: each step of
+    the agent collects ``n_envs`` transitions, then takes ``gradient_steps`` updates.
 
     ``env_kwargs`` go to ``gymnasium.make`` (e.g. ``{"layout_seed": 0}`` for a fixed grid
-    instance); ``rho`` and ``self_loops`` to the distilled target (``DistilledTarget``);
-    ``overrides`` to the algorithm (TD3's ``action_noise`` may be a spec such as
-    ``{"type": "persistent", "sigma": 0.6, "resample": 0.1}``: ``agents/noise.py``)."""
-    if method not in METHODS:
-        raise KeyError(f"unknown method {method!r}; methods: {sorted(METHODS)}")
+    instance); ``rho`` and ``self_loops`` to the distilled target (``DistilledTarget``;
+    None: the method's); ``overrides`` to the algorithm (TD3's ``action_noise`` may be a
+    spec such as ``{"type": "persistent", "sigma": 0.6, "resample": 0.1}``: ``agents/noise.py``)."""
+    check_methods([method])
     m = METHODS[method]
-    continuous = "-Cont-" in env_id
-    if continuous != (m.algorithm is AutomatonTD3):
-        kind = "MuJoCo (-Cont-)" if m.algorithm is AutomatonTD3 else "grid"
-        raise ValueError(f"method {method!r} is for {kind} ids, not {env_id}")
+    if world_kind(parse_id(env_id)[1]) != m.world:
+        raise ValueError(f"method {method!r} is for {m.world} worlds, not {env_id}")
     env = make_vec_env(env_id, n_envs=n_envs, seed=seed, env_kwargs={**(env_kwargs or {}), "product": m.product})
     base = env.envs[0].unwrapped
     automaton = base.automaton
-    kwargs = dict(TD3_DEFAULTS if continuous else DQN_DEFAULTS)
+    kwargs = dict(TD3_DEFAULTS if m.algorithm == "td3" else DQN_DEFAULTS)
     kwargs.update(overrides)
+    # fused Adam: one kernel per step instead of a Python loop over the parameters, about
+    # 25% more updates per second for these small nets on a CPU (docs/performance.md)
+    policy_kwargs = dict(kwargs.get("policy_kwargs") or {})
+    policy_kwargs["optimizer_kwargs"] = {"fused": True, **policy_kwargs.get("optimizer_kwargs", {})}
+    kwargs["policy_kwargs"] = policy_kwargs
     if isinstance(kwargs.get("action_noise"), dict):
-        kwargs["action_noise"] = make_action_noise(kwargs["action_noise"], env.action_space.shape[0], seed)
+        kwargs["action_noise"] = make_action_noise(kwargs["action_noise"], env.action_space.shape[0], seed, n_envs)
     if m.crm:
         kwargs["replay_buffer_class"] = CRMReplayBuffer
         kwargs["replay_buffer_kwargs"] = {"automaton": automaton, "completion_reward": base.task.completion_reward,
                                           **kwargs.get("replay_buffer_kwargs", {})}
+    target = m.target_kwargs(rho=rho, self_loops=self_loops)
     if m.distill == "dynamic":
         if table is None:
             raise ValueError(f"method {method!r} needs a teacher's table (distill_from_replay)")
-        kwargs["distill"] = DistilledTarget(table, automaton, rho, self_loops)
+        kwargs["distill"] = DistilledTarget(table, automaton, **target)
     elif m.distill == "static":
         kwargs["distill"] = DistilledTarget(table or static_distillation(
-            automaton, completion_reward=base.task.completion_reward), automaton, rho, self_loops)
-    return m.algorithm("MlpPolicy", env, seed=seed, verbose=verbose, **kwargs)
+            automaton, completion_reward=base.task.completion_reward), automaton, **target)
+    return CLASSES[m.algorithm]("MlpPolicy", env, seed=seed, verbose=verbose, **kwargs)
 
 
 def distill_from_replay(teacher: AutomatonDQN, chunk: int = 4096) -> AutomatonQTable:

@@ -9,7 +9,8 @@ configs, suites and ``--hyper`` can name it:
 from __future__ import annotations
 
 import numpy as np
-from stable_baselines3.common.noise import ActionNoise, NormalActionNoise, OrnsteinUhlenbeckActionNoise
+from stable_baselines3.common.noise import (ActionNoise, NormalActionNoise, OrnsteinUhlenbeckActionNoise,
+                                            VectorizedActionNoise)
 
 
 class PersistentActionNoise(ActionNoise):
@@ -42,8 +43,10 @@ class PersistentActionNoise(ActionNoise):
 NOISES = {"normal": ("sigma",), "ou": ("sigma",), "persistent": ("sigma", "resample")}
 
 
-def make_action_noise(spec: dict, dim: int, seed: int = 0) -> ActionNoise:
-    """The ``ActionNoise`` a spec (see the module docstring) names, for ``dim`` actions."""
+def make_action_noise(spec: dict, dim: int, seed: int = 0, n_envs: int = 1) -> ActionNoise:
+    """The ``ActionNoise`` a spec (see the module docstring) names, for ``dim`` actions
+    in each of ``n_envs`` envs: one independent process per env. (SB3 vectorises a single
+    noise by deep copies, which would give every env the same persistent draws.)"""
     if not isinstance(spec, dict) or spec.get("type") not in NOISES:
         raise ValueError(f"action_noise must be an ActionNoise or a spec {{'type': one of {sorted(NOISES)}, "
                          f"'sigma': ...}}, got {spec!r}")
@@ -59,7 +62,15 @@ def make_action_noise(spec: dict, dim: int, seed: int = 0) -> ActionNoise:
         raise ValueError(f"action_noise {kind!r} takes numbers: {spec!r}") from None
     if not params["sigma"] >= 0:
         raise ValueError(f"sigma must be >= 0, got {params['sigma']!r}")
-    if kind == "persistent":
-        return PersistentActionNoise(params["sigma"], params["resample"], dim, seed)
-    noise = NormalActionNoise if kind == "normal" else OrnsteinUhlenbeckActionNoise
-    return noise(np.zeros(dim), params["sigma"] * np.ones(dim))
+
+    def one(i: int) -> ActionNoise:
+        if kind == "persistent":
+            return PersistentActionNoise(params["sigma"], params["resample"], dim, seed + 7919 * i)
+        noise = NormalActionNoise if kind == "normal" else OrnsteinUhlenbeckActionNoise
+        return noise(np.zeros(dim), params["sigma"] * np.ones(dim))
+
+    if n_envs == 1:
+        return one(0)
+    vectorized = VectorizedActionNoise(one(0), n_envs)
+    vectorized.noises = [one(i) for i in range(n_envs)]
+    return vectorized

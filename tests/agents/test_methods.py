@@ -7,6 +7,7 @@ import pytest
 
 from craftsuite.agents import AutomatonQTable
 from craftsuite.agents.methods import METHODS, distill_from_replay, load_agent, make_agent
+from craftsuite.methods import Method, MethodError, methods_for
 
 GRID, CONT = "CraftSuite/DungeonQuest-Grid7-v0", "CraftSuite/DungeonQuest-Cont-v0"
 SMALL_DQN = dict(learning_starts=50, buffer_size=2_000, target_update_interval=100)
@@ -33,7 +34,7 @@ def test_teacher_distills_a_table(teacher, table):
     assert table.seen[start, 0]  # 'nothing happened' from the start was certainly seen
 
 
-@pytest.mark.parametrize("method", [m for m in METHODS if METHODS[m].algorithm.__name__ == "AutomatonDQN"])
+@pytest.mark.parametrize("method", methods_for("Grid10"))
 def test_grid_methods_train(method, table):
     agent = make_agent(method, "CraftSuite/DungeonQuest-Grid10-v0", table=table, seed=1, **SMALL_DQN)
     agent.learn(300)
@@ -45,7 +46,7 @@ def test_grid_methods_train(method, table):
         assert agent.replay_buffer.n_envs == agent.replay_buffer.n_live
 
 
-@pytest.mark.parametrize("method", [m for m in METHODS if METHODS[m].algorithm.__name__ == "AutomatonTD3"])
+@pytest.mark.parametrize("method", methods_for("Cont"))
 def test_cont_methods_train(method, table):
     agent = make_agent(method, CONT, table=table, seed=1, **SMALL_TD3)
     agent.learn(200)
@@ -84,8 +85,10 @@ def test_n_step_targets_bootstrap_with_the_buffers_discounts(method, table):
 
 
 def test_method_and_world_must_match(table):
-    with pytest.raises(ValueError, match="for MuJoCo"):
+    with pytest.raises(ValueError, match="'td3' is for Cont worlds, not CraftSuite/DungeonQuest-Grid7-v0"):
         make_agent("td3", GRID)
+    with pytest.raises(ValueError, match="is not a CraftSuite id"):
+        make_agent("td3", "Pendulum-v1")
     with pytest.raises(ValueError, match="needs a teacher's table"):
         make_agent("dynamic", GRID)
     with pytest.raises(KeyError, match="unknown method"):
@@ -113,3 +116,32 @@ def test_table_round_trip(table, tmp_path, teacher):
     a = teacher.get_env().envs[0].unwrapped.automaton
     back = AutomatonQTable.load(table.save(tmp_path / "t.npz"), a)
     assert np.array_equal(back.q, table.q) and np.array_equal(back.counts, table.counts)
+
+
+def test_every_method_is_a_row_for_a_world_that_exists():
+    assert set(methods_for("Grid10")) | set(methods_for("Cont")) == set(METHODS)
+    assert methods_for("Grid7") == methods_for("Grid10")
+    with pytest.raises(MethodError, match="METHODS row 'moon-dqn': world 'Moon' does not exist; worlds: "
+                                          r"\['Grid', 'Cont'\]"):
+        Method("moon-dqn", "Moon", "dqn", False)
+    with pytest.raises(MethodError, match="algorithm 'dqn' does not run in the Cont world"):
+        Method("cont-dqn", "Cont", "dqn", False)
+    with pytest.raises(MethodError, match="target takes"):
+        Method("td3-nearly", "Cont", "td3", False, target={"rho": 0.5})  # a target without distillation
+
+
+def test_the_edges_variant_is_the_paper_target_on_edges_never_faded(table):
+    paper = make_agent("td3-dynamic", CONT, table=table, **SMALL_TD3).distill
+    edges = make_agent("td3-dynamic-edges", CONT, table=table, **SMALL_TD3).distill
+    assert (paper.rho, paper.self_loops) == (0.999, True)
+    assert (edges.rho, edges.self_loops) == (1.0, False)
+    assert edges.seen.sum() < paper.seen.sum()  # the self-loop values are left to the student
+    # a keyword still overrides the row, as --hyper does
+    assert make_agent("td3-dynamic-edges", CONT, table=table, rho=0.99, **SMALL_TD3).distill.rho == 0.99
+
+
+def test_each_env_of_a_vector_explores_with_its_own_persistent_noise():
+    agent = make_agent("td3", CONT, n_envs=3, action_noise={"type": "persistent", "sigma": 0.6, "resample": 0.1},
+                       **SMALL_TD3)
+    draws = agent.action_noise()
+    assert draws.shape == (3, 2) and len({tuple(d) for d in draws}) == 3

@@ -1,0 +1,100 @@
+"""The methods a benchmark compares, as data: one row per method, named for what it does.
+
+``METHODS`` drives the suites (which methods run in which world), the command line's
+choices and the leaderboard's legend; ``craftsuite.agents.methods.make_agent`` builds a row
+into an agent. This module imports no torch, so listing methods stays cheap.
+
+A row names its world kind (``Grid``: DQN on the grids, ``Cont``: TD3 in the MuJoCo
+world), whether the policy sees the automaton state, and how the student uses the
+automaton: a distilled target (``static`` or ``dynamic``, with the ``DistilledTarget``
+keywords in ``target``) or counterfactual experience (``crm``). A variant of a method is
+a row of its own, never a hyperparameter of a suite, so a leaderboard row says what ran.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from types import MappingProxyType
+
+from .registration import WORLD_KINDS
+
+# the algorithm family of each world kind: DQN needs discrete moves, TD3 continuous thrust
+ALGORITHMS = MappingProxyType({"dqn": "Grid", "td3": "Cont"})
+DISTILLATIONS = (None, "static", "dynamic")
+TARGET_DEFAULTS = MappingProxyType({"rho": 0.999, "self_loops": True})  # the paper's
+
+
+class MethodError(ValueError):
+    """A ``METHODS`` row that cannot run: unknown world, algorithm or target setting."""
+
+
+@dataclass(frozen=True)
+class Method:
+    name: str
+    world: str  # a world kind of WORLD_KINDS
+    algorithm: str  # a key of ALGORITHMS
+    product: bool  # the automaton state's one-hot in the observation
+    distill: str | None = None  # None, "static" or "dynamic" (needs a teacher's table)
+    crm: bool = False  # counterfactual experience over automaton states
+    target: dict = field(default_factory=dict)  # DistilledTarget keywords over TARGET_DEFAULTS
+    description: str = ""
+
+    def __post_init__(self):
+        where = f"METHODS row {self.name!r}"
+        if self.world not in WORLD_KINDS:
+            raise MethodError(f"{where}: world {self.world!r} does not exist; worlds: {list(WORLD_KINDS)}")
+        if ALGORITHMS.get(self.algorithm) != self.world:
+            fits = [a for a, w in ALGORITHMS.items() if w == self.world]
+            raise MethodError(f"{where}: algorithm {self.algorithm!r} does not run in the {self.world} world; "
+                              f"use one of {fits}")
+        if self.distill not in DISTILLATIONS:
+            raise MethodError(f"{where}: distill must be one of {list(DISTILLATIONS)}, got {self.distill!r}")
+        unknown = sorted(set(self.target) - set(TARGET_DEFAULTS))
+        if unknown or (self.target and self.distill is None):
+            raise MethodError(f"{where}: target takes {sorted(TARGET_DEFAULTS)} and only with distill; "
+                              f"got {self.target!r}")
+
+    @property
+    def needs_table(self) -> bool:
+        """Whether the method needs a teacher's table (``craftsuite teacher``)."""
+        return self.distill == "dynamic"
+
+    def target_kwargs(self, **given) -> dict:
+        """The ``DistilledTarget`` keywords: the paper's, then the row's, then ``given``
+        (entries of None are left to the row)."""
+        return {**TARGET_DEFAULTS, **self.target, **{k: v for k, v in given.items() if v is not None}}
+
+
+METHODS = MappingProxyType({m.name: m for m in (
+    Method("dqn", "Grid", "dqn", False, description="DQN without the automaton state"),
+    Method("product-dqn", "Grid", "dqn", True, description="DQN over the product MDP (also the teacher)"),
+    Method("crm", "Grid", "dqn", True, crm=True, description="product DQN with counterfactual experiences"),
+    Method("static", "Grid", "dqn", True, "static", description="DQN student, statically distilled automaton"),
+    Method("dynamic", "Grid", "dqn", True, "dynamic",
+           description="DQN student, teacher distilled into the automaton (the paper's method)"),
+    Method("td3", "Cont", "td3", False, description="TD3 from scratch"),
+    Method("product-td3", "Cont", "td3", True, description="TD3 over the product MDP"),
+    Method("td3-static", "Cont", "td3", True, "static", description="TD3 student, statically distilled automaton"),
+    Method("td3-dynamic", "Cont", "td3", True, "dynamic",
+           description="TD3 student, teacher distilled into the automaton (the paper's method)"),
+    # the one distilled variant under which a MuJoCo student was measured to learn Blind
+    # Craftsman sooner than scratch: the teacher's values only where the automaton moves
+    # (its flat self-loop values are fitted everywhere otherwise), never faded
+    Method("td3-dynamic-edges", "Cont", "td3", True, "dynamic", target={"rho": 1.0, "self_loops": False},
+           description="td3-dynamic with the teacher's values on the automaton's edges only, never faded (rho 1)"),
+)})
+
+
+def methods_for(world: str) -> list[str]:
+    """The methods that run in a student world (``Cont``, ``Grid10``, ...), in table order."""
+    from .registration import world_kind
+
+    kind = world_kind(world)
+    return [name for name, m in METHODS.items() if m.world == kind]
+
+
+def check_methods(names) -> None:
+    """Raise KeyError naming the unknown methods and the known ones."""
+    unknown = [n for n in names if n not in METHODS]
+    if unknown:
+        raise KeyError(f"unknown method(s) {unknown}; methods: {list(METHODS)}")

@@ -49,7 +49,7 @@ def coverage(task: str, make_noise, episodes: int = 20) -> dict:
 
     import craftsuite  # noqa: F401
 
-    env = gym.make(f"CraftSuite/{task}-Cont-v0")
+    env = gym.make(f"CraftSuite/{task}-Cont-v0", frame_skip=2, max_episode_steps=1000)  # the world it was written for
     events = wall = 0
     spans = []
     for episode in range(episodes):

@@ -55,7 +55,7 @@ SCENES = {
              "recipes": [{"at": "factory", "consume": {"wood": 1}, "produce": {"tools": 1}, "repeat": True}]},
 }
 # frame skip -> (label, gymnasium.make keywords); every limit is 50 s of simulated time
-HORIZONS = {2: ("frame skip 2, 1,000 steps", {}),
+HORIZONS = {2: ("frame skip 2, 1,000 steps", {"frame_skip": 2, "max_episode_steps": 1000}),
             5: ("frame skip 5, 400 steps", {"frame_skip": 5, "max_episode_steps": 400}),
             10: ("frame skip 10, 200 steps", {"frame_skip": 10, "max_episode_steps": 200})}
 NOISES = ("white", "persistent")

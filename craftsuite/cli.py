@@ -8,17 +8,23 @@ from pathlib import Path
 
 
 def _tasks(args) -> int:
-    from .registration import registered_ids, tasks
+    from .registration import ladder, parse_id, registered_ids
 
+    if args.markdown:
+        from .references import write_tasks_page
+
+        path = write_tasks_page(args.markdown, episodes=args.episodes)
+        print(f"wrote {path}")
+        return 0
     ids = registered_ids()
-    for name, spec in tasks().items():
+    for spec in ladder(*args.tag):
         a = spec.automaton
         states, edges = a.size()
-        print(f"{name}: {spec.formula}")
+        print(f"{spec.name} [{', '.join(spec.tags)}]: {spec.formula}")
         print(f"  propositions: {', '.join(spec.proposition_names)}")
         print(f"  automaton: {states} states, {edges} transitions (+ rejecting sink: {bool(a.rejecting.any())})")
         for env_id in ids:
-            if env_id.split("/")[1].split("-")[0] == name:
+            if parse_id(env_id)[0] == spec.name:
                 print(f"  {env_id}")
     return 0
 
@@ -187,13 +193,15 @@ def _distill(args) -> int:
 
 
 def _student(args) -> int:
+    from .methods import METHODS
     from .training import StudentConfig, train_student
 
     config = StudentConfig(task=args.task, method=args.method, world=args.world, seed=args.seed, steps=args.steps,
-                           table=str(Path(args.table).resolve()) if args.table else None, eval_every=args.eval_every, eval_episodes=args.eval_episodes,
-                           hyperparameters=_json_object(args.hyper), layout_seed=args.layout_seed,
-                           world_kwargs=_json_object(args.env, "--env"))
-    if args.method.endswith("dynamic") and not args.table:
+                           table=str(Path(args.table).resolve()) if args.table else None, eval_every=args.eval_every,
+                           eval_episodes=args.eval_episodes, hyperparameters=_json_object(args.hyper),
+                           layout_seed=args.layout_seed, world_kwargs=_json_object(args.env, "--env"),
+                           n_envs=args.n_envs)
+    if METHODS[args.method].needs_table and not args.table:
         raise ValueError(f"method {args.method!r} needs --table (a teacher's table.npz: craftsuite teacher)")
     path = train_student(config, args.out)
     print((path / "result.json").read_text().strip())
@@ -209,8 +217,9 @@ def _transfer(args) -> int:
     if args.suite not in SUITES:
         raise KeyError(f"unknown suite {args.suite!r}; suites: {sorted(SUITES)}")
     suite = SUITES[args.suite]
-    changes = {k: v for k, v in (("tasks", tuple(args.tasks) if args.tasks else None),
-                                 ("worlds", tuple(args.worlds) if args.worlds else None), ("seeds", args.seeds),
+    if args.tags is not None or args.tasks is not None:  # the rungs given replace the suite's
+        suite = dataclasses.replace(suite, tags=tuple(args.tags or ()), tasks=tuple(args.tasks or ()))
+    changes = {k: v for k, v in (("worlds", tuple(args.worlds) if args.worlds else None), ("seeds", args.seeds),
                                  ("student_steps", args.steps), ("methods", tuple(args.methods) if args.methods else None),
                                  ("teacher_max_steps", args.teacher_steps), ("eval_every", args.eval_every))
                if v is not None}
@@ -235,7 +244,13 @@ def _transfer(args) -> int:
 def _leaderboard(args) -> int:
     from . import leaderboard
 
-    root = Path(args.runs)
+    if args.page:
+        path = leaderboard.write_page(args.runs, args.page)
+        print(f"wrote {path}")
+        return 0
+    if len(args.runs) > 1:
+        raise ValueError("several run directories make one results page: add --page PATH")
+    root = Path(args.runs[0])
     students = root / "students" if (root / "students").is_dir() else root
     if not students.is_dir():
         raise FileNotFoundError(f"no run directory at {root}")
@@ -258,10 +273,18 @@ def _positive(text: str) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from .methods import METHODS
+
     parser = argparse.ArgumentParser(prog="craftsuite", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
+    methods = ", ".join(METHODS)
 
-    p = sub.add_parser("tasks", help="list the tasks, their formulas, automata and gymnasium ids")
+    p = sub.add_parser("tasks", help="list the tasks (the ladder's rungs, easiest first), formulas, automata, ids")
+    p.add_argument("--tag", nargs="+", default=(), help="only the tasks with any of these tags (e.g. easy, paper)")
+    p.add_argument("--markdown", metavar="PATH", help="write the tasks page (specs, automata, scripted and random "
+                   "references) to PATH instead, e.g. docs/tasks.md")
+    p.add_argument("--episodes", type=_positive, default=100,
+                   help="episodes per id for the references of --markdown (default: 100)")
     p.set_defaults(run=_tasks)
 
     p = sub.add_parser("automaton", help="draw or print a task's automaton")
@@ -303,13 +326,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("student", help="train one student or baseline run (any method, one seed)")
     p.add_argument("task", help="task name, e.g. BlindCraftsman")
-    p.add_argument("--method", default="td3-dynamic", help="td3-dynamic, td3-static, td3, product-td3 (MuJoCo); "
-                   "dynamic, static, dqn, product-dqn, crm (grids)")
+    p.add_argument("--method", default="td3-dynamic", choices=list(METHODS), metavar="METHOD",
+                   help=f"one of {methods} (craftsuite.methods.METHODS; default: td3-dynamic)")
     p.add_argument("--world", default="Cont", help="Cont (MuJoCo, default), Grid10 or Grid7")
     p.add_argument("--table", help="a teacher's table.npz (the *dynamic methods)")
     p.add_argument("--out", default="runs/students", help="runs directory (default: runs/students)")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--steps", type=_positive, default=20_000)
+    p.add_argument("--steps", type=_positive, default=20_000, help="the budget in transitions (default: 20000)")
+    p.add_argument("--n-envs", type=_positive, default=1,
+                   help="envs stepped side by side; each agent step collects one transition from each (default: 1)")
     p.add_argument("--eval-every", type=_positive, default=2_000)
     p.add_argument("--eval-episodes", type=_positive, default=10)
     p.add_argument("--hyper", help="JSON overrides of the algorithm's settings, e.g. "
@@ -322,12 +347,13 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("transfer", help="a suite end to end: teacher, distillation, students, leaderboard, video")
     p.add_argument("--suite", default="quick", help="quick (default, ~12 min), standard or paper")
     p.add_argument("--out", default="runs/quick", help="output directory (default: runs/quick)")
-    p.add_argument("--tasks", nargs="+", help="override the suite's tasks")
+    p.add_argument("--tags", nargs="+", help="override the suite's rungs: the tasks with any of these tags")
+    p.add_argument("--tasks", nargs="+", help="override the suite's rungs: these tasks (with --tags: and these)")
     p.add_argument("--worlds", nargs="+", choices=("Cont", "Grid10", "Grid7"),
                    help="override the student worlds (Cont: TD3 methods; Grid10, Grid7: DQN methods)")
-    p.add_argument("--methods", nargs="+", help="override the suite's methods")
+    p.add_argument("--methods", nargs="+", metavar="METHOD", help=f"override the suite's methods: any of {methods}")
     p.add_argument("--seeds", type=_positive, help="override the number of seeds")
-    p.add_argument("--steps", type=_positive, help="override the student budget (env steps)")
+    p.add_argument("--steps", type=_positive, help="one student budget for every rung (transitions)")
     p.add_argument("--teacher-steps", type=_positive, help="override the teacher's step limit")
     p.add_argument("--eval-every", type=_positive, help="override the evaluation interval")
     p.add_argument("--env", help="JSON gymnasium.make keywords of the MuJoCo students' world (replaces the suite's), "
@@ -340,8 +366,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_transfer)
 
     p = sub.add_parser("leaderboard", help="leaderboard (Markdown, CSV) and learning curves from run directories")
-    p.add_argument("runs", help="a transfer output directory, or a directory of student runs")
+    p.add_argument("runs", nargs="+", help="a transfer output directory, or a directory of student runs "
+                   "(several with --page)")
     p.add_argument("--out", help="where to write (default: RUNS)")
+    p.add_argument("--page", metavar="PATH", help="write a results page (Markdown with provenance, tables, plots) "
+                   "from the RUNS directories to PATH, e.g. docs/results.md")
     p.set_defaults(run=_leaderboard)
 
     p = sub.add_parser("video", help="record rollouts of a policy as an MP4 (grid and MuJoCo ids)")

@@ -10,7 +10,8 @@ Per run (``run_metrics``):
 * ``auc``: area under the evaluation success curve, as a fraction of the budget (the mean
   of the evaluations, every ``eval_every`` steps and at the end): 1.0 means solved from the
   first one;
-* ``steps_to_80``: env steps at the first evaluation with success >= 0.8 (None: never).
+* ``steps_to_80``: transitions at the first evaluation with success >= 0.8 (None: never);
+* ``budget`` and ``updates``: the run's transitions and gradient updates.
 
 Per task, world and method (``build``): the mean over seeds with a 95% bootstrap
 confidence interval (percentile, 2,000 resamples of the seeds). The world is its kind and
@@ -79,7 +80,7 @@ def run_metrics(run: Path) -> dict | None:
     reached = next((int(e["step"]) for e in evals if float(e["success"]) >= 0.8), None)
     return {
         "task": config["task"], "world": world_label(config), "method": config["method"], "seed": config["seed"],
-        "budget": budget, "steps": result["steps"],
+        "budget": budget, "steps": result["steps"], "updates": result.get("updates"),
         "success": success[-1] if success else float("nan"),
         "return": float(np.mean([float(e["return"]) for e in tail])) if tail else float("nan"),
         "train_success": float(np.mean([int(e["success"]) for e in tail])) if tail else float("nan"),
@@ -110,6 +111,13 @@ class Entry:
     stats: dict  # metric -> (mean, lo, hi)
     censored: int  # runs that never reached 80% (counted at their budget)
     differs: tuple[str, ...] = ()  # config fields, other than the seed, in which the pooled runs differ
+    budget: int = 0  # transitions per run (the largest, if the pooled runs differ)
+    updates: int | None = None  # mean gradient updates per run (None: runs from before they were recorded)
+
+    @property
+    def budget_text(self) -> str:
+        """The budget in transitions and gradient updates, e.g. ``60,000 / 15,000``."""
+        return f"{self.budget:,} / " + (f"{self.updates:,}" if self.updates is not None else "?")
 
 
 def build(students_root) -> list[Entry]:
@@ -130,8 +138,11 @@ def build(students_root) -> list[Entry]:
         mine = configs[(task, world, method)]
         differs = tuple(sorted(k for k in {k for c in mine for k in c} - {"seed"}
                                if len({json.dumps(c.get(k), sort_keys=True) for c in mine}) > 1))
+        updates = [r["updates"] for r in runs]
         entries.append(Entry(task, world, method, len(runs), stats,
-                             sum(r["steps_to_80"] is None for r in runs), differs))
+                             sum(r["steps_to_80"] is None for r in runs), differs,
+                             budget=max(r["budget"] for r in runs),
+                             updates=None if None in updates else round(float(np.mean(updates)))))
     return entries
 
 
@@ -144,17 +155,28 @@ def _fmt(stat, digits=2, integer=False, prefix="") -> str:
     return f"{prefix}{mean:.{digits}f} [{lo:.{digits}f}, {hi:.{digits}f}]"
 
 
-def to_markdown(entries: list[Entry]) -> str:
-    lines = ["# Leaderboard", "",
-             "Mean over seeds [95% bootstrap interval]. success: greedy, last evaluation; return and "
-             "training success: training episodes (exploration noise on), last 10% of steps; AUC: mean "
-             "evaluation success over training; steps to 80% (greedy) success: '>=' when some seeds never "
-             "got there (counted at their budget).", ""]
-    for key in sorted({(e.task, e.world) for e in entries}):
+def _rung_order(task: str) -> tuple:
+    """Sections follow the task ladder, easiest rung first (unknown tasks last, by name)."""
+    from .registration import tasks
+
+    spec = tasks().get(task)
+    return spec.rung if spec is not None else (99, True, task)
+
+
+def to_markdown(entries: list[Entry], title: str | None = "# Leaderboard") -> str:
+    from .methods import METHODS
+
+    lines = [title, ""] if title else []
+    lines += ["Mean over seeds [95% bootstrap interval]. success: greedy, last evaluation; return and "
+              "training success: training episodes (exploration noise on), last 10% of the budget; AUC: mean "
+              "evaluation success over training; steps to 80% (greedy) success, in transitions: '>=' when "
+              "some seeds never got there (counted at their budget); budget: transitions / gradient updates "
+              "per run. A world with settings beyond the registered one names them.", ""]
+    for key in sorted({(e.task, e.world) for e in entries}, key=lambda k: (_rung_order(k[0]), k[1])):
         lines += [f"## {key[0]} ({key[1]})", "",
                   "| method | seeds | success | return (last 10%) | training success (last 10%) | AUC "
-                  "| steps to 80% success |",
-                  "|---|---|---|---|---|---|---|"]
+                  "| steps to 80% success | budget |",
+                  "|---|---|---|---|---|---|---|---|"]
         rows = sorted((e for e in entries if (e.task, e.world) == key),
                       key=lambda e: (-e.stats["auc"][0], -e.stats["return"][0]))
         for e in rows:
@@ -162,7 +184,7 @@ def to_markdown(entries: list[Entry]) -> str:
             if e.censored:
                 steps += f" ({e.seeds - e.censored}/{e.seeds} reached)"
             lines.append(f"| {e.method} | {e.seeds} | {_fmt(e.stats['success'])} | {_fmt(e.stats['return'], 1)} "
-                         f"| {_fmt(e.stats['train_success'])} | {_fmt(e.stats['auc'])} | {steps} |")
+                         f"| {_fmt(e.stats['train_success'])} | {_fmt(e.stats['auc'])} | {steps} | {e.budget_text} |")
         notes = [f"*{e.method}: its {e.seeds} runs differ in {', '.join(e.differs)}, not only in the seed; "
                  "they are pooled here (put runs of another setting in another directory)*"
                  for e in rows if e.differs]
@@ -171,9 +193,15 @@ def to_markdown(entries: list[Entry]) -> str:
         if ref:
             for method, value in ref.items():
                 lines.append(f"| *reference: authors' {method}, 1 run, 2M steps (return over the last 5%)* "
-                             f"| 1 | | {value:.2f} | | | |")
+                             f"| 1 | | {value:.2f} | | | | |")
         lines += ["", *notes] if notes else []
         lines.append("")
+    shown = [m for m in METHODS if m in {e.method for e in entries}]
+    shown += sorted({e.method for e in entries} - set(shown))  # runs of a method no longer in the table
+    lines += ["Methods:", ""]
+    lines += [f"- `{m}`: {METHODS[m].description if m in METHODS else 'not a method of this version'}"
+              for m in shown]
+    lines.append("")
     return "\n".join(lines)
 
 
@@ -181,10 +209,10 @@ def to_csv(entries: list[Entry]) -> str:
     buf = io.StringIO()
     writer = csv.writer(buf)
     writer.writerow(["task", "world", "method", "seeds", *(f"{m}{s}" for m in METRICS for s in ("", "_lo", "_hi")),
-                     "steps_to_80_censored", "pooled_runs_differ_in"])
+                     "steps_to_80_censored", "pooled_runs_differ_in", "budget_transitions", "updates"])
     for e in entries:
         writer.writerow([e.task, e.world, e.method, e.seeds, *(v for m in METRICS for v in e.stats[m]), e.censored,
-                         " ".join(e.differs)])
+                         " ".join(e.differs), e.budget, "" if e.updates is None else e.updates])
     return buf.getvalue()
 
 
@@ -194,6 +222,55 @@ def write(entries: list[Entry], out) -> Path:
     atomic_write(out / "leaderboard.csv", to_csv(entries))
     atomic_write(out / "leaderboard.md", to_markdown(entries))
     return out / "leaderboard.md"
+
+
+def write_page(run_dirs, path, title: str = "Results") -> Path:
+    """A results page (Markdown) from transfer output directories: per directory, its
+    suite, the sessions that made it (command, date, commit, machine: ``provenance.json``),
+    its leaderboard and learning curves (copied beside the page, under ``images/``).
+
+    Raises:
+        FileNotFoundError, ValueError: a directory that is missing or holds no finished run,
+            named; the page is then not written.
+    """
+    import shutil
+
+    from .provenance import read
+
+    path = Path(path)
+    lines = [f"# {title}", "",
+             f"<!-- generated by `craftsuite leaderboard {' '.join(str(d) for d in run_dirs)} --page {path}`;"
+             " do not edit -->", ""]
+    parts = []
+    for run_dir in map(Path, run_dirs):
+        students = run_dir / "students" if (run_dir / "students").is_dir() else run_dir
+        if not students.is_dir():
+            raise FileNotFoundError(f"no run directory at {run_dir}")
+        entries = build(students)
+        if not entries:
+            raise ValueError(f"no finished student runs under {students}")
+        parts.append((run_dir, students, entries))
+    for run_dir, students, entries in parts:
+        suite = json.loads((run_dir / "suite.json").read_text()) if (run_dir / "suite.json").exists() else {}
+        name = suite.get("name", run_dir.name)
+        lines += [f"## {name}" + (f": {suite['description']}" if suite.get("description") else ""), ""]
+        sessions = read(run_dir)
+        for s in sessions:
+            lines.append(f"- `{s['command']}`: {s['started'][:10]}, commit {s.get('commit') or 'unknown'}, "
+                         f"{s['seconds'] / 60:.1f} min on {s['machine']}")
+        if not sessions:
+            lines.append(f"- runs in `{run_dir}` (no provenance.json: not made by `craftsuite transfer`)")
+        board = to_markdown(entries, title=None).replace("\n## ", "\n### ")
+        lines += ["", board.strip(), ""]
+        images = path.parent / "images" / _file_part(f"results-{name}")
+        images.mkdir(parents=True, exist_ok=True)
+        for plot in plot_curves(students, images):
+            lines += [f"![{plot.stem}]({plot.relative_to(path.parent).as_posix()})", ""]
+        for video in sorted(run_dir.glob("best-*.mp4")):
+            shutil.copy(video, images / video.name)
+            lines += [f"Video of the best student: [{video.name}]({(images / video.name).relative_to(path.parent).as_posix()})", ""]
+    atomic_write(path, "\n".join(lines))
+    return path
 
 
 def _curve(values_at, grid):
@@ -244,8 +321,8 @@ def plot_curves(students_root, out) -> list[Path]:
                     lo, hi = np.array([bootstrap_ci(col[~np.isnan(col)])[1:] for col in data.T]).T
                     ax.fill_between(grid, lo, hi, color=color, alpha=0.2)
         fig.suptitle(f"{task} ({world})")  # a world with settings is too long for a panel's title
-        axes[0].set(title="training episode return", xlabel="env steps", ylabel="return")
-        axes[1].set(xlabel="env steps", ylabel="success rate", ylim=(-0.02, 1.02))
+        axes[0].set(title="training episode return", xlabel="transitions", ylabel="return")
+        axes[1].set(xlabel="transitions", ylabel="success rate", ylim=(-0.02, 1.02))
         axes[1].set_title("success: greedy evaluation (solid), training episodes (dashed)", fontsize=9)
         axes[1].legend(loc="upper left", fontsize=8)
         fig.tight_layout()

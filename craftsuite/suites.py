@@ -1,15 +1,17 @@
-"""Benchmark suites and the transfer pipeline: teacher, distillation, students, leaderboard.
+"""Benchmark suites and the transfer pipeline: teachers, distillation, students, leaderboard.
 
-A ``Suite`` is data: tasks, student worlds, methods, seeds and budgets. ``transfer`` runs
-one end to end under an output directory::
+A ``Suite`` is data: rungs of the task ladder (by tag or name), student worlds, methods,
+seeds, a budget per rung level and each world's collection regime. ``transfer`` runs one
+end to end under an output directory::
 
     <out>/teachers/teacher-<Task>-Grid7-s0-<key>/     teacher.zip, table.npz, evals.csv
     <out>/students/student-<Task>-Cont-<method>-s<seed>-<key>/
     <out>/leaderboard.md, leaderboard.csv, curves-<Task>-<world>[-<settings>].png, best-<...>.mp4
 
-Student runs go to local processes (``workers`` at a time) or, with ``ray``, to a Ray
-cluster (``"local"`` starts one in-process; a real cluster needs ``out`` on a filesystem
-every node sees). Runs that already finished are reused.
+Teachers and students share one pool of local processes (``workers`` at a time) or, with
+``ray``, a Ray cluster (``"local"`` starts one in-process; a real cluster needs ``out`` on
+a filesystem every node sees): students that need no teacher start at once, the others
+as soon as their rung's teacher is distilled. Runs that already finished are reused.
 """
 
 from __future__ import annotations
@@ -18,84 +20,111 @@ import dataclasses
 import json
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .methods import METHODS, check_methods, methods_for
+from .registration import ladder, resolve_task, world_kind
 from .runs import atomic_write
+from .spec import TaskSpec
 from .training import StudentConfig, TeacherConfig, train_student, train_teacher
-
-GRID_METHODS = ("dynamic", "static", "dqn", "product-dqn", "crm")
-CONT_METHODS = ("td3-dynamic", "td3-static", "td3", "product-td3")
 
 
 @dataclass(frozen=True)
 class Suite:
     name: str
     description: str
-    tasks: tuple[str, ...]
-    worlds: tuple[str, ...]  # student worlds: "Cont" (MuJoCo, TD3 methods), "Grid10" (DQN methods)
-    methods: tuple[str, ...]  # each runs in the worlds it is made for
-    seeds: int
-    student_steps: int
+    tags: tuple[str, ...] = ()  # rungs: every task with any of these tags (registration.ladder)
+    tasks: tuple[str, ...] = ()  # rungs by name, besides those by tag
+    worlds: tuple[str, ...] = ("Cont",)  # student worlds: "Cont" (MuJoCo), "Grid10", "Grid7"
+    methods: tuple[str, ...] = ("td3",)  # each runs in the worlds its METHODS row is for
+    seeds: int = 5
+    # each rung's budget in transitions, by its level (TaskSpec.level); student_steps, when
+    # set, is one budget for every rung
+    budgets: dict = field(default_factory=dict)
+    student_steps: int | None = None
     teacher_max_steps: int = 300_000
-    eval_every: int = 2_000
-    eval_episodes: int = 10
-    # overrides of each student algorithm's defaults (craftsuite.agents.methods): MuJoCo
-    # students are TD3, grid students DQN, so one network size never reaches the other
+    eval_every: int | None = None  # None: 20 evaluations per run
+    eval_episodes: int = 20
+    # each world's collection regime: envs stepped side by side per agent step, and
+    # overrides of its algorithm's defaults (craftsuite.agents.methods): MuJoCo students
+    # are TD3, grid students DQN, so one network size never reaches the other
     td3_hyperparameters: dict = field(default_factory=dict)
     dqn_hyperparameters: dict = field(default_factory=dict)
+    td3_n_envs: int = 1
+    dqn_n_envs: int = 1
     # grid students learn one fixed instance, generated independently of the teacher's (layout 0),
     # as the paper's did; None gives them a new layout every episode
     grid_layout_seed: int | None = 1
-    # gymnasium.make keywords of the MuJoCo students' world, e.g. {"frame_skip": 10, "max_episode_steps": 200}
+    # gymnasium.make keywords of the MuJoCo students' world beyond the registered one; the
+    # leaderboard names each in its world label
     cont_world_kwargs: dict = field(default_factory=dict)
 
-    def student_configs(self, tables: dict[str, str]) -> list[StudentConfig]:
-        unknown = [m for m in self.methods if m not in GRID_METHODS + CONT_METHODS]
-        if unknown:
-            raise KeyError(f"unknown method(s) {unknown}; methods: {sorted(GRID_METHODS + CONT_METHODS)}")
+    def rungs(self) -> list[TaskSpec]:
+        """The suite's tasks, easiest first."""
+        if not self.tags and not self.tasks:
+            raise ValueError(f"suite {self.name!r} selects no rung: give it tags or tasks")
+        chosen = {s.name: s for s in ladder(*self.tags)} if self.tags else {}
+        chosen.update({name: resolve_task(name) for name in self.tasks})
+        return sorted(chosen.values(), key=lambda s: s.rung)
+
+    def budget(self, spec: TaskSpec) -> int:
+        """A rung's student budget in transitions."""
+        if self.student_steps is not None:
+            return self.student_steps
+        if spec.level not in self.budgets:
+            raise ValueError(f"suite {self.name!r} has no budget for {spec.name}'s level {spec.level!r} "
+                             f"(tags {list(spec.tags)}); budgets: {self.budgets}")
+        return self.budgets[spec.level]
+
+    def teachers(self) -> dict[str, TeacherConfig]:
+        """One grid teacher per rung whose students need a teacher's table."""
+        if not any(METHODS[m].needs_table for m in self.methods):
+            return {}
+        return {spec.name: TeacherConfig(task=spec.name, max_steps=self.teacher_max_steps) for spec in self.rungs()}
+
+    def student_configs(self, teacher_root) -> list[StudentConfig]:
+        """Every student run; a distilled student reads its rung's teacher's table from
+        under ``teacher_root`` (where ``transfer`` trains it first)."""
+        check_methods(self.methods)
+        teachers = self.teachers()
         out = []
-        for task in self.tasks:
+        for spec in self.rungs():
+            steps = self.budget(spec)
             for world in self.worlds:
-                fits = CONT_METHODS if world == "Cont" else GRID_METHODS
-                for method in (m for m in self.methods if m in fits):
+                cont = world_kind(world) == "Cont"
+                for method in (m for m in methods_for(world) if m in self.methods):
+                    table = None
+                    if METHODS[method].needs_table:
+                        table = str((Path(teacher_root) / teachers[spec.name].run_name() / "table.npz").resolve())
                     for seed in range(self.seeds):
                         out.append(StudentConfig(
-                            task=task, method=method, world=world, seed=seed, steps=self.student_steps,
-                            table=tables[task] if method.endswith("dynamic") else None,
-                            eval_every=self.eval_every, eval_episodes=self.eval_episodes,
-                            hyperparameters=dict(self.td3_hyperparameters if world == "Cont"
-                                                 else self.dqn_hyperparameters),
-                            layout_seed=self.grid_layout_seed if world.startswith("Grid") else None,
-                            world_kwargs=dict(self.cont_world_kwargs) if world == "Cont" else {}))
+                            task=spec.name, method=method, world=world, seed=seed, steps=steps, table=table,
+                            eval_every=self.eval_every or max(1, steps // 20), eval_episodes=self.eval_episodes,
+                            hyperparameters=dict(self.td3_hyperparameters if cont else self.dqn_hyperparameters),
+                            layout_seed=None if cont else self.grid_layout_seed,
+                            world_kwargs=dict(self.cont_world_kwargs) if cont else {},
+                            n_envs=self.td3_n_envs if cont else self.dqn_n_envs))
         if not out:
             raise ValueError(f"no method of {list(self.methods)} runs in the worlds {list(self.worlds)} "
-                             f"(grid: {list(GRID_METHODS)}; Cont: {list(CONT_METHODS)})")
+                             f"({', '.join(f'{w}: {methods_for(w)}' for w in self.worlds)})")
         return out
 
 
 SUITES = {s.name: s for s in (
-    # quick runs where the teacher was measured to help on Blind Craftsman (docs/benchmarks.md,
-    # "The quick suite"): a control period on the grid teacher's scale, a persistent exploration
-    # noise, the teacher's values kept on the automaton's edges (rho 1, no self-loops), and a
-    # small net updated every second step, so 100k steps per student fit the 15 minutes.
-    Suite("quick", "Blind Craftsman: grid teacher -> MuJoCo TD3 student, dynamic distillation vs scratch "
-          "(about 12 minutes on 2 cores)",
-          tasks=("BlindCraftsman",), worlds=("Cont",), methods=("td3-dynamic", "td3"), seeds=2,
-          student_steps=100_000, eval_every=5_000, eval_episodes=5,
-          td3_hyperparameters={"rho": 1.0, "self_loops": False, "train_freq": 2,
-                               "policy_kwargs": {"net_arch": [64, 64]},
-                               "action_noise": {"type": "persistent", "sigma": 0.6, "resample": 0.1}},
-          cont_world_kwargs={"frame_skip": 10, "max_episode_steps": 200}),
-    Suite("standard", "all three tasks in MuJoCo: dynamic, static and scratch TD3, 5 seeds, 200k steps",
-          tasks=("BlindCraftsman", "DungeonQuest", "DiamondMine"), worlds=("Cont",),
-          methods=("td3-dynamic", "td3-static", "td3"), seeds=5, student_steps=200_000,
-          eval_every=10_000, eval_episodes=20),
+    Suite("quick", "the ladder's easy rungs in MuJoCo: TD3 from scratch and distilled (about 12 minutes on 2 cores)",
+          tags=("easy",), worlds=("Cont",), methods=("td3", "td3-dynamic-edges"), seeds=2,
+          budgets={"easy": 60_000}, eval_episodes=10, td3_n_envs=4,
+          td3_hyperparameters={"policy_kwargs": {"net_arch": [64, 64]}, "prioritized": False, "batch_size": 256,
+                               "learning_rate": 1e-3,
+                               "action_noise": {"type": "persistent", "sigma": 0.6, "resample": 0.1}}),
+    Suite("standard", "every rung x every method, 5 seeds (about 3 hours on 2 cores)",
+          tags=("easy", "medium", "hard"), worlds=("Grid10", "Cont"), methods=tuple(METHODS), seeds=5,
+          budgets={"easy": 60_000, "medium": 150_000, "hard": 300_000}),
     Suite("paper", "everything the paper ran: grid and MuJoCo students, all baselines, 20 seeds, 2M steps",
-          tasks=("BlindCraftsman", "DungeonQuest", "DiamondMine"), worlds=("Grid10", "Cont"),
-          methods=GRID_METHODS + CONT_METHODS, seeds=20, student_steps=2_000_000,
-          eval_every=50_000, eval_episodes=20),
+          tags=("paper",), worlds=("Grid10", "Cont"), methods=tuple(METHODS), seeds=20,
+          student_steps=2_000_000, eval_every=50_000),
 )}
 
 
@@ -107,6 +136,16 @@ def _student_job(config: dict, root: str) -> str:
     import craftsuite  # noqa: F401  (registers the ids in this process)
 
     return str(train_student(StudentConfig(**config), root, progress=False))
+
+
+def _teacher_job(config: dict, root: str) -> str:
+    """One teacher run (training, then distillation) in a worker process."""
+    import torch
+
+    torch.set_num_threads(1)
+    import craftsuite  # noqa: F401
+
+    return str(train_teacher(TeacherConfig(**config), root, progress=False))
 
 
 def _exit_with(driver: int, period: float = 0.5) -> None:
@@ -125,15 +164,57 @@ def _exit_with(driver: int, period: float = 0.5) -> None:
     threading.Thread(target=watch, name="craftsuite-driver-watch", daemon=True).start()
 
 
+class _Workers:
+    """Where jobs run: local worker processes, or a Ray cluster; ``submit`` gives a Future either way."""
+
+    def __init__(self, jobs: int, workers: int | None, ray: str | None):
+        self.ray, self.started, self.remote = None, False, {}
+        if ray is not None:
+            try:
+                import ray as ray_module
+            except ImportError:
+                raise RuntimeError("--ray needs Ray: pip install 'craftsuite[ray]'") from None
+            self.ray, self.started = ray_module, not ray_module.is_initialized()
+            if self.started:
+                ray_module.init(address=None if ray == "local" else ray, include_dashboard=False,
+                                log_to_driver=False, ignore_reinit_error=True)
+        else:
+            import multiprocessing as mp
+
+            self.pool = ProcessPoolExecutor(workers or max(1, min(jobs, os.cpu_count() or 1)),
+                                            mp_context=mp.get_context("spawn"), initializer=_exit_with,
+                                            initargs=(os.getpid(),))
+
+    def submit(self, job, *args) -> Future:
+        if self.ray is not None:
+            if job not in self.remote:
+                self.remote[job] = self.ray.remote(num_cpus=1)(job)
+            return self.remote[job].remote(*args).future()
+        return self.pool.submit(job, *args)
+
+    def close(self) -> None:
+        if self.ray is None:
+            self.pool.shutdown(cancel_futures=True)
+        elif self.started:
+            self.ray.shutdown()
+
+
 def run_students(configs: list[StudentConfig], root, workers: int | None = None, ray: str | None = None,
-                 progress: bool = True) -> list[Path]:
-    """Run students in parallel (processes or Ray) with one progress bar over all their steps."""
+                 progress: bool = True, teachers: dict[str, TeacherConfig] | None = None, teacher_root=None,
+                 log=print) -> list[Path]:
+    """Run students in parallel (processes or Ray) with one progress bar over all their
+    transitions. With ``teachers`` (by task, trained under ``teacher_root``), each
+    teacher runs first in the same pool and its task's distilled students start when it
+    is done; the other students start at once."""
     from tqdm import tqdm
 
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
-    jobs = [dataclasses.asdict(c) for c in configs]
+    teachers = teachers or {}
+    waiting = {task: [c for c in configs if c.task == task and METHODS[c.method].needs_table] for task in teachers}
+    ready = [c for c in configs if not (c.task in teachers and METHODS[c.method].needs_table)]
     total = sum(c.steps for c in configs)
+    workers_ = _Workers(len(configs) + len(teachers), workers, ray)
     with tqdm(total=total, desc=f"{len(configs)} student runs", unit="step", disable=not progress,
               dynamic_ncols=True) as bar:
         def poll():
@@ -149,43 +230,31 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                         pass
             bar.update(done - bar.n)
 
-        if ray is not None:
-            paths = _run_on_ray(jobs, str(root), ray, poll)
-        else:
-            workers = workers or min(len(jobs), os.cpu_count() or 1)
-            import multiprocessing as mp
-
-            with ProcessPoolExecutor(workers, mp_context=mp.get_context("spawn"), initializer=_exit_with,
-                                     initargs=(os.getpid(),)) as pool:
-                futures = [pool.submit(_student_job, job, str(root)) for job in jobs]
-                while not all(f.done() for f in futures):
-                    time.sleep(1.0)
-                    poll()
-                paths = [f.result() for f in futures]  # re-raises a worker's error
+        try:
+            pending = {workers_.submit(_teacher_job, dataclasses.asdict(t), str(teacher_root)): task
+                       for task, t in teachers.items()}
+            students = {c.run_name(): workers_.submit(_student_job, dataclasses.asdict(c), str(root)) for c in ready}
+            while pending or not all(f.done() for f in students.values()):
+                time.sleep(0.5)
+                poll()
+                for future in [f for f in pending if f.done()]:
+                    task = pending.pop(future)
+                    path = Path(future.result())  # re-raises a teacher's error
+                    result = json.loads((path / "result.json").read_text())
+                    reached = "reached" if result["reached_target"] else "did NOT reach"
+                    (bar.write if progress else log)(
+                        f"teacher {task}: {result['steps']:,} steps, greedy success {result['success']:.2f} "
+                        f"({reached} {teachers[task].target_success:.0%}) -> {path}")
+                    for c in waiting.pop(task):
+                        students[c.run_name()] = workers_.submit(_student_job, dataclasses.asdict(c), str(root))
+                for future in students.values():
+                    if future.done() and future.exception() is not None:
+                        raise future.exception()  # a worker's error, at once rather than at the end
+            paths = [students[c.run_name()].result() for c in configs]
+        finally:
+            workers_.close()
         poll()
     return [Path(p) for p in paths]
-
-
-def _run_on_ray(jobs: list[dict], root: str, address: str, poll) -> list[str]:
-    try:
-        import ray
-    except ImportError:
-        raise RuntimeError("--ray needs Ray: pip install 'craftsuite[ray]'") from None
-    started = not ray.is_initialized()
-    if started:
-        ray.init(address=None if address == "local" else address, include_dashboard=False,
-                 log_to_driver=False, ignore_reinit_error=True)
-    try:
-        remote = ray.remote(num_cpus=1)(_student_job)
-        pending = [remote.remote(job, root) for job in jobs]
-        while True:
-            ready, waiting = ray.wait(pending, num_returns=len(pending), timeout=1.0)
-            poll()
-            if not waiting:
-                return ray.get(pending)
-    finally:
-        if started:
-            ray.shutdown()
 
 
 @dataclass(frozen=True)
@@ -200,23 +269,21 @@ class TransferResult:
 
 def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None = None, video: bool = True,
              progress: bool = True, log=print) -> TransferResult:
-    """The suite end to end: teachers, distillation, students, leaderboard, plots, video."""
-    from . import leaderboard
+    """The suite end to end: teachers and distillation, students, leaderboard, plots, video."""
+    from datetime import datetime
 
-    _check_students(suite.student_configs({task: "" for task in suite.tasks}))  # fail before any training
+    from . import leaderboard
+    from .provenance import record_session
+
+    started, clock = datetime.now().astimezone(), time.perf_counter()
     out = Path(out)
+    configs = suite.student_configs(out / "teachers")
+    _check_students(configs)  # fail before any training
     out.mkdir(parents=True, exist_ok=True)
     atomic_write(out / "suite.json", json.dumps(dataclasses.asdict(suite), indent=2) + "\n")
-    teachers, tables = {}, {}
-    for task in suite.tasks:
-        config = TeacherConfig(task=task, max_steps=suite.teacher_max_steps)
-        path = train_teacher(config, out / "teachers", progress=progress)
-        result = json.loads((path / "result.json").read_text())
-        log(f"teacher {task}: {result['steps']:,} steps, greedy success {result['success']:.2f} "
-            f"({'reached' if result['reached_target'] else 'did NOT reach'} {config.target_success:.0%}) -> {path}")
-        teachers[task], tables[task] = path, str((path / "table.npz").resolve())
-    configs = suite.student_configs(tables)
-    students = run_students(configs, out / "students", workers=workers, ray=ray, progress=progress)
+    teachers = suite.teachers()
+    students = run_students(configs, out / "students", workers=workers, ray=ray, progress=progress,
+                            teachers=teachers, teacher_root=out / "teachers", log=log)
     board = leaderboard.build(out / "students")
     board_md = leaderboard.write(board, out)
     plots = leaderboard.plot_curves(out / "students", out)
@@ -225,7 +292,9 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     movie = None
     if video:
         movie = _best_student_video(students, out)
-    return TransferResult(out, teachers, students, board_md, plots, movie)
+    record_session(out, started, time.perf_counter() - clock)
+    return TransferResult(out, {task: out / "teachers" / t.run_name() for task, t in teachers.items()},
+                          students, board_md, plots, movie)
 
 
 def _check_students(configs: list[StudentConfig]) -> None:
@@ -236,17 +305,19 @@ def _check_students(configs: list[StudentConfig]) -> None:
 
     from .agents.methods import make_agent
 
-    kinds = {(c.env_id, c.world, json.dumps(c.env_kwargs, sort_keys=True), json.dumps(c.hyperparameters, sort_keys=True))
-             for c in configs}
-    for env_id, world, env_kwargs, hyper in kinds:
-        agent = make_agent("td3" if world == "Cont" else "dqn", env_id, env_kwargs=json.loads(env_kwargs),
+    kinds = {(c.env_id, c.world, c.n_envs, json.dumps(c.env_kwargs, sort_keys=True),
+              json.dumps(c.hyperparameters, sort_keys=True)) for c in configs}
+    for env_id, world, n_envs, env_kwargs, hyper in kinds:
+        plain = next(m for m in methods_for(world) if not METHODS[m].needs_table)
+        agent = make_agent(plain, env_id, n_envs=n_envs, env_kwargs=json.loads(env_kwargs),
                            **{**json.loads(hyper), "buffer_size": 16})
         agent.get_env().close()
 
 
 def _best_student_video(students: list[Path], out: Path) -> Path | None:
     """A rollout of the best of this suite's student runs (highest final success, then
-    return); runs of another config in the same directory are not candidates."""
+    the hardest rung, then return); runs of another config in the same directory are not
+    candidates."""
     from .rollouts import record_video
     from .runs import read_csv
 
@@ -257,10 +328,11 @@ def _best_student_video(students: list[Path], out: Path) -> Path | None:
             r = json.loads(result.read_text())
             evals = read_csv(run / "evals.csv")
             last = evals[-1] if evals else {"success": 0, "return": float("-inf")}
-            runs.append((float(last["success"]), float(last["return"]), run, r))
+            level = resolve_task(r["task"]).rung[0]
+            runs.append(((float(last["success"]), level, float(last["return"])), run, r))
     if not runs:
         return None
-    _, _, run, r = max(runs, key=lambda x: (x[0], x[1]))
+    _, run, r = max(runs, key=lambda x: x[0])
     name = f"best-{r['env_id'].split('/')[1]}-{r['method']}-s{r['seed']}.mp4"
     rec = record_video(r["env_id"], str(run / r["model"]), 1, str(out / name), seed=10**8,
                        product=r["product"], progress=False, env_kwargs=r.get("env_kwargs"))

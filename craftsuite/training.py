@@ -53,7 +53,7 @@ class StudentConfig:
     method: str = "td3-dynamic"
     world: str = "Cont"  # "Cont" (MuJoCo) or "Grid10" / "Grid7"
     seed: int = 0
-    steps: int = 20_000
+    steps: int = 20_000  # the budget in transitions (env steps over all n_envs envs)
     table: str | None = None  # a teacher's table.npz (method *-dynamic)
     eval_every: int = 2_000
     eval_episodes: int = 10
@@ -61,8 +61,13 @@ class StudentConfig:
     layout_seed: int | None = None  # grid worlds: one fixed instance (None: a new one per episode)
     # more gymnasium.make keywords for the student's world, e.g. {"frame_skip": 10, "max_episode_steps": 200}
     world_kwargs: dict = field(default_factory=dict, metadata={"omit_if_default": True})
+    # envs stepped side by side: each agent step collects n_envs transitions, then takes
+    # the algorithm's gradient_steps updates (the authors' students used 10)
+    n_envs: int = field(default=1, metadata={"omit_if_default": True})
 
     def __post_init__(self):
+        if not isinstance(self.n_envs, int) or isinstance(self.n_envs, bool) or self.n_envs < 1:
+            raise ValueError(f"n_envs must be a positive integer, got {self.n_envs!r}")
         if layout_kwargs(self.layout_seed) and not self.world.startswith("Grid"):  # also checks the seed
             raise ValueError(f"layout_seed fixes a grid instance; the {self.world} world has none "
                              "(its objects are placed anew every episode)")
@@ -261,6 +266,7 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
         evals = read_csv(run.path / "evals.csv")
         success = float(evals[-1]["success"]) if evals else 0.0
         run.write_result({"kind": "teacher", "env_id": config.env_id, "steps": int(agent.num_timesteps),
+                          "updates": int(agent._n_updates),
                           "success": success, "reached_target": success >= config.target_success,
                           "seconds_this_session": round(time.perf_counter() - start, 1),
                           "table": "table.npz", "model": "teacher.zip"})
@@ -282,7 +288,7 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
         table = AutomatonQTable.load(config.table) if method.distill == "dynamic" else None
         hyper = dict(config.hyperparameters)
         hyper.setdefault("buffer_size", min(config.steps, 1_000_000))
-        fresh = make_agent(config.method, config.env_id, table=table, seed=config.seed,
+        fresh = make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=config.n_envs,
                            env_kwargs=config.env_kwargs, **hyper)
 
         def evaluate_fn(model, step):
@@ -295,7 +301,7 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
         agent.save(run.path / "model.zip")
         run.write_result({"kind": "student", "env_id": config.env_id, "method": config.method,
                           "task": config.task, "seed": config.seed, "steps": int(agent.num_timesteps),
-                          "product": method.product, "env_kwargs": config.env_kwargs, "model": "model.zip",
+                          "updates": int(agent._n_updates), "product": method.product, "env_kwargs": config.env_kwargs, "model": "model.zip",
                           "seconds_this_session": round(time.perf_counter() - start, 1)})
         return run.path
 

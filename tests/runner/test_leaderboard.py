@@ -127,3 +127,25 @@ def test_runs_pooled_in_one_row_that_differ_beyond_the_seed_are_flagged(runs, tm
     assert "*td3: its 3 runs differ in steps, not only in the seed" in md and "td3-dynamic: its" not in md
     with open(leaderboard.write(list(entries.values()), tmp_path).with_suffix(".csv")) as f:
         assert {r["method"]: r["pooled_runs_differ_in"] for r in csv.DictReader(f)} == {"td3": "steps", "td3-dynamic": ""}
+
+
+def test_budget_reads_in_transitions_and_gradient_updates_and_methods_are_explained(runs):
+    for seed, updates in ((5, 240), (6, 260)):
+        run = fake_run(runs, "td3-dynamic-edges", seed, [(1000, 0.5)], [(995, 1.0)])
+        (run / "result.json").write_text(json.dumps({"kind": "student", "steps": 1000, "updates": updates}))
+    entries = {e.method: e for e in leaderboard.build(runs)}
+    assert entries["td3-dynamic-edges"].budget_text == "1,000 / 250"
+    assert entries["td3"].budget_text == "1,000 / ?"  # runs from before updates were recorded
+    md = leaderboard.to_markdown(list(entries.values()))
+    assert "| 1,000 / 250 |" in md
+    assert "- `td3-dynamic-edges`: td3-dynamic with the teacher's values on the automaton's edges only" in md
+    assert md.index("- `td3`:") < md.index("- `td3-dynamic`:")  # the legend follows the methods table
+
+
+def test_results_page_names_the_missing_and_the_empty(tmp_path):
+    with pytest.raises(FileNotFoundError, match="no run directory"):
+        leaderboard.write_page([tmp_path / "nope"], tmp_path / "results.md")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError, match="no finished student runs"):
+        leaderboard.write_page([tmp_path / "empty"], tmp_path / "results.md")
+    assert not (tmp_path / "results.md").exists()

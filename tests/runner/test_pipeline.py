@@ -90,25 +90,44 @@ def test_transfer_flags_reach_the_suite(tmp_path, monkeypatch):
         return craftsuite.suites.TransferResult(Path(out), {}, [], Path(out) / "leaderboard.md", [], None)
 
     monkeypatch.setattr(craftsuite.suites, "transfer", fake_transfer)
-    assert main(["transfer", "--out", str(tmp_path), "--env", '{"frame_skip": 10}',
-                 "--td3-hyper", '{"learning_rate": 0.001}']) == 0
+    assert main(["transfer", "--out", str(tmp_path), "--env", '{"frame_skip": 2}',
+                 "--td3-hyper", '{"learning_rate": 0.0005}', "--tags", "medium", "--tasks", "Reach"]) == 0
     [suite] = seen
-    assert suite.cont_world_kwargs == {"frame_skip": 10}
+    assert suite.cont_world_kwargs == {"frame_skip": 2}
+    assert (suite.tags, suite.tasks) == (("medium",), ("Reach",))
     # merged over the suite's own TD3 settings, not replacing them
-    assert suite.td3_hyperparameters == {**SUITES["quick"].td3_hyperparameters, "learning_rate": 0.001}
+    assert suite.td3_hyperparameters == {**SUITES["quick"].td3_hyperparameters, "learning_rate": 0.0005}
 
 
-def test_suites_are_well_formed():
+def test_suites_are_well_formed(tmp_path):
+    from itertools import product
+
+    from craftsuite.methods import METHODS
+    from craftsuite.registration import ladder
+
     assert {"quick", "standard", "paper"} <= set(SUITES)
-    quick = SUITES["quick"].student_configs({"BlindCraftsman": "t.npz"})
-    assert {c.method for c in quick} == {"td3-dynamic", "td3"}
-    assert all(c.world == "Cont" for c in quick)
-    assert all((c.table == "t.npz") == (c.method == "td3-dynamic") for c in quick)
+    quick = SUITES["quick"].student_configs(tmp_path)
+    assert {c.task for c in quick} == {s.name for s in ladder("easy")}
+    assert {c.method for c in quick} == {"td3-dynamic-edges", "td3"}
+    assert all(c.world == "Cont" and c.n_envs == SUITES["quick"].td3_n_envs for c in quick)
+    teachers = SUITES["quick"].teachers()
+    for c in quick:  # a distilled student reads its own rung's teacher's table
+        expected = str((tmp_path / teachers[c.task].run_name() / "table.npz").resolve())
+        assert c.table == (expected if c.method == "td3-dynamic-edges" else None)
     # quick's TD3 network stays with its TD3 students when the worlds are overridden
     both = dataclasses.replace(SUITES["quick"], worlds=("Cont", "Grid10"), methods=("td3", "dqn"))
-    nets = {c.world: c.hyperparameters.get("policy_kwargs") for c in both.student_configs({})}
+    nets = {c.world: c.hyperparameters.get("policy_kwargs") for c in both.student_configs(tmp_path)}
     assert nets == {"Cont": {"net_arch": [64, 64]}, "Grid10": None}
-    paper = SUITES["paper"].student_configs({t: "t.npz" for t in SUITES["paper"].tasks})
+    assert both.teachers() == {}  # no method needs a teacher
+    # standard: every rung x every method (each in its world) x 5 seeds, budgets by level
+    standard = SUITES["standard"].student_configs(tmp_path)
+    assert {(c.task, c.method) for c in standard} == set(product([s.name for s in ladder()], METHODS))
+    assert {c.seed for c in standard} == set(range(5))
+    budgets = SUITES["standard"].budgets
+    assert all(c.steps == budgets[ladder_spec.level] for c in standard for ladder_spec in ladder()
+               if ladder_spec.name == c.task)
+    paper = SUITES["paper"].student_configs(tmp_path)
+    assert {c.task for c in paper} == {s.name for s in ladder("paper")}
     assert {(c.world, c.method) for c in paper} >= {("Grid10", "crm"), ("Cont", "td3-static")}
     assert not any(c.world == "Cont" and c.method == "dqn" for c in paper)
     # grid students learn one instance of their own, as the paper's did; MuJoCo layouts vary
@@ -116,9 +135,50 @@ def test_suites_are_well_formed():
     assert {c.layout_seed for c in paper if c.world == "Cont"} == {None}
     # the MuJoCo world's settings reach the MuJoCo students only
     skipped = dataclasses.replace(SUITES["quick"], worlds=("Cont", "Grid10"), methods=("td3", "dqn"),
-                                  cont_world_kwargs={"frame_skip": 10})
-    assert {c.world: c.env_kwargs for c in skipped.student_configs({})} == \
-        {"Cont": {"frame_skip": 10}, "Grid10": {"layout_seed": 1}}
+                                  cont_world_kwargs={"frame_skip": 2})
+    assert {c.world: c.env_kwargs for c in skipped.student_configs(tmp_path)} == \
+        {"Cont": {"frame_skip": 2}, "Grid10": {"layout_seed": 1}}
+
+
+def test_suite_selection_errors_name_the_problem(tmp_path):
+    quick = SUITES["quick"]
+    with pytest.raises(KeyError, match=r"no task spec has tag \['hardest'\]"):
+        dataclasses.replace(quick, tags=("hardest",)).student_configs(tmp_path)
+    with pytest.raises(ValueError, match="selects no rung"):
+        dataclasses.replace(quick, tags=()).student_configs(tmp_path)
+    with pytest.raises(ValueError, match="has no budget for FirstTool's level 'medium'"):
+        dataclasses.replace(quick, tags=("medium",)).student_configs(tmp_path)
+    with pytest.raises(KeyError, match="unknown method"):
+        dataclasses.replace(quick, methods=("td3", "td4")).student_configs(tmp_path)
+
+
+def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenance(tmp_path):
+    from craftsuite import leaderboard
+    from craftsuite.provenance import read
+    from craftsuite.suites import transfer
+
+    tiny = dataclasses.replace(SUITES["quick"], tags=("calibration",), seeds=1, student_steps=300, eval_every=150,
+                               eval_episodes=1, teacher_max_steps=400, td3_n_envs=2,
+                               td3_hyperparameters={"learning_starts": 100, "policy_kwargs": {"net_arch": [16]}})
+    result = transfer(tiny, tmp_path / "out", workers=2, video=False, progress=False, log=lambda *_: None)
+    [teacher] = result.teachers.values()
+    assert (teacher / "table.npz").is_file()
+    results = {json.loads((p / "result.json").read_text())["method"]: json.loads((p / "result.json").read_text())
+               for p in result.students}
+    assert set(results) == {"td3", "td3-dynamic-edges"}
+    for r in results.values():  # budgets in transitions and in gradient updates, 2 envs per update
+        assert r["steps"] == 300 and 0 < r["updates"] <= (300 - 100) // 2 + 1
+    board = result.leaderboard.read_text()
+    assert "## Reach (Cont)" in board and "| 300 / " in board and "- `td3-dynamic-edges`:" in board
+    [session] = read(tmp_path / "out")
+    assert session["command"] and session["machine"] and "torch" in session["versions"]
+    page = leaderboard.write_page([tmp_path / "out"], tmp_path / "docs" / "results.md")
+    text = page.read_text()
+    assert "## quick:" in text and "### Reach (Cont)" in text and session["command"] in text
+    assert "images/results-quick/curves-Reach-Cont.png" in text
+    assert (tmp_path / "docs" / "images" / "results-quick" / "curves-Reach-Cont.png").is_file()
+    transfer(tiny, tmp_path / "out", workers=2, video=False, progress=False, log=lambda *_: None)  # all reused
+    assert len(read(tmp_path / "out")) == 2
 
 
 def test_students_on_a_local_ray_instance(tmp_path):

@@ -192,11 +192,12 @@ def test_runs_made_before_world_kwargs_existed_keep_their_directories(tmp_path):
     import hashlib
 
     plain, skipped = StudentConfig(), StudentConfig(world_kwargs={"frame_skip": 10})
-    assert plain.run_name() != skipped.run_name()
-    saved = {k: v for k, v in dataclasses.asdict(plain).items() if k != "world_kwargs"}
+    assert plain.run_name() != skipped.run_name() != StudentConfig(n_envs=4).run_name()
+    # as older versions wrote it: no world_kwargs nor n_envs field
+    saved = {k: v for k, v in dataclasses.asdict(plain).items() if k not in ("world_kwargs", "n_envs")}
     before = hashlib.sha256(json.dumps(saved, sort_keys=True).encode()).hexdigest()[:10]  # the old key
     assert plain.run_name().endswith(before)
-    old = tmp_path / plain.run_name()  # as an older version wrote it: no world_kwargs field
+    old = tmp_path / plain.run_name()
     old.mkdir()
     (old / "config.json").write_text(json.dumps(saved))
     with RunDir(old, plain):  # the same configuration: taken, not refused

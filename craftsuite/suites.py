@@ -40,8 +40,10 @@ class Suite:
     worlds: tuple[str, ...] = ("Cont",)  # student worlds: "Cont" (MuJoCo), "Grid10", "Grid7"
     methods: tuple[str, ...] = ("td3",)  # each runs in the worlds its METHODS row is for
     seeds: int = 5
-    # each rung's budget in transitions, by its level (TaskSpec.level); student_steps, when
-    # set, is one budget for every rung
+    # each run's budget in transitions, by world kind and rung level (TaskSpec.level), e.g.
+    # {"Cont": {"easy": 150_000, "hard": 100_000}, "Grid": {...}}: the two worlds' students
+    # collect at different rates and learn at different rates per transition. student_steps,
+    # when set, is one budget for every run.
     budgets: dict = field(default_factory=dict)
     student_steps: int | None = None
     teacher_max_steps: int = 300_000
@@ -69,14 +71,15 @@ class Suite:
         chosen.update({name: resolve_task(name) for name in self.tasks})
         return sorted(chosen.values(), key=lambda s: s.rung)
 
-    def budget(self, spec: TaskSpec) -> int:
-        """A rung's student budget in transitions."""
+    def budget(self, spec: TaskSpec, world: str) -> int:
+        """A student's budget in transitions on a rung in a world."""
         if self.student_steps is not None:
             return self.student_steps
-        if spec.level not in self.budgets:
-            raise ValueError(f"suite {self.name!r} has no budget for {spec.name}'s level {spec.level!r} "
+        kind = world_kind(world)
+        if spec.level not in self.budgets.get(kind, {}):
+            raise ValueError(f"suite {self.name!r} has no {kind} budget for {spec.name}'s level {spec.level!r} "
                              f"(tags {list(spec.tags)}); budgets: {self.budgets}")
-        return self.budgets[spec.level]
+        return self.budgets[kind][spec.level]
 
     def teachers(self) -> dict[str, TeacherConfig]:
         """One grid teacher per rung whose students need a teacher's table."""
@@ -91,10 +94,13 @@ class Suite:
         teachers = self.teachers()
         out = []
         for spec in self.rungs():
-            steps = self.budget(spec)
             for world in self.worlds:
+                methods = [m for m in methods_for(world) if m in self.methods]
+                if not methods:
+                    continue
+                steps = self.budget(spec, world)
                 cont = world_kind(world) == "Cont"
-                for method in (m for m in methods_for(world) if m in self.methods):
+                for method in methods:
                     table = None
                     if METHODS[method].needs_table:
                         table = str((Path(teacher_root) / teachers[spec.name].run_name() / "table.npz").resolve())
@@ -112,16 +118,26 @@ class Suite:
         return out
 
 
+# The collection regimes measured to learn most per wall-clock second on two cores
+# (experiments/collection-regime): TD3 collects from 10 envs per gradient update (as the
+# authors did), with batch 256, lr 1e-3, a [64, 64] network, uniform replay and a
+# persistent exploration noise; DQN from 4 envs with 2 updates per step (one update per two
+# transitions) and its target network updated every 100 updates.
+TD3_REGIME = dict(td3_n_envs=10, td3_hyperparameters={
+    "batch_size": 256, "learning_rate": 1e-3, "policy_kwargs": {"net_arch": [64, 64]}, "prioritized": False,
+    "action_noise": {"type": "persistent", "sigma": 0.6, "resample": 0.1}})
+DQN_REGIME = dict(dqn_n_envs=4, dqn_hyperparameters={"gradient_steps": 2, "target_update_interval": 200})
+
 SUITES = {s.name: s for s in (
-    Suite("quick", "the ladder's easy rungs in MuJoCo: TD3 from scratch and distilled (about 12 minutes on 2 cores)",
-          tags=("easy",), worlds=("Cont",), methods=("td3", "td3-dynamic-edges"), seeds=2,
-          budgets={"easy": 60_000}, eval_episodes=10, td3_n_envs=4,
-          td3_hyperparameters={"policy_kwargs": {"net_arch": [64, 64]}, "prioritized": False, "batch_size": 256,
-                               "learning_rate": 1e-3,
-                               "action_noise": {"type": "persistent", "sigma": 0.6, "resample": 0.1}}),
+    Suite("quick", "the calibration rung and the two-stage rung in MuJoCo: TD3 from scratch and distilled "
+          "(about 12 minutes on 2 cores)",
+          tags=("calibration", "medium"), worlds=("Cont",), methods=("td3", "td3-dynamic-edges"), seeds=2,
+          budgets={"Cont": {"easy": 100_000, "medium": 800_000}}, **TD3_REGIME),
     Suite("standard", "every rung x every method, 5 seeds (about 3 hours on 2 cores)",
           tags=("easy", "medium", "hard"), worlds=("Grid10", "Cont"), methods=tuple(METHODS), seeds=5,
-          budgets={"easy": 60_000, "medium": 150_000, "hard": 300_000}),
+          budgets={"Cont": {"easy": 120_000, "medium": 600_000, "hard": 100_000},
+                   "Grid": {"easy": 30_000, "medium": 60_000, "hard": 70_000}},
+          **TD3_REGIME, **DQN_REGIME),
     Suite("paper", "everything the paper ran: grid and MuJoCo students, all baselines, 20 seeds, 2M steps",
           tags=("paper",), worlds=("Grid10", "Cont"), methods=tuple(METHODS), seeds=20,
           student_steps=2_000_000, eval_every=50_000),

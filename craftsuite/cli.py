@@ -345,7 +345,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_student)
 
     p = sub.add_parser("transfer", help="a suite end to end: teacher, distillation, students, leaderboard, video")
-    p.add_argument("--suite", default="quick", help="quick (default, ~12 min), standard or paper")
+    p.add_argument("--suite", default="quick", help="quick (default, ~11 min), standard (~3 h) or paper (a cluster)")
     p.add_argument("--out", default="runs/quick", help="output directory (default: runs/quick)")
     p.add_argument("--tags", nargs="+", help="override the suite's rungs: the tasks with any of these tags")
     p.add_argument("--tasks", nargs="+", help="override the suite's rungs: these tasks (with --tags: and these)")

@@ -284,6 +284,7 @@ def _curve(values_at, grid):
 def plot_curves(students_root, out) -> list[Path]:
     """Figure-5-style learning curves per task and world: mean and 95% band over seeds."""
     from matplotlib.figure import Figure  # not pyplot: no global backend switch in the caller's session
+    from matplotlib.ticker import EngFormatter
 
     runs: dict[tuple, list[tuple[dict, list, list, int]]] = {}
     for run in sorted(Path(students_root).iterdir()) if Path(students_root).is_dir() else []:
@@ -325,6 +326,8 @@ def plot_curves(students_root, out) -> list[Path]:
         axes[1].set(xlabel="transitions", ylabel="success rate", ylim=(-0.02, 1.02))
         axes[1].set_title("success: greedy evaluation (solid), training episodes (dashed)", fontsize=9)
         axes[1].legend(loc="upper left", fontsize=8)
+        for ax in axes:  # 800k, not 800000 run into its neighbours
+            ax.xaxis.set_major_formatter(EngFormatter(sep=""))
         fig.tight_layout()
         name = f"curves-{task}-{_file_part(world)}"
         if any(p.stem == name for p in paths):  # two settings that read alike once in a file name

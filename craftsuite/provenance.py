@@ -61,8 +61,10 @@ def record_session(out, started: datetime, seconds: float, command: list[str] | 
     """Append this invocation to ``out/provenance.json``."""
     path = Path(out) / FILE
     sessions = read(out)
-    argv = command if command is not None else [Path(sys.argv[0]).name, *sys.argv[1:]]
-    sessions.append({"command": shlex.join(argv), "started": started.astimezone(timezone.utc).isoformat(timespec="seconds"),
+    if command is None:  # `python -m craftsuite` runs __main__.py: name it as users type it
+        program = Path(sys.argv[0]).name
+        command = ["craftsuite" if program in ("__main__.py", "craftsuite") else program, *sys.argv[1:]]
+    sessions.append({"command": shlex.join(command), "started": started.astimezone(timezone.utc).isoformat(timespec="seconds"),
                      "seconds": round(seconds, 1), "commit": git_commit(), "machine": machine(),
                      "versions": versions()})
     atomic_write(path, json.dumps(sessions, indent=2) + "\n")

@@ -1,5 +1,5 @@
 # The two commands a new user needs (both do the whole set-up first, once):
-#   make demo   the main job: the quick transfer benchmark (grid teacher -> MuJoCo students),
+#   make demo   the main job: the quick transfer benchmark (grid teachers -> MuJoCo students),
 #               ending in a leaderboard, learning curves and a video in runs/quick
 #   make test   the default test run (slow tests excluded; `make test-slow` runs them)
 VENV ?= .venv
@@ -27,6 +27,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/automata.py
 	$(PY) benchmarks/grid_steps.py
 	$(PY) benchmarks/cont_steps.py
+	$(PY) benchmarks/student_throughput.py
 
 clean:
 	rm -rf out .pytest_cache

@@ -294,12 +294,13 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     from datetime import datetime
 
     from . import leaderboard
-    from .provenance import record_session
+    from .provenance import read, record_session
 
     started, clock = datetime.now().astimezone(), time.perf_counter()
     out = Path(out)
     configs = suite.student_configs(out / "teachers")
     _check_students(configs)  # fail before any training
+    read(out)  # a damaged provenance record, too
     out.mkdir(parents=True, exist_ok=True)
     atomic_write(out / "suite.json", json.dumps(dataclasses.asdict(suite), indent=2) + "\n")
     teachers = suite.teachers()

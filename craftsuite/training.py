@@ -301,7 +301,8 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
         agent.save(run.path / "model.zip")
         run.write_result({"kind": "student", "env_id": config.env_id, "method": config.method,
                           "task": config.task, "seed": config.seed, "steps": int(agent.num_timesteps),
-                          "updates": int(agent._n_updates), "product": method.product, "env_kwargs": config.env_kwargs, "model": "model.zip",
+                          "updates": int(agent._n_updates), "product": method.product,
+                          "env_kwargs": config.env_kwargs, "model": "model.zip",
                           "seconds_this_session": round(time.perf_counter() - start, 1)})
         return run.path
 

@@ -1,7 +1,8 @@
 """Where a result came from: the command, the code (version and git commit), the machine.
 
-``transfer`` appends one session per invocation to ``<out>/provenance.json``; the results
-page (``leaderboard.write_page``) prints them beside the leaderboard it generates.
+``transfer`` takes a session when it starts (``start_session``) and appends it to
+``<out>/provenance.json`` when it ends; the results page (``leaderboard.write_page``)
+prints the sessions beside the leaderboard it generates.
 """
 
 from __future__ import annotations
@@ -57,16 +58,22 @@ def versions() -> dict[str, str]:
     return out
 
 
-def record_session(out, started: datetime, seconds: float, command: list[str] | None = None) -> Path:
-    """Append this invocation to ``out/provenance.json``."""
-    path = Path(out) / FILE
-    sessions = read(out)
+def start_session(command: list[str] | None = None) -> dict:
+    """This invocation as ``record_session`` writes it, taken when it starts: the code that
+    runs is the code at its start, whatever is committed while it runs."""
     if command is None:  # `python -m craftsuite` runs __main__.py: name it as users type it
         program = Path(sys.argv[0]).name
         command = ["craftsuite" if program in ("__main__.py", "craftsuite") else program, *sys.argv[1:]]
-    sessions.append({"command": shlex.join(command), "started": started.astimezone(timezone.utc).isoformat(timespec="seconds"),
-                     "seconds": round(seconds, 1), "commit": git_commit(), "machine": machine(),
-                     "versions": versions()})
+    return {"command": shlex.join(command),
+            "started": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+            "commit": git_commit(), "machine": machine(), "versions": versions()}
+
+
+def record_session(out, session: dict, seconds: float) -> Path:
+    """Append a session (``start_session``) that took ``seconds`` to ``out/provenance.json``."""
+    path = Path(out) / FILE
+    sessions = read(out)
+    sessions.append({**session, "seconds": round(seconds, 1)})
     atomic_write(path, json.dumps(sessions, indent=2) + "\n")
     return path
 

@@ -291,12 +291,10 @@ class TransferResult:
 def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None = None, video: bool = True,
              progress: bool = True, log=print) -> TransferResult:
     """The suite end to end: teachers and distillation, students, leaderboard, plots, video."""
-    from datetime import datetime
-
     from . import leaderboard
-    from .provenance import read, record_session
+    from .provenance import read, record_session, start_session
 
-    started, clock = datetime.now().astimezone(), time.perf_counter()
+    session, clock = start_session(), time.perf_counter()
     out = Path(out)
     configs = suite.student_configs(out / "teachers")
     _check_students(configs)  # fail before any training
@@ -314,7 +312,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     movie = None
     if video:
         movie = _best_student_video(students, out)
-    record_session(out, started, time.perf_counter() - clock)
+    record_session(out, session, time.perf_counter() - clock)
     return TransferResult(out, {task: out / "teachers" / t.run_name() for task, t in teachers.items()},
                           students, board_md, plots, movie)
 

@@ -329,7 +329,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--method", default="td3-dynamic", choices=list(METHODS), metavar="METHOD",
                    help=f"one of {methods} (craftsuite.methods.METHODS; default: td3-dynamic)")
     p.add_argument("--world", default="Cont", help="Cont (MuJoCo, default), Grid10 or Grid7")
-    p.add_argument("--table", help="a teacher's table.npz (the *dynamic methods)")
+    p.add_argument("--table", help="a teacher's table.npz (craftsuite teacher), for the methods that distil one: "
+                   + ", ".join(m for m, row in METHODS.items() if row.needs_table))
     p.add_argument("--out", default="runs/students", help="runs directory (default: runs/students)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--steps", type=_positive, default=20_000, help="the budget in transitions (default: 20000)")
@@ -339,8 +340,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--eval-episodes", type=_positive, default=10)
     p.add_argument("--hyper", help="JSON overrides of the algorithm's settings, e.g. "
                    "'{\"action_noise\": {\"type\": \"persistent\", \"sigma\": 0.6, \"resample\": 0.1}}'")
-    p.add_argument("--env", help="JSON gymnasium.make keywords of the world, e.g. "
-                   "'{\"frame_skip\": 10, \"max_episode_steps\": 200}'")
+    p.add_argument("--env", help="JSON gymnasium.make keywords beyond the registered world, e.g. the "
+                   "fine-control MuJoCo world '{\"frame_skip\": 2, \"max_episode_steps\": 1000}'")
     p.add_argument("--layout-seed", type=int, help="grid worlds: one fixed instance (default: a new one per episode)")
     p.set_defaults(run=_student)
 
@@ -357,7 +358,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--teacher-steps", type=_positive, help="override the teacher's step limit")
     p.add_argument("--eval-every", type=_positive, help="override the evaluation interval")
     p.add_argument("--env", help="JSON gymnasium.make keywords of the MuJoCo students' world (replaces the suite's), "
-                   "e.g. '{\"frame_skip\": 10, \"max_episode_steps\": 200}'")
+                   "e.g. '{\"frame_skip\": 2, \"max_episode_steps\": 1000}'; the leaderboard names them")
     p.add_argument("--td3-hyper", help="JSON overrides of the TD3 students' settings, merged over the suite's, e.g. "
                    "'{\"action_noise\": {\"type\": \"persistent\", \"sigma\": 0.6, \"resample\": 0.1}}'")
     p.add_argument("--workers", type=_positive, help="parallel local processes (default: one per core)")
@@ -383,7 +384,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--fps", type=float, help="frames per second (default: the env's render_fps)")
     p.add_argument("--product", action="store_true",
                    help="make the env with product=True (for checkpoints trained on the product MDP)")
-    p.add_argument("--env", help="JSON gymnasium.make keywords, e.g. '{\"frame_skip\": 10}' "
+    p.add_argument("--env", help="JSON gymnasium.make keywords, e.g. '{\"frame_skip\": 2}' "
                    "(the world the checkpoint was trained in)")
     p.set_defaults(run=_video)
     return parser

@@ -256,8 +256,9 @@ def write_page(run_dirs, path, title: str = "Results") -> Path:
         lines += [f"## {name}" + (f": {suite['description']}" if suite.get("description") else ""), ""]
         sessions = read(run_dir)
         for s in sessions:
-            lines.append(f"- `{s['command']}`: {s['started'][:10]}, commit {s.get('commit') or 'unknown'}, "
-                         f"{s['seconds'] / 60:.1f} min on {s['machine']}")
+            took = "did not finish" if s.get("seconds") is None else f"{s['seconds'] / 60:.1f} min"
+            lines.append(f"- `{s['command']}`: {s['started'][:16].replace('T', ' ')} UTC, commit "
+                         f"{s.get('commit') or 'unknown'}, {took} on {s['machine']}")
         if not sessions:
             lines.append(f"- runs in `{run_dir}` (no provenance.json: not made by `craftsuite transfer`)")
         board = to_markdown(entries, title=None).replace("\n## ", "\n### ")

@@ -1,8 +1,9 @@
 """Where a result came from: the command, the code (version and git commit), the machine.
 
-``transfer`` takes a session when it starts (``start_session``) and appends it to
-``<out>/provenance.json`` when it ends; the results page (``leaderboard.write_page``)
-prints the sessions beside the leaderboard it generates.
+``transfer`` takes a session when it starts (``start_session``), records it in
+``<out>/provenance.json`` at once without a duration, and records its duration when it
+ends: a session that is killed still leaves its command and commit, marked unfinished.
+The results page (``leaderboard.write_page``) prints the sessions beside the leaderboard.
 """
 
 from __future__ import annotations
@@ -69,11 +70,18 @@ def start_session(command: list[str] | None = None) -> dict:
             "commit": git_commit(), "machine": machine(), "versions": versions()}
 
 
-def record_session(out, session: dict, seconds: float) -> Path:
-    """Append a session (``start_session``) that took ``seconds`` to ``out/provenance.json``."""
+def record_session(out, session: dict, seconds: float | None) -> Path:
+    """Record a session (``start_session``) in ``out/provenance.json``: appended, or, if it
+    is there already (same start and command), updated. ``seconds`` None: not finished."""
     path = Path(out) / FILE
     sessions = read(out)
-    sessions.append({**session, "seconds": round(seconds, 1)})
+    entry = {**session, "seconds": None if seconds is None else round(seconds, 1)}
+    same = [i for i, s in enumerate(sessions)
+            if (s.get("started"), s.get("command")) == (session["started"], session["command"])]
+    if same:
+        sessions[same[-1]] = entry
+    else:
+        sessions.append(entry)
     atomic_write(path, json.dumps(sessions, indent=2) + "\n")
     return path
 

@@ -301,6 +301,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     read(out)  # a damaged provenance record, too
     out.mkdir(parents=True, exist_ok=True)
     atomic_write(out / "suite.json", json.dumps(dataclasses.asdict(suite), indent=2) + "\n")
+    record_session(out, session, None)  # if this session is killed, its command and commit stay on record
     teachers = suite.teachers()
     students = run_students(configs, out / "students", workers=workers, ray=ray, progress=progress,
                             teachers=teachers, teacher_root=out / "teachers", log=log)

@@ -152,8 +152,8 @@ def test_suite_selection_errors_name_the_problem(tmp_path):
         dataclasses.replace(quick, methods=("td3", "td4")).student_configs(tmp_path)
 
 
-def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenance(tmp_path):
-    from craftsuite import leaderboard
+def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenance(tmp_path, monkeypatch):
+    from craftsuite import leaderboard, suites
     from craftsuite.provenance import read
     from craftsuite.suites import transfer
 
@@ -179,6 +179,15 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
     assert (tmp_path / "docs" / "images" / "results-quick" / "curves-Reach-Cont.png").is_file()
     transfer(tiny, tmp_path / "out", workers=2, video=False, progress=False, log=lambda *_: None)  # all reused
     assert len(read(tmp_path / "out")) == 2
+
+    def killed(*args, **kwargs):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(suites, "run_students", killed)
+    with pytest.raises(KeyboardInterrupt):
+        transfer(tiny, tmp_path / "out", workers=2, video=False, progress=False, log=lambda *_: None)
+    assert [s["seconds"] is None for s in read(tmp_path / "out")] == [False, False, True]
+    text = leaderboard.write_page([tmp_path / "out"], tmp_path / "docs" / "results.md").read_text()
+    assert text.count("min on ") == 2 and text.count("did not finish on ") == 1
 
 
 def test_students_on_a_local_ray_instance(tmp_path):

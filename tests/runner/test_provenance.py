@@ -33,3 +33,12 @@ def test_a_damaged_record_is_named_and_kept(tmp_path):
     (tmp_path / "provenance.json").write_text(json.dumps({"a": 1}))
     with pytest.raises(ValueError, match="holds no list of sessions"):
         read(tmp_path)
+
+
+def test_a_session_is_on_record_from_its_start_and_updated_when_it_ends(tmp_path):
+    killed, finished = start_session(command=["craftsuite", "transfer"]), start_session(command=["craftsuite", "x"])
+    record_session(tmp_path, killed, None)  # never updated: killed
+    record_session(tmp_path, finished, None)
+    record_session(tmp_path, finished, 12.34)
+    assert [(s["command"], s["seconds"]) for s in read(tmp_path)] == [("craftsuite transfer", None),
+                                                                       ("craftsuite x", 12.3)]

@@ -78,13 +78,14 @@ class Suite:
         kind = world_kind(world)
         if spec.level not in self.budgets.get(kind, {}):
             raise ValueError(f"suite {self.name!r} has no {kind} budget for {spec.name}'s level {spec.level!r} "
-                             f"(tags {list(spec.tags)}); budgets: {self.budgets}")
+                             f"(tags {list(spec.tags)}); budgets: {self.budgets}. Give every run the same "
+                             "budget (--steps N, Suite.student_steps) or tag the task with a level the suite has")
         return self.budgets[kind][spec.level]
 
     def teachers(self) -> dict[str, TeacherConfig]:
         """One grid teacher per rung whose students need a teacher's table."""
-        if not any(METHODS[m].needs_table for m in self.methods):
-            return {}
+        if not any(METHODS[m].needs_table for w in self.worlds for m in methods_for(w) if m in self.methods):
+            return {}  # e.g. grid-only distillers in a MuJoCo-only suite: no teacher would be used
         return {spec.name: TeacherConfig(task=spec.name, max_steps=self.teacher_max_steps) for spec in self.rungs()}
 
     def student_configs(self, teacher_root) -> list[StudentConfig]:
@@ -120,7 +121,7 @@ class Suite:
 
 # The collection regimes measured to learn most per wall-clock second on two cores
 # (experiments/collection-regime): TD3 collects from 10 envs per gradient update (as the
-# authors did), with batch 256, lr 1e-3, a [64, 64] network, uniform replay and a
+# authors collected too), with batch 256, lr 1e-3, a [64, 64] network, uniform replay and a
 # persistent exploration noise; DQN from 4 envs with 2 updates per step (one update per two
 # transitions) and its target network updated every 100 updates.
 TD3_REGIME = dict(td3_n_envs=10, td3_hyperparameters={
@@ -135,7 +136,7 @@ DQN_REGIME = dict(dqn_n_envs=4, dqn_hyperparameters={"gradient_steps": 2, "targe
 # on 2 cores for the standard suite (no TD3 student learns them in so few).
 SUITES = {s.name: s for s in (
     Suite("quick", "the calibration rung and the two-stage rung in MuJoCo: TD3 from scratch and distilled "
-          "(about 11 minutes on 2 cores)",
+          "(about 10 minutes on 2 cores)",
           tags=("calibration", "medium"), worlds=("Cont",), methods=("td3", "td3-dynamic-edges"), seeds=2,
           budgets={"Cont": {"easy": 200_000, "medium": 800_000}}, **TD3_REGIME),
     Suite("standard", "every rung x every method, 5 seeds (about 3 hours on 2 cores)",
@@ -143,7 +144,7 @@ SUITES = {s.name: s for s in (
           budgets={"Cont": {"easy": 250_000, "medium": 800_000, "hard": 60_000},
                    "Grid": {"easy": 30_000, "medium": 60_000, "hard": 60_000}},
           **TD3_REGIME, **DQN_REGIME),
-    Suite("paper", "everything the paper ran: grid and MuJoCo students, all baselines, 20 seeds, 2M steps",
+    Suite("paper", "the paper's tasks in the grid and MuJoCo worlds, every method, 20 seeds, 2M transitions per run",
           tags=("paper",), worlds=("Grid10", "Cont"), methods=tuple(METHODS), seeds=20,
           student_steps=2_000_000, eval_every=50_000),
 )}
@@ -185,6 +186,9 @@ def _exit_with(driver: int, period: float = 0.5) -> None:
     threading.Thread(target=watch, name="craftsuite-driver-watch", daemon=True).start()
 
 
+RUNS_PER_WORKER = 4  # local worker processes are replaced after this many runs
+
+
 class _Workers:
     """Where jobs run: local worker processes, or a Ray cluster; ``submit`` gives a Future either way."""
 
@@ -202,9 +206,11 @@ class _Workers:
         else:
             import multiprocessing as mp
 
+            # a fresh process every few runs: a worker that ran ~90 students in a row had grown to
+            # 13 GB and was killed for memory; spawning costs a few seconds of imports per run
             self.pool = ProcessPoolExecutor(workers or max(1, min(jobs, os.cpu_count() or 1)),
                                             mp_context=mp.get_context("spawn"), initializer=_exit_with,
-                                            initargs=(os.getpid(),))
+                                            initargs=(os.getpid(),), max_tasks_per_child=RUNS_PER_WORKER)
 
     def submit(self, job, *args) -> Future:
         if self.ray is not None:
@@ -213,9 +219,15 @@ class _Workers:
             return self.remote[job].remote(*args).future()
         return self.pool.submit(job, *args)
 
-    def close(self) -> None:
+    def close(self, abort: bool = False) -> None:
+        """Wait for the jobs; or, with ``abort`` (a job failed, or the driver was interrupted),
+        stop them now: every run resumes from its last checkpoint when asked for again."""
         if self.ray is None:
-            self.pool.shutdown(cancel_futures=True)
+            processes = list((getattr(self.pool, "_processes", None) or {}).values())  # shutdown forgets them
+            self.pool.shutdown(wait=not abort, cancel_futures=True)
+            if abort:  # shutdown alone would still let each running job finish (hours, in a suite)
+                for process in processes:
+                    process.terminate()
         elif self.started:
             self.ray.shutdown()
 
@@ -272,8 +284,10 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                     if future.done() and future.exception() is not None:
                         raise future.exception()  # a worker's error, at once rather than at the end
             paths = [students[c.run_name()].result() for c in configs]
-        finally:
-            workers_.close()
+        except BaseException:
+            workers_.close(abort=True)
+            raise
+        workers_.close()
         poll()
     return [Path(p) for p in paths]
 
@@ -289,12 +303,17 @@ class TransferResult:
 
 
 def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None = None, video: bool = True,
-             progress: bool = True, log=print) -> TransferResult:
-    """The suite end to end: teachers and distillation, students, leaderboard, plots, video."""
+             progress: bool = True, log=print, command: list[str] | None = None) -> TransferResult:
+    """The suite end to end: teachers and distillation, students, leaderboard, plots, video.
+
+    ``command``: how this run was asked for, as ``provenance.json`` records it (the CLI
+    passes its command line); by default, this Python call."""
     from . import leaderboard
     from .provenance import read, record_session, start_session
 
-    session, clock = start_session(), time.perf_counter()
+    if command is None:
+        command = f"python: craftsuite.suites.transfer(suite {suite.name!r}, out {str(out)!r})"
+    session, clock = start_session(command), time.perf_counter()
     out = Path(out)
     configs = suite.student_configs(out / "teachers")
     _check_students(configs)  # fail before any training

@@ -58,6 +58,8 @@ def test_cli_errors_name_the_problem(tmp_path, capsys):
     assert "unknown suite 'huge'" in capsys.readouterr().err
     assert main(["leaderboard", str(tmp_path / "nothing")]) == 2
     assert "no run directory" in capsys.readouterr().err
+    assert main(["leaderboard", str(tmp_path), "--page", str(tmp_path / "r.md"), "--out", str(tmp_path)]) == 2
+    assert "--page writes the page" in capsys.readouterr().err
     bad = tmp_path / "bad.npz"
     bad.write_bytes(b"not a table")
     assert main(["student", "BlindCraftsman", "--table", str(bad), "--out", str(tmp_path)]) == 2
@@ -120,6 +122,8 @@ def test_suites_are_well_formed(tmp_path):
     nets = {c.world: c.hyperparameters.get("policy_kwargs") for c in both.student_configs(tmp_path)}
     assert nets == {"Cont": {"net_arch": [64, 64]}, "Grid10": None}
     assert both.teachers() == {}  # no method needs a teacher
+    grid_distiller = dataclasses.replace(SUITES["quick"], methods=("td3", "dynamic"))
+    assert grid_distiller.teachers() == {}  # `dynamic` needs one, but runs on the grids, not in this suite's world
     # standard: every rung x every method (each in its world) x 5 seeds, budgets by level
     standard = SUITES["standard"].student_configs(tmp_path)
     assert {(c.task, c.method) for c in standard} == set(product([s.name for s in ladder()], METHODS))
@@ -146,7 +150,7 @@ def test_suite_selection_errors_name_the_problem(tmp_path):
         dataclasses.replace(quick, tags=("hardest",)).student_configs(tmp_path)
     with pytest.raises(ValueError, match="selects no rung"):
         dataclasses.replace(quick, tags=()).student_configs(tmp_path)
-    with pytest.raises(ValueError, match="has no Grid budget for Reach's level 'easy'"):
+    with pytest.raises(ValueError, match="has no Grid budget for Reach's level 'easy'.*--steps N"):
         dataclasses.replace(quick, worlds=("Grid10",), methods=("dqn",)).student_configs(tmp_path)
     with pytest.raises(KeyError, match="unknown method"):
         dataclasses.replace(quick, methods=("td3", "td4")).student_configs(tmp_path)
@@ -171,12 +175,13 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
     board = result.leaderboard.read_text()
     assert "## Reach (Cont)" in board and "| 300 / " in board and "- `td3-dynamic-edges`:" in board
     [session] = read(tmp_path / "out")
-    assert session["command"] and session["machine"] and "torch" in session["versions"]
+    assert session["command"] == f"python: craftsuite.suites.transfer(suite 'quick', out {str(tmp_path / 'out')!r})"
+    assert session["machine"] and "torch" in session["versions"]
     page = leaderboard.write_page([tmp_path / "out"], tmp_path / "docs" / "results.md")
     text = page.read_text()
     assert "## quick:" in text and "### Reach (Cont)" in text and session["command"] in text
-    assert "images/results-quick/curves-Reach-Cont.png" in text
-    assert (tmp_path / "docs" / "images" / "results-quick" / "curves-Reach-Cont.png").is_file()
+    assert "images/results-out/curves-Reach-Cont.png" in text  # named after the directory
+    assert (tmp_path / "docs" / "images" / "results-out" / "curves-Reach-Cont.png").is_file()
     transfer(tiny, tmp_path / "out", workers=2, video=False, progress=False, log=lambda *_: None)  # all reused
     assert len(read(tmp_path / "out")) == 2
 
@@ -242,3 +247,23 @@ def test_killing_the_driver_stops_its_student_processes(tmp_path):
             if _alive(pid):
                 os.kill(pid, signal.SIGKILL)
     assert not any(tmp_path.glob("*/result.json"))  # killed mid-run: both stay resumable
+
+
+def test_a_failing_student_stops_the_others_at_once(tmp_path):
+    """A worker's error surfaces when it happens, and the other students are stopped (they
+    resume when asked for again), rather than after they have run their budgets."""
+    long = StudentConfig(method="dqn", world="Grid7", seed=0, steps=1_000_000, eval_every=100_000,
+                         hyperparameters={"learning_starts": 100, "buffer_size": 1000})
+    broken = StudentConfig(method="dynamic", world="Grid7", seed=0, steps=1_000, table=str(tmp_path / "none.npz"))
+    start = time.time()
+    with pytest.raises(Exception, match="none.npz"):
+        run_students([long, broken], tmp_path, workers=2, progress=False)
+    assert time.time() - start < 120  # the long one alone would take many minutes
+    lock = tmp_path / long.run_name() / ".lock"
+    pid = int(lock.read_text().split()[1]) if lock.exists() and len(lock.read_text().split()) == 2 else None
+    deadline = time.time() + 10
+    while pid is not None and _alive(pid) and time.time() < deadline:
+        time.sleep(0.2)
+    assert pid is None or not _alive(pid)
+    assert not (tmp_path / long.run_name() / "result.json").exists()
+

@@ -13,6 +13,8 @@ def _tasks(args) -> int:
     if args.markdown:
         from .references import write_tasks_page
 
+        if args.tag:
+            raise ValueError("--markdown writes the page of every rung; --tag selects rungs to list: use one or the other")
         path = write_tasks_page(args.markdown, episodes=args.episodes)
         print(f"wrote {path}")
         return 0
@@ -212,6 +214,7 @@ def _student(args) -> int:
 def _transfer(args) -> int:
     import dataclasses
 
+    from .provenance import command_line
     from .suites import SUITES, transfer
 
     if args.suite not in SUITES:
@@ -232,7 +235,8 @@ def _transfer(args) -> int:
         changes["td3_hyperparameters"] = {**suite.td3_hyperparameters, **_json_object(args.td3_hyper, "--td3-hyper")}
     suite = dataclasses.replace(suite, **changes)
     print(f"suite {suite.name}: {suite.description}")
-    result = transfer(suite, args.out, workers=args.workers, ray=args.ray, video=not args.no_video)
+    result = transfer(suite, args.out, workers=args.workers, ray=args.ray, video=not args.no_video,
+                      command=command_line())
     print(f"leaderboard: {result.leaderboard} (and .csv)")
     for plot in result.plots:
         print(f"learning curves: {plot}")
@@ -245,6 +249,9 @@ def _leaderboard(args) -> int:
     from . import leaderboard
 
     if args.page:
+        if args.out:
+            raise ValueError("--page writes the page and its images beside PATH; --out is for one directory's "
+                             "leaderboard: use one or the other")
         path = leaderboard.write_page(args.runs, args.page)
         print(f"wrote {path}")
         return 0
@@ -346,7 +353,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_student)
 
     p = sub.add_parser("transfer", help="a suite end to end: teacher, distillation, students, leaderboard, video")
-    p.add_argument("--suite", default="quick", help="quick (default, ~11 min), standard (~3 h) or paper (a cluster)")
+    p.add_argument("--suite", default="quick", help="quick (default, ~10 min), standard (~3 h) or paper (a cluster)")
     p.add_argument("--out", default="runs/quick", help="output directory (default: runs/quick)")
     p.add_argument("--tags", nargs="+", help="override the suite's rungs: the tasks with any of these tags")
     p.add_argument("--tasks", nargs="+", help="override the suite's rungs: these tasks (with --tags: and these)")

@@ -47,7 +47,7 @@ PAPER_REFERENCE = {
 
 def world_label(config: dict) -> str:
     """A student's world as a leaderboard shows it: ``Cont``, ``Grid10``, or with the
-    settings that change it, e.g. ``Cont: frame_skip=10, max_episode_steps=200``."""
+    settings that change it, e.g. ``Cont: frame_skip=2, max_episode_steps=1000``."""
     from .training import StudentConfig  # the owner of a student's world settings
 
     settings = StudentConfig(**config).env_kwargs  # world_kwargs is absent from configs older than the field
@@ -57,7 +57,7 @@ def world_label(config: dict) -> str:
 
 
 def _file_part(label: str) -> str:
-    """``label`` as part of a file name: ``Cont: frame_skip=10`` -> ``Cont-frame_skip-10``."""
+    """``label`` as part of a file name: ``Cont: frame_skip=2`` -> ``Cont-frame_skip-2``."""
     return re.sub(r"[^\w.]+", "-", label).strip("-")
 
 
@@ -253,7 +253,8 @@ def write_page(run_dirs, path, title: str = "Results") -> Path:
     for run_dir, students, entries in parts:
         suite = json.loads((run_dir / "suite.json").read_text()) if (run_dir / "suite.json").exists() else {}
         name = suite.get("name", run_dir.name)
-        lines += [f"## {name}" + (f": {suite['description']}" if suite.get("description") else ""), ""]
+        lines += [f"## {name}" + (f": {suite['description']}" if suite.get("description") else ""), "",
+                  f"Runs in `{run_dir.as_posix()}`.", ""]
         sessions = read(run_dir)
         for s in sessions:
             took = "did not finish" if s.get("seconds") is None else f"{s['seconds'] / 60:.1f} min"
@@ -263,7 +264,8 @@ def write_page(run_dirs, path, title: str = "Results") -> Path:
             lines.append(f"- runs in `{run_dir}` (no provenance.json: not made by `craftsuite transfer`)")
         board = to_markdown(entries, title=None).replace("\n## ", "\n### ")
         lines += ["", board.strip(), ""]
-        images = path.parent / "images" / _file_part(f"results-{name}")
+        # named after the directory, not the suite: two directories of one suite keep their own plots
+        images = path.parent / "images" / _file_part(f"results-{run_dir.name}")
         images.mkdir(parents=True, exist_ok=True)
         for plot in plot_curves(students, images):
             lines += [f"![{plot.stem}]({plot.relative_to(path.parent).as_posix()})", ""]

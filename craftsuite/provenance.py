@@ -14,6 +14,7 @@ import platform
 import shlex
 import subprocess
 import sys
+import uuid
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -59,25 +60,32 @@ def versions() -> dict[str, str]:
     return out
 
 
-def start_session(command: list[str] | None = None) -> dict:
+def command_line() -> list[str]:
+    """This process's command line as users type it (``python -m craftsuite`` runs
+    ``__main__.py``: ``craftsuite``)."""
+    program = Path(sys.argv[0]).name
+    return ["craftsuite" if program in ("__main__.py", "craftsuite") else program, *sys.argv[1:]]
+
+
+def start_session(command: list[str] | str | None = None) -> dict:
     """This invocation as ``record_session`` writes it, taken when it starts: the code that
-    runs is the code at its start, whatever is committed while it runs."""
-    if command is None:  # `python -m craftsuite` runs __main__.py: name it as users type it
-        program = Path(sys.argv[0]).name
-        command = ["craftsuite" if program in ("__main__.py", "craftsuite") else program, *sys.argv[1:]]
-    return {"command": shlex.join(command),
+    runs is the code at its start, whatever is committed while it runs. ``command``: an
+    argument list, a description (e.g. of a Python call) or None, this process's command line.
+    Each session gets an id of its own, so two that start in the same second stay two."""
+    if command is None:
+        command = command_line()
+    return {"id": uuid.uuid4().hex[:12], "command": command if isinstance(command, str) else shlex.join(command),
             "started": datetime.now(timezone.utc).isoformat(timespec="seconds"),
             "commit": git_commit(), "machine": machine(), "versions": versions()}
 
 
 def record_session(out, session: dict, seconds: float | None) -> Path:
     """Record a session (``start_session``) in ``out/provenance.json``: appended, or, if it
-    is there already (same start and command), updated. ``seconds`` None: not finished."""
+    is there already (its id), updated. ``seconds`` None: not finished."""
     path = Path(out) / FILE
     sessions = read(out)
     entry = {**session, "seconds": None if seconds is None else round(seconds, 1)}
-    same = [i for i, s in enumerate(sessions)
-            if (s.get("started"), s.get("command")) == (session["started"], session["command"])]
+    same = [i for i, s in enumerate(sessions) if s.get("id") == session["id"]]
     if same:
         sessions[same[-1]] = entry
     else:

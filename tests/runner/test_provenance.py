@@ -37,8 +37,10 @@ def test_a_damaged_record_is_named_and_kept(tmp_path):
 
 def test_a_session_is_on_record_from_its_start_and_updated_when_it_ends(tmp_path):
     killed, finished = start_session(command=["craftsuite", "transfer"]), start_session(command=["craftsuite", "x"])
+    twin = start_session(command=["craftsuite", "x"])  # the same command, started in the same second
     record_session(tmp_path, killed, None)  # never updated: killed
     record_session(tmp_path, finished, None)
+    record_session(tmp_path, twin, None)
     record_session(tmp_path, finished, 12.34)
     assert [(s["command"], s["seconds"]) for s in read(tmp_path)] == [("craftsuite transfer", None),
-                                                                       ("craftsuite x", 12.3)]
+                                                                       ("craftsuite x", 12.3), ("craftsuite x", None)]

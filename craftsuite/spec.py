@@ -10,7 +10,7 @@ Format (see ``tasks/blind_craftsman.toml`` for a full example)::
     name = "BlindCraftsman"          # CamelCase; ids are CraftSuite/<name>-Grid<size>-v0
     formula = "G(wood -> F factory) & F(tools3 & home)"
     tags = ["paper", "hard"]         # optional: rungs of the ladder (craftsuite tasks --tag hard)
-    extends = "other_spec"           # optional: start from tasks/other_spec.toml
+    extends = "other_spec"           # optional: start from tasks/other_spec.toml (all but its tags)
 
     [propositions]                   # bit order = order written here
     wood = { obtained = "wood" }     # event: inventory count of wood went up this step
@@ -57,13 +57,13 @@ from __future__ import annotations
 import re
 import tomllib
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cache, cached_property
 from pathlib import Path
 from typing import Any
 
 from .automata import Automaton, LTLfSyntaxError, compile_ltlf, parse
 from .automata.ltlf import atoms
-from .paths import tasks_dir
+from .paths import assets_dir, tasks_dir
 
 __all__ = [
     "LEVELS", "SpecError", "TaskSpec", "Item", "Place", "Recipe", "Proposition", "GridConfig", "ContinuousConfig",
@@ -145,6 +145,29 @@ class ContinuousConfig:
     boundary_reward: float = -0.1
     control_period: float = 0.25  # seconds each action is held
     max_steps: int = 200  # decisions per episode: 50 s at the default period
+
+    def frame_skip(self, timestep: float | None = None) -> int:
+        """Physics steps per decision: the control period over the physics step (by default
+        ``assets/arena.xml``'s), which must divide it.
+
+        Raises:
+            ValueError: the period is not a whole number of physics steps.
+        """
+        step = physics_timestep() if timestep is None else timestep
+        skip = round(self.control_period / step)
+        if skip < 1 or abs(skip * step - self.control_period) > 1e-9:
+            raise ValueError(f"{self.control_period} s is not a whole number of physics steps of {step} s "
+                             f"(e.g. {max(1, skip) * step:g})")
+        return skip
+
+
+@cache
+def physics_timestep() -> float:
+    """The MuJoCo worlds' physics step in seconds, as ``assets/arena.xml`` sets it; read
+    without MuJoCo, so that a spec's control period is checked when the spec loads."""
+    from xml.etree import ElementTree
+
+    return float(ElementTree.parse(assets_dir() / "arena.xml").getroot().find("option").get("timestep"))
 
 
 @dataclass(frozen=True)
@@ -284,7 +307,9 @@ def _raw(path: Path, seen: tuple[Path, ...] = ()) -> dict:
     base_path = (path.parent / base).with_suffix(".toml")
     if base_path.resolve() in seen:
         raise SpecError(f"{path}: extends: {base!r} extends itself (cycle)")
-    return _merge(_raw(base_path, seen + (path.resolve(),)), data)
+    inherited = _raw(base_path, seen + (path.resolve(),))
+    inherited.pop("tags", None)  # a variant is not on its base's rung (nor in its suites) unless it says so
+    return _merge(inherited, data)
 
 
 def load_spec(source: str | Path | dict, *, name_hint: str = "<dict>") -> TaskSpec:
@@ -487,6 +512,10 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
         r.fail("continuous", "arena and pickup_radius must be positive")
     if not continuous.control_period > 0:
         r.fail("continuous.control_period", f"must be > 0 seconds, got {continuous.control_period!r}")
+    try:
+        continuous.frame_skip()
+    except ValueError as err:
+        r.fail("continuous.control_period", str(err))
     spacing = 2 * continuous.pickup_radius
     per_side = int((continuous.arena - spacing) // spacing)
     if n_objects + 1 > per_side * per_side:

@@ -127,13 +127,26 @@ def test_frame_skip_keyword_gives_the_fine_control_world():
 
 
 def test_a_control_period_off_the_physics_step_is_named(tmp_path):
-    from craftsuite.spec import load_spec
+    import dataclasses
 
+    from craftsuite.spec import SpecError, load_spec, physics_timestep
+
+    assert physics_timestep() == ContinuousWorldEnv().model.opt.timestep  # the spec reads arena.xml's step
     path = tmp_path / "odd.toml"
     path.write_text('name = "Odd"\nformula = "F coin"\n[propositions]\ncoin = { obtained = "coin" }\n'
                     '[items.coin]\ncount = 1\n[continuous]\ncontrol_period = 0.26\n')
-    with pytest.raises(ValueError, match=r"odd.toml: continuous.control_period: 0.26 s is not a whole number"):
-        ContinuousWorldEnv(load_spec(path))
+    with pytest.raises(SpecError, match=r"odd.toml.*continuous.control_period.*0.26 s is not a whole number"):
+        load_spec(path)  # at load, before any world is built
+    spec = load_spec(_rewrite(path, "0.26", "0.5"))
+    assert ContinuousWorldEnv(spec).frame_skip == 20
+    odd = dataclasses.replace(spec, continuous=dataclasses.replace(spec.continuous, control_period=0.26))
+    with pytest.raises(ValueError, match=r"continuous.control_period: 0.26 s is not a whole number"):
+        ContinuousWorldEnv(odd)  # a spec changed in code is checked by the world
+
+
+def _rewrite(path, old, new):
+    path.write_text(path.read_text().replace(old, new))
+    return path
 
 
 def test_sqrt_offsets_keep_sign_and_order_and_read_zero_once_consumed():

@@ -60,6 +60,14 @@ def test_extends_merges_the_base_spec():
     assert obstacles.grid.max_steps == base.grid.max_steps
 
 
+def test_a_variant_does_not_inherit_its_bases_tags(tmp_path):
+    write(tmp_path, GOOD.replace('name = "Treasure"', 'name = "Treasure"\ntags = ["paper", "hard"]'), "base.toml")
+    write(tmp_path, 'extends = "base"\nname = "TreasureVariant"', "variant.toml")
+    assert load_spec(tmp_path / "base.toml").tags == ("paper", "hard")
+    variant = load_spec(tmp_path / "variant.toml")
+    assert variant.tags == () and variant.level is None  # off the ladder and out of the suites
+
+
 def test_good_spec_loads(tmp_path):
     spec = load_spec(write(tmp_path, GOOD))
     assert spec.name == "Treasure" and spec.automaton.n_states >= 2

@@ -30,7 +30,7 @@ def train_with_reports(method: str, table: str | None, *, task: str, seed: int, 
     from craftsuite.training import evaluate
 
     env_id = f"CraftSuite/{task}-Cont-v0"
-    table = AutomatonQTable.load(table) if method.endswith("dynamic") else None
+    table = AutomatonQTable.load(table) if METHODS[method].needs_table else None
     agent = make_agent(method, env_id, table=table, seed=seed, env_kwargs=env_kwargs, **agent_kwargs)
     rows, start = [], time.perf_counter()
 

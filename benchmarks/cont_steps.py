@@ -3,7 +3,7 @@
 Usage: python benchmarks/cont_steps.py [--steps N]
 
 Per task, in one run: raw ``mujoco.mj_step`` on the same compiled model (as many calls as
-one env step makes, FRAME_SKIP), the bare ``ContinuousWorldEnv``, and
+one env step makes: the registered world's frame skip), the bare ``ContinuousWorldEnv``, and
 ``gymnasium.make(id, product=True)`` as users get it; then dm_control's ``point_mass``
 through ``dm_env`` as the outside reference. Also ``reset()`` time and render frames/s at
 240x240 (OSMesa unless MUJOCO_GL says otherwise).
@@ -19,15 +19,14 @@ import numpy as np
 
 import craftsuite  # chooses MUJOCO_GL before mujoco is imported
 import mujoco
-from craftsuite.envs.continuous import FRAME_SKIP
 from _timing import reset_ms, steps_per_second
 
 
-def raw_steps(model, n) -> float:
+def raw_steps(model, frame_skip, n) -> float:
     data = mujoco.MjData(model)
     t = time.perf_counter()
     for _ in range(n):
-        for _ in range(FRAME_SKIP):
+        for _ in range(frame_skip):
             mujoco.mj_step(model, data)
     return n / (time.perf_counter() - t)
 
@@ -52,12 +51,12 @@ def main():
     parser.add_argument("--no-render", action="store_true")
     args = parser.parse_args()
     actions = list(np.random.default_rng(0).uniform(-1, 1, (args.steps, 2)).astype(np.float32))
-    print(f"| id | raw mj_step x{FRAME_SKIP} /s | world steps/s | product (make) steps/s | reset ms | render fps 240x240 |")
+    print("| id | raw mj_step x frame skip /s | world steps/s | product (make) steps/s | reset ms | render fps 240x240 |")
     print("|---|---|---|---|---|---|")
     for env_id in [i for i in craftsuite.registered_ids() if "-Cont-" in i]:
         product = gym.make(env_id, product=True, render_mode="rgb_array")
         world = product.unwrapped
-        raw = raw_steps(world.model, args.steps)
+        raw = raw_steps(world.model, world.frame_skip, args.steps)
         w = steps_per_second(world, actions)
         p = max(steps_per_second(product, actions) for _ in range(2))
         reset = reset_ms(product)

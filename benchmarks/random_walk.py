@@ -4,7 +4,7 @@ Usage: python benchmarks/random_walk.py [--tasks T ...] [--episodes N] [--frame-
 
 The walk keeps a uniform random thrust and draws a new one with probability 0.1 per step
 (about what TD3's early, near-constant actor plus noise does, but livelier). Per task it
-prints, per episode (at most 1,000 steps; a violation ends one early): rewarded events
+prints, per episode (50 s: 1,000 steps at frame skip 2; a violation ends one early): rewarded events
 (an item or the completion: a reward above the step and wall costs), changes of
 automaton state, the episodes that ended in success or in a violation (the rejecting
 sink), and the mean episode length.
@@ -21,7 +21,8 @@ def random_walk(task: str, episodes: int = 20, frame_skip: int = 2) -> dict:
 
     import craftsuite  # noqa: F401
 
-    env = gym.make(f"CraftSuite/{task}-Cont-v0", frame_skip=frame_skip)
+    env = gym.make(f"CraftSuite/{task}-Cont-v0", frame_skip=frame_skip,  # 50 s episodes
+                   max_episode_steps=round(50 / (0.025 * frame_skip)))
     rng = np.random.default_rng(0)
     events = changes = wins = violations = steps = 0
     for episode in range(episodes):

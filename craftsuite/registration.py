@@ -103,7 +103,7 @@ def make_continuous(task: str | TaskSpec, product: bool = False, render_mode: st
     return AutomatonObservation(env) if product else env
 
 
-make_continuous.metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+make_continuous.metadata = {"render_modes": ["rgb_array"], "render_fps": 4}  # the default world; each env sets its own
 
 
 def _register(spec: TaskSpec, builtin: bool) -> list[str]:

@@ -54,12 +54,12 @@ class StudentConfig:
     world: str = "Cont"  # "Cont" (MuJoCo) or "Grid10" / "Grid7"
     seed: int = 0
     steps: int = 20_000  # the budget in transitions (env steps over all n_envs envs)
-    table: str | None = None  # a teacher's table.npz (method *-dynamic)
+    table: str | None = None  # a teacher's table.npz (the methods that distil one: Method.needs_table)
     eval_every: int = 2_000
     eval_episodes: int = 10
     hyperparameters: dict = field(default_factory=dict)
     layout_seed: int | None = None  # grid worlds: one fixed instance (None: a new one per episode)
-    # more gymnasium.make keywords for the student's world, e.g. {"frame_skip": 10, "max_episode_steps": 200}
+    # more gymnasium.make keywords for the student's world, e.g. {"frame_skip": 2, "max_episode_steps": 1000}
     world_kwargs: dict = field(default_factory=dict, metadata={"omit_if_default": True})
     # envs stepped side by side: each agent step collects n_envs transitions, then takes
     # the algorithm's gradient_steps updates (the authors' students used 10)
@@ -92,8 +92,8 @@ class StudentConfig:
 def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kwargs: dict | None = None,
              on_step=None):
     """Greedy episodes on fresh seeds, played side by side so that the policy sees one
-    batch per step (an untrained policy that never finishes costs 1,000 batched calls, not
-    ``episodes`` x 1,000): (success rate, mean return). ``on_step(episode, reward, info)``,
+    batch per step (an untrained policy that never finishes costs one batched call per
+    decision of the episode limit, not ``episodes`` times as many): (success rate, mean return). ``on_step(episode, reward, info)``,
     if given, sees every step (for measures beyond these two)."""
     envs = [gym.make(env_id, product=product, **(env_kwargs or {})) for _ in range(episodes)]
     obs = np.stack([env.reset(seed=seed + i)[0] for i, env in enumerate(envs)])

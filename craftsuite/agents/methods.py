@@ -59,7 +59,7 @@ def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None
     kwargs = dict(TD3_DEFAULTS if m.algorithm == "td3" else DQN_DEFAULTS)
     kwargs.update(overrides)
     # fused Adam: one kernel per step instead of a Python loop over the parameters, about
-    # 25% more updates per second for these small nets on a CPU (docs/performance.md)
+    # 25% more updates per second for these small nets on a CPU (benchmarks/student_throughput.py)
     policy_kwargs = dict(kwargs.get("policy_kwargs") or {})
     policy_kwargs["optimizer_kwargs"] = {"fused": True, **policy_kwargs.get("optimizer_kwargs", {})}
     kwargs["policy_kwargs"] = policy_kwargs

@@ -3,6 +3,7 @@ completed by the scripted planner; the tasks page generated from them."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import gymnasium as gym
@@ -49,12 +50,15 @@ def test_an_unknown_tag_is_named_with_the_tags_in_use(capsys):
     assert "tags in use" in capsys.readouterr().err
 
 
-def test_cli_lists_the_rungs_of_a_tag(capsys):
+def test_cli_lists_the_rungs_of_a_tag(capsys, tmp_path):
     assert main(["tasks", "--tag", "easy"]) == 0
     out = capsys.readouterr().out
     assert "Reach [calibration, easy]: F wood" in out and "FirstWood [easy]" in out
     assert "FirstTool" not in out and "BlindCraftsman" not in out
     assert "CraftSuite/Reach-Grid7-v0" in out and "CraftSuite/Reach-Cont-v0" in out
+    # the page lists every rung: a --tag beside it is refused, not ignored
+    assert main(["tasks", "--tag", "easy", "--markdown", str(tmp_path / "tasks.md")]) == 2
+    assert "use one or the other" in capsys.readouterr().err and not (tmp_path / "tasks.md").exists()
 
 
 @pytest.mark.parametrize("name", sorted(BUILTIN))
@@ -96,3 +100,7 @@ def test_the_committed_tasks_page_lists_every_builtin_rung():
         assert f"## {spec.name}" in page, f"docs/tasks.md lacks {spec.name}: run craftsuite tasks --markdown docs/tasks.md"
         for world in ("Grid7", "Grid10", "Cont"):
             assert f"`CraftSuite/{spec.name}-{world}-v0`" in page
+    # every id row's episode limit is the registered one (a changed limit or a stale id fails)
+    rows = dict(re.findall(r"^\| `(CraftSuite/[\w-]+)` \| (\d+) \|", page, flags=re.M))
+    assert set(rows) == {f"CraftSuite/{n}-{w}-v0" for n in BUILTIN for w in ("Grid7", "Grid10", "Cont")}
+    assert {i: int(limit) for i, limit in rows.items()} == {i: gym.spec(i).max_episode_steps for i in rows}

@@ -5,7 +5,8 @@ A run directory holds
 * ``config.json``: the run's configuration (a dataclass, see ``craftsuite.training``);
 * ``episodes.csv``: one row per finished training episode (step, return, length, success);
 * ``evals.csv``: one row per evaluation (step, success rate, mean return, episodes);
-* ``checkpoint/``: the last model and replay buffer, written together at each evaluation;
+* ``checkpoint/``: the last model and replay buffer, written together at each evaluation
+  (a student's is removed when it finishes: its final model is ``model.zip``);
 * ``tb/``: TensorBoard logs (on resume, what the killed run logged after its checkpoint is
   purged, as from the CSV logs);
 * ``result.json``: written last; its presence means the run is finished and reusable.

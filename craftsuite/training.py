@@ -304,5 +304,8 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
                           "updates": int(agent._n_updates), "product": method.product,
                           "env_kwargs": config.env_kwargs, "model": "model.zip",
                           "seconds_this_session": round(time.perf_counter() - start, 1)})
+        # a finished run is reused, never resumed (a larger budget is another run): its replay
+        # buffer, up to gigabytes (CRM keeps one row per live automaton state), is dead weight
+        shutil.rmtree(run.checkpoint.parent, ignore_errors=True)
         return run.path
 

@@ -128,6 +128,7 @@ def test_a_killed_run_resumes_from_its_checkpoint(tmp_path):
     assert [k for k in kept if int(k[0]) <= checkpoint_step] == \
         [(r["step"], r["return"]) for r in episodes if int(r["step"]) <= checkpoint_step]
     assert json.loads((run / "result.json").read_text())["steps"] == 3_000
+    assert (run / "model.zip").is_file() and not (run / "checkpoint").exists()  # no replay buffer kept
 
 
 def _scalar_steps(log_dir) -> dict[str, list[int]]:

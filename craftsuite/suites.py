@@ -186,9 +186,6 @@ def _exit_with(driver: int, period: float = 0.5) -> None:
     threading.Thread(target=watch, name="craftsuite-driver-watch", daemon=True).start()
 
 
-RUNS_PER_WORKER = 4  # local worker processes are replaced after this many runs
-
-
 class _Workers:
     """Where jobs run: local worker processes, or a Ray cluster; ``submit`` gives a Future either way."""
 
@@ -206,11 +203,9 @@ class _Workers:
         else:
             import multiprocessing as mp
 
-            # a fresh process every few runs: a worker that ran ~90 students in a row had grown to
-            # 13 GB and was killed for memory; spawning costs a few seconds of imports per run
             self.pool = ProcessPoolExecutor(workers or max(1, min(jobs, os.cpu_count() or 1)),
                                             mp_context=mp.get_context("spawn"), initializer=_exit_with,
-                                            initargs=(os.getpid(),), max_tasks_per_child=RUNS_PER_WORKER)
+                                            initargs=(os.getpid(),))
 
     def submit(self, job, *args) -> Future:
         if self.ray is not None:

@@ -13,6 +13,7 @@ a row of its own, never a hyperparameter of a suite, so a leaderboard row says w
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
@@ -36,7 +37,8 @@ class Method:
     product: bool  # the automaton state's one-hot in the observation
     distill: str | None = None  # None, "static" or "dynamic" (needs a teacher's table)
     crm: bool = False  # counterfactual experience over automaton states
-    target: dict = field(default_factory=dict)  # DistilledTarget keywords over TARGET_DEFAULTS
+    # DistilledTarget keywords over TARGET_DEFAULTS (read-only once the row is built)
+    target: Mapping = field(default_factory=dict, hash=False)
     description: str = ""
 
     def __post_init__(self):
@@ -53,6 +55,7 @@ class Method:
         if unknown or (self.target and self.distill is None):
             raise MethodError(f"{where}: target takes {sorted(TARGET_DEFAULTS)} and only with distill; "
                               f"got {self.target!r}")
+        object.__setattr__(self, "target", MappingProxyType(dict(self.target)))  # a row of a read-only table
 
     @property
     def needs_table(self) -> bool:

@@ -128,6 +128,9 @@ def test_every_method_is_a_row_for_a_world_that_exists():
         Method("cont-dqn", "Cont", "dqn", False)
     with pytest.raises(MethodError, match="target takes"):
         Method("td3-nearly", "Cont", "td3", False, target={"rho": 0.5})  # a target without distillation
+    with pytest.raises(TypeError):  # the table's rows are read-only, their target too
+        METHODS["td3-dynamic-edges"].target["rho"] = 0.5
+    assert METHODS["td3-dynamic-edges"].target["rho"] == 1.0 and hash(METHODS["td3-dynamic-edges"])
 
 
 def test_the_edges_variant_is_the_paper_target_on_edges_never_faded(table):

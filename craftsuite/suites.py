@@ -132,7 +132,7 @@ DQN_REGIME = dict(dqn_n_envs=4, dqn_hyperparameters={"gradient_steps": 2, "targe
 # Budgets, in transitions: TD3 students on the easy and medium rungs get enough to pass the
 # collapse that follows their first success (greedy success falls for 30-80k transitions
 # before it settles: experiments/collection-regime, "Stability"), so that the last
-# evaluation reads what was learned; the hard rungs get what is left of about 2.5 hours
+# evaluation reads what was learned; the hard rungs get what is left of about 3 hours
 # on 2 cores for the standard suite (no TD3 student learns them in so few).
 SUITES = {s.name: s for s in (
     Suite("quick", "the calibration rung and the two-stage rung in MuJoCo: TD3 from scratch and distilled "

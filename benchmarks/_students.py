@@ -53,7 +53,7 @@ def train_with_reports(method: str, table: str | None, *, task: str, seed: int, 
                     greedy_edges.append(w != w2)
                     greedy_violations.append(info["violation"])
 
-                success, ret = evaluate(agent, env_id, EVAL_EPISODES, 10**6, METHODS[method].product, env_kwargs,
+                success, ret, _ = evaluate(agent, env_id, EVAL_EPISODES, 10**6, METHODS[method].product, env_kwargs,
                                         on_step=count)
                 row = {"method": method, "step": self.num_timesteps, "eval_success": success,
                        "eval_return": round(ret, 1), "eval_events": sum(greedy_events) / EVAL_EPISODES,

@@ -25,10 +25,10 @@ import numpy as np
 def _load(run: Path):
     """A run's config, its last checkpoint's model, and whether it sees the automaton state."""
     from craftsuite.agents.methods import METHODS, load_agent
-    from craftsuite.runs import RunDir
+    from craftsuite.runs import RunDir, load_config
     from craftsuite.training import StudentConfig, checkpoint_dir
 
-    config = StudentConfig(**json.loads((run / "config.json").read_text()))
+    config = load_config(StudentConfig, run)
     saved = checkpoint_dir(RunDir(run, config))
     if saved is None:
         raise FileNotFoundError(f"{run} has no checkpoint yet")

@@ -155,15 +155,12 @@ def _distill(args) -> int:
         source = Path(args.source)
         env_id, env_kwargs = args.env_id or f"CraftSuite/{args.task}-Grid7-v0", {}
         if source.is_dir():  # a teacher run directory: its config names the env, its checkpoint the replay
-            import json
-
             from .training import TeacherConfig, checkpoint_dir
-            from .runs import RunDir
+            from .runs import RunDir, load_config
 
-            config_path = source / "config.json"
-            if not config_path.is_file():
+            if not (source / "config.json").is_file():
                 raise FileNotFoundError(f"{source} is not a teacher run directory (no config.json)")
-            config = TeacherConfig(**json.loads(config_path.read_text()))
+            config = load_config(TeacherConfig, source)
             env_id, env_kwargs = config.env_id, config.env_kwargs
             saved = checkpoint_dir(RunDir(source, config))
             if saved is None:

@@ -60,6 +60,13 @@ def versions() -> dict[str, str]:
     return out
 
 
+def stamp() -> dict:
+    """The code that runs now, as a run's ``config.json`` records each session that trains
+    it: the time, the git commit and the package versions (CraftSuite's among them)."""
+    return {"at": datetime.now(timezone.utc).isoformat(timespec="seconds"), "commit": git_commit(),
+            "versions": versions()}
+
+
 def command_line() -> list[str]:
     """This process's command line as users type it (``python -m craftsuite`` runs
     ``__main__.py``: ``craftsuite``)."""

@@ -2,9 +2,16 @@
 
 A run directory holds
 
-* ``config.json``: the run's configuration (a dataclass, see ``craftsuite.training``);
+* ``config.json``: the run's configuration (a dataclass, see ``craftsuite.training``),
+  its effective settings (``effective``: the algorithm's defaults merged with the
+  overrides, the method's row, the world and its task's rules digest), the record format
+  and its provenance (``provenance``: per session that trained it, the time, the
+  CraftSuite version, the git commit and the versions of torch, SB3, gymnasium and
+  mujoco). The run key, the last part of the directory's name, hashes the configuration
+  and the effective settings, so a change of a default makes a new run;
 * ``episodes.csv``: one row per finished training episode (step, return, length, success);
-* ``evals.csv``: one row per evaluation (step, success rate, mean return, episodes);
+* ``evals.csv``: one row per evaluation (step, success rate, mean return, episodes, mean
+  episode length);
 * ``checkpoint/``: the last model and replay buffer, written together at each evaluation
   (a student's is removed when it finishes: its final model is ``model.zip``);
 * ``tb/``: TensorBoard logs (on resume, what the killed run logged after its checkpoint is
@@ -29,7 +36,7 @@ import socket
 from pathlib import Path
 
 EPISODE_FIELDS = ("step", "return", "length", "success")
-EVAL_FIELDS = ("step", "success", "return", "episodes")
+EVAL_FIELDS = ("step", "success", "return", "episodes", "length")  # length: absent from runs before 0.2
 
 
 class RunError(RuntimeError):
@@ -51,6 +58,12 @@ def atomic_write(path: Path, text: str) -> None:
         tmp.unlink(missing_ok=True)
 
 
+# config.json's layout: 1 (before 0.2: the dataclass fields alone) or 2 (with ``effective``
+# and ``provenance``). Readers take both; a run directory of layout 1 is never resumed.
+FORMAT = 2
+RECORD_KEYS = ("format", "provenance")  # in config.json, beside the settings: not hashed, not compared
+
+
 def config_dict(config) -> dict:
     """A config dataclass as saved and hashed. A field added after runs existed carries
     ``metadata={"omit_if_default": True}``: at its default it is left out, so the runs made
@@ -64,10 +77,54 @@ def config_dict(config) -> dict:
     return out
 
 
+def settings(config) -> dict:
+    """What a run computes from: the config's fields and, if the config has an
+    ``effective()`` method, its effective settings under ``"effective"``."""
+    out = config_dict(config)
+    if hasattr(config, "effective"):
+        out["effective"] = config.effective()
+    return out
+
+
 def config_key(config) -> str:
-    """A short stable hash of a config dataclass: equal configs share a run directory."""
-    text = json.dumps(config_dict(config), sort_keys=True)
+    """A short stable hash of a config's settings: equal settings share a run directory."""
+    text = json.dumps(settings(config), sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:10]
+
+
+def read_config(run) -> dict:
+    """A run directory's ``config.json``, of any layout this version reads.
+
+    Raises:
+        RunError: no config.json, not JSON, not a run's record, or a layout newer than
+            this version of CraftSuite reads; the message names the file and the reason.
+    """
+    path = Path(run) / "config.json"
+    try:
+        data = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise RunError(f"{path} is missing: {Path(run)} is not a run directory") from None
+    except ValueError as err:
+        raise RunError(f"{path} is not valid JSON ({err}): the run's record is damaged") from None
+    if not isinstance(data, dict) or "task" not in data:
+        raise RunError(f"{path} holds no run configuration (no task): not a CraftSuite run record")
+    layout = data.get("format", 1)
+    if not isinstance(layout, int) or layout > FORMAT:
+        raise RunError(f"{path} has record format {layout!r}, newer than this CraftSuite reads (up to {FORMAT}): "
+                       "upgrade CraftSuite to read it")
+    return data
+
+
+def load_config(cls, run):
+    """The config dataclass (``cls``) a run directory was made with, from its record of any
+    layout this version reads (the effective settings and the provenance are left out)."""
+    names = {f.name for f in dataclasses.fields(cls)}
+    return cls(**{k: v for k, v in read_config(run).items() if k in names})
+
+
+def run_settings(record: dict) -> dict:
+    """The settings part of a ``config.json`` record (what the run key hashes)."""
+    return {k: v for k, v in record.items() if k not in RECORD_KEYS}
 
 
 class RunDir:
@@ -83,14 +140,35 @@ class RunDir:
         self._created = not self.path.exists()
         self.path.mkdir(parents=True, exist_ok=True)
         self._acquire()
-        saved = self.path / "config.json"
-        mine = json.dumps(config_dict(self.config), indent=2, sort_keys=True)
-        if saved.exists() and json.loads(saved.read_text()) != json.loads(mine):
+        try:
+            self._record()
+        except BaseException:
             self._release()
-            raise RunError(f"{self.path} holds a run with another configuration ({saved}); "
-                           "choose another output directory")
-        atomic_write(saved, mine + "\n")
+            raise
         return self
+
+    def _record(self) -> None:
+        """Write config.json: the settings, and this session in its provenance. A finished
+        run's record is left as it is (reusing it trains nothing)."""
+        from .provenance import stamp
+
+        mine = json.loads(json.dumps(settings(self.config)))  # as it reads back: tuples are lists
+        path = self.path / "config.json"
+        sessions = []
+        if path.exists():
+            saved = read_config(self.path)
+            if "effective" not in saved and "effective" in mine:
+                raise RunError(f"{self.path} holds a run recorded by an older CraftSuite, without its effective "
+                               "settings, so it cannot be told to match this configuration; it is not resumed: "
+                               "choose another output directory")
+            if run_settings(saved) != mine:
+                raise RunError(f"{self.path} holds a run with another configuration ({path}); "
+                               "choose another output directory")
+            if self.finished():
+                return
+            sessions = saved.get("provenance", [])
+        record = {**mine, "format": FORMAT, "provenance": [*sessions, stamp()]}
+        atomic_write(path, json.dumps(record, indent=2, sort_keys=True) + "\n")
 
     def __exit__(self, exc_type, *exc) -> None:
         try:

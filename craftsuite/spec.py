@@ -56,7 +56,7 @@ from __future__ import annotations
 
 import re
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from functools import cache, cached_property
 from pathlib import Path
 from typing import Any
@@ -217,6 +217,23 @@ class TaskSpec:
     @cached_property
     def automaton(self) -> Automaton:
         return compile_ltlf(self.formula, self.proposition_names)
+
+    def digest(self) -> str:
+        """A short hash of the rules: everything that changes what an agent experiences, not
+        the description, tags, file, colours or symbols. Runs record it and hash it into
+        their run key, so a run made under other rules is never reused."""
+        import hashlib
+        import json
+
+        def rules(value):
+            if isinstance(value, dict):
+                return {k: rules(v) for k, v in value.items() if k not in ("color", "symbol")}
+            if isinstance(value, (list, tuple)):
+                return [rules(v) for v in value]
+            return value
+
+        data = {k: v for k, v in asdict(self).items() if k not in ("description", "tags", "path")}
+        return hashlib.sha256(json.dumps(rules(data), sort_keys=True).encode()).hexdigest()[:12]
 
 
 # Readable defaults for objects a spec gives no colour; the paper's Figure 1c colours first.

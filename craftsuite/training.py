@@ -10,10 +10,12 @@ last checkpoint.
 
 from __future__ import annotations
 
+import json
 import shutil
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 import gymnasium as gym
 import numpy as np
@@ -42,6 +44,11 @@ class TeacherConfig:
     @property
     def env_kwargs(self) -> dict:
         return layout_kwargs(self.layout_seed)
+
+    def effective(self) -> dict:
+        """The settings the teacher trains with beyond its fields: DQN's defaults merged with
+        ``hyperparameters``, its method's row and its world (recorded and hashed)."""
+        return _effective("product-dqn", self.hyperparameters, self.env_id, self.env_kwargs, self.task)
 
     def run_name(self) -> str:
         return f"teacher-{self.task}-Grid{self.size}-s{self.seed}-{config_key(self)}"
@@ -85,19 +92,42 @@ class StudentConfig:
     def env_kwargs(self) -> dict:
         return {**layout_kwargs(self.layout_seed), **self.world_kwargs}
 
+    def effective(self) -> dict:
+        """The settings the student trains with beyond its fields: its algorithm's defaults
+        merged with ``hyperparameters`` (the replay buffer no larger than the budget), its
+        method's row and its world (recorded and hashed)."""
+        return _effective(self.method, {"buffer_size": min(self.steps, 1_000_000), **self.hyperparameters},
+                          self.env_id, self.env_kwargs, self.task)
+
     def run_name(self) -> str:
         return f"student-{self.task}-{self.world}-{self.method}-s{self.seed}-{config_key(self)}"
 
 
+def _effective(method: str, hyperparameters: dict, env_id: str, env_kwargs: dict, task: str) -> dict:
+    from .methods import METHODS, algorithm_settings, check_methods
+    from .registration import resolve_task
+
+    check_methods([method])
+    row = METHODS[method]
+    return {"method": row.settings(), "hyperparameters": algorithm_settings(row.algorithm, hyperparameters),
+            "world": {"id": env_id, "kwargs": env_kwargs, "rules": resolve_task(task).digest()}}
+
+
+class Evaluation(NamedTuple):
+    success: float  # the share of episodes that completed the task
+    mean_return: float
+    mean_length: float  # decisions per episode
+
+
 def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kwargs: dict | None = None,
-             on_step=None):
+             on_step=None) -> Evaluation:
     """Greedy episodes on fresh seeds, played side by side so that the policy sees one
     batch per step (an untrained policy that never finishes costs one batched call per
-    decision of the episode limit, not ``episodes`` times as many): (success rate, mean return). ``on_step(episode, reward, info)``,
-    if given, sees every step (for measures beyond these two)."""
+    decision of the episode limit, not ``episodes`` times as many). ``on_step(episode,
+    reward, info)``, if given, sees every step (for measures beyond an ``Evaluation``'s)."""
     envs = [gym.make(env_id, product=product, **(env_kwargs or {})) for _ in range(episodes)]
     obs = np.stack([env.reset(seed=seed + i)[0] for i, env in enumerate(envs)])
-    returns, wins = np.zeros(episodes), np.zeros(episodes, dtype=bool)
+    returns, lengths, wins = np.zeros(episodes), np.zeros(episodes), np.zeros(episodes, dtype=bool)
     active = np.ones(episodes, dtype=bool)
     while active.any():
         live = np.flatnonzero(active)
@@ -105,6 +135,7 @@ def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kw
         for i, action in zip(live, actions):
             obs[i], reward, term, trunc, info = envs[i].step(action)
             returns[i] += float(reward)
+            lengths[i] += 1
             if on_step is not None:
                 on_step(i, float(reward), info)
             if term or trunc:
@@ -112,11 +143,15 @@ def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kw
                 wins[i] = bool(info["is_success"])
     for env in envs:
         env.close()
-    return float(wins.mean()), float(returns.mean())
+    return Evaluation(float(wins.mean()), float(returns.mean()), float(lengths.mean()))
 
 
 class RunCallback(BaseCallback):
-    """Logs episodes, evaluates, checkpoints, reports progress; stops at ``stop_at`` success."""
+    """Logs episodes, evaluates, checkpoints, reports progress; stops at ``stop_at`` success.
+
+    TensorBoard gets SB3's own evaluation tags (``eval/mean_reward``, ``eval/success_rate``,
+    ``eval/mean_ep_length``, as its ``EvalCallback`` writes them) and the run's settings as
+    an ``HParam``, so CraftSuite runs lie beside SB3 and RL Zoo runs in one TensorBoard."""
 
     def __init__(self, run: RunDir, total: int, eval_every: int, eval_episodes: int, evaluate_fn,
                  stop_at: float | None = None, bar=None):
@@ -128,6 +163,12 @@ class RunCallback(BaseCallback):
     def _on_training_start(self) -> None:
         if self.num_timesteps > 0:  # resumed from a checkpoint
             _purge_tensorboard(self.logger, self.num_timesteps)
+        else:  # once per run: a resumed run's first session logged them
+            from stable_baselines3.common.logger import HParam
+
+            self.logger.record("hparams", HParam(hparams(self.run.config),
+                                                 {"eval/mean_reward": 0.0, "eval/success_rate": 0.0}),
+                               exclude=("stdout", "log", "json", "csv"))
         self.next_eval = (self.num_timesteps // self.eval_every + 1) * self.eval_every
         self.next_flush = self.num_timesteps + 1_000
         if self.bar is not None:
@@ -156,16 +197,41 @@ class RunCallback(BaseCallback):
 
     def _evaluate_and_checkpoint(self) -> bool:
         self._flush()
-        success, ret = self.evaluate_fn(self.model, self.num_timesteps)
-        self.run.append("evals.csv", EVAL_FIELDS, [{"step": self.num_timesteps, "success": success,
-                                                     "return": round(ret, 4), "episodes": self.eval_episodes}])
-        self.logger.record("eval/success", success)
-        self.logger.record("eval/return", ret)
+        result = self.evaluate_fn(self.model, self.num_timesteps)
+        self.run.append("evals.csv", EVAL_FIELDS, [{"step": self.num_timesteps, "success": result.success,
+                                                     "return": round(result.mean_return, 4),
+                                                     "episodes": self.eval_episodes,
+                                                     "length": round(result.mean_length, 2)}])
+        self.logger.record("eval/mean_reward", result.mean_return)
+        self.logger.record("eval/mean_ep_length", result.mean_length)
+        self.logger.record("eval/success_rate", result.success)
         self.logger.dump(self.num_timesteps)  # at the evaluation's step, as SB3's EvalCallback does
         save_checkpoint(self.model, self.run)
         if self.bar is not None:
-            self.bar.set_postfix(success=f"{success:.2f}")
-        return self.stop_at is None or success < self.stop_at
+            self.bar.set_postfix(success=f"{result.success:.2f}")
+        return self.stop_at is None or result.success < self.stop_at
+
+
+def hparams(config) -> dict:
+    """A run's settings as TensorBoard's HParams take them: one flat level of numbers,
+    strings and booleans (``hyperparameters.learning_rate``; lists and None as text)."""
+    from .runs import settings
+
+    flat = {}
+
+    def walk(prefix, value):
+        if isinstance(value, dict):
+            for k, v in value.items():
+                walk(f"{prefix}.{k}" if prefix else k, v)
+        elif isinstance(value, (bool, int, float, str)):
+            flat[prefix] = value
+        else:
+            flat[prefix] = json.dumps(value)
+
+    data = settings(config)
+    walk("", {k: v for k, v in data.items() if k != "effective"})
+    walk("", data.get("effective", {}))
+    return flat
 
 
 def _purge_tensorboard(logger, step: int) -> None:
@@ -252,7 +318,7 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
             return run.path
         start = time.perf_counter()
         fresh = make_agent("product-dqn", config.env_id, seed=config.seed, env_kwargs=config.env_kwargs,
-                           **config.hyperparameters)
+                           **config.effective()["hyperparameters"])
 
         def evaluate_fn(model, step):
             return evaluate(model, config.env_id, config.eval_episodes, seed=10**7 + step, product=True,
@@ -286,10 +352,8 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
             return run.path
         start = time.perf_counter()
         table = AutomatonQTable.load(config.table) if method.distill == "dynamic" else None
-        hyper = dict(config.hyperparameters)
-        hyper.setdefault("buffer_size", min(config.steps, 1_000_000))
         fresh = make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=config.n_envs,
-                           env_kwargs=config.env_kwargs, **hyper)
+                           env_kwargs=config.env_kwargs, **config.effective()["hyperparameters"])
 
         def evaluate_fn(model, step):
             return evaluate(model, config.env_id, config.eval_episodes, seed=10**7 + step, product=method.product,

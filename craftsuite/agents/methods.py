@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 from stable_baselines3.common.env_util import make_vec_env
 
-from ..methods import ALGORITHMS, METHODS, Method, check_methods  # noqa: F401  (METHODS re-exported)
+from ..methods import (  # noqa: F401  (METHODS and the defaults re-exported)
+    ALGORITHMS, DQN_DEFAULTS, METHODS, TD3_DEFAULTS, Method, algorithm_settings, check_methods)
 from ..registration import parse_id, world_kind
 from .crm import CRMReplayBuffer
 from .distillation import AutomatonQTable, DistilledTarget, dynamic_distillation, static_distillation
@@ -23,20 +24,6 @@ from .td3 import AutomatonTD3
 
 CLASSES = {"dqn": AutomatonDQN, "td3": AutomatonTD3}
 assert set(CLASSES) == set(ALGORITHMS), "every algorithm of the methods table needs its class here"
-
-# The authors' settings (REFERENCE.md section 5), changed where a small MLP on one env needs
-# it (measured, docs/benchmarks.md "Teachers"): a hard target update every 100 steps instead
-# of 1,000 and epsilon annealed from 1.0 to 0.1 over the first 10% instead of a constant 0.1;
-# with the authors' two, the teacher did not learn Blind Craftsman's fixed 7x7 instance in
-# 100k steps, with these it did in 40k.
-DQN_DEFAULTS = dict(learning_rate=5e-4, buffer_size=150_000, batch_size=64, learning_starts=1_000,
-                    gamma=0.99, train_freq=1, target_update_interval=100, exploration_fraction=0.1,
-                    exploration_initial_eps=1.0, exploration_final_eps=0.1,
-                    policy_kwargs=dict(net_arch=[64, 64]))
-TD3_DEFAULTS = dict(learning_rate=1e-4, buffer_size=1_000_000, batch_size=64, learning_starts=1_000,
-                    gamma=0.99, tau=0.005, target_policy_noise=0.2, target_noise_clip=0.5,
-                    action_noise={"type": "normal", "sigma": 0.3},  # a spec (agents/noise.py)
-                    policy_kwargs=dict(net_arch=[400, 300]))
 
 
 def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None, seed: int = 0,
@@ -56,13 +43,7 @@ def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None
     env = make_vec_env(env_id, n_envs=n_envs, seed=seed, env_kwargs={**(env_kwargs or {}), "product": m.product})
     base = env.envs[0].unwrapped
     automaton = base.automaton
-    kwargs = dict(TD3_DEFAULTS if m.algorithm == "td3" else DQN_DEFAULTS)
-    kwargs.update(overrides)
-    # fused Adam: one kernel per step instead of a Python loop over the parameters, about
-    # 25% more updates per second for these small nets on a CPU (benchmarks/student_throughput.py)
-    policy_kwargs = dict(kwargs.get("policy_kwargs") or {})
-    policy_kwargs["optimizer_kwargs"] = {"fused": True, **policy_kwargs.get("optimizer_kwargs", {})}
-    kwargs["policy_kwargs"] = policy_kwargs
+    kwargs = algorithm_settings(m.algorithm, overrides)
     if isinstance(kwargs.get("action_noise"), dict):
         kwargs["action_noise"] = make_action_noise(kwargs["action_noise"], env.action_space.shape[0], seed, n_envs)
     if m.crm:

@@ -89,7 +89,7 @@ def run(task: str, name: str, seed: int, seconds: float, every: float, transitio
             now = time.perf_counter()
             self.trained += now - self.mark
             if self.trained >= self.next:
-                success, ret = evaluate(agent, env_id, EVAL_EPISODES, seed=10**7 + len(rows), product=False,
+                success, ret, _ = evaluate(agent, env_id, EVAL_EPISODES, seed=10**7 + len(rows), product=False,
                                         env_kwargs=env_kwargs)
                 rows.append({"task": task, "regime": name, "seed": seed, "seconds": round(self.trained, 1),
                              "transitions": int(self.num_timesteps), "updates": int(agent._n_updates),

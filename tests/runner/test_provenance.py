@@ -44,3 +44,62 @@ def test_a_session_is_on_record_from_its_start_and_updated_when_it_ends(tmp_path
     record_session(tmp_path, finished, 12.34)
     assert [(s["command"], s["seconds"]) for s in read(tmp_path)] == [("craftsuite transfer", None),
                                                                        ("craftsuite x", 12.3), ("craftsuite x", None)]
+
+
+def test_a_run_records_its_effective_settings_and_the_code_that_trained_it(tmp_path, monkeypatch):
+    from craftsuite.methods import TD3_DEFAULTS
+    from craftsuite.runs import FORMAT, RunDir, load_config, read_config, run_settings, settings
+    from craftsuite.training import StudentConfig
+
+    config = StudentConfig(method="td3-dynamic-edges", steps=500, table="t.npz",
+                           hyperparameters={"batch_size": 32})
+    with RunDir(tmp_path / "r", config):
+        pass
+    monkeypatch.setattr(provenance, "git_commit", lambda: "a-later-commit")
+    with RunDir(tmp_path / "r", config):  # resumed under other code: a second session on record
+        pass
+    record = read_config(tmp_path / "r")
+    assert record["format"] == FORMAT and load_config(StudentConfig, tmp_path / "r") == config  # the round trip
+    assert run_settings(record) == json.loads(json.dumps(settings(config)))
+    effective = record["effective"]
+    assert effective["hyperparameters"]["batch_size"] == 32  # the override
+    assert effective["hyperparameters"]["learning_rate"] == TD3_DEFAULTS["learning_rate"]  # the default merged in
+    assert effective["hyperparameters"]["buffer_size"] == 500  # no larger than the budget
+    assert effective["method"]["target"] == {"rho": 1.0, "self_loops": False}  # the row's own target
+    assert effective["world"] == {"id": "CraftSuite/BlindCraftsman-Cont-v0", "kwargs": {},
+                                  "rules": craftsuite_task_digest("BlindCraftsman")}
+    first, second = record["provenance"]
+    assert {"craftsuite", "torch", "stable-baselines3", "gymnasium", "mujoco"} <= set(first["versions"])
+    assert first["commit"] != "a-later-commit"  # the code that started the run
+    assert second["commit"] == "a-later-commit" and second["at"] >= first["at"]
+
+
+def craftsuite_task_digest(task: str) -> str:
+    from craftsuite.registration import resolve_task
+
+    return resolve_task(task).digest()
+
+
+def test_a_change_of_a_default_or_of_the_rules_gives_a_new_run_key(monkeypatch):
+    import dataclasses
+
+    from craftsuite import methods, registration
+    from craftsuite.training import StudentConfig, TeacherConfig
+
+    student, teacher = StudentConfig(method="td3"), TeacherConfig()
+    keys = student.run_name(), teacher.run_name()
+    monkeypatch.setitem(methods.TD3_DEFAULTS, "learning_rate", 3e-4)
+    assert student.run_name() != keys[0] and teacher.run_name() == keys[1]  # DQN's defaults did not change
+    monkeypatch.setitem(methods.DQN_DEFAULTS, "target_update_interval", 1_000)
+    assert teacher.run_name() != keys[1]
+    monkeypatch.undo()
+    assert (student.run_name(), teacher.run_name()) == keys
+    # the task's rules: a longer episode is another benchmark; a new description is not
+    spec = registration.resolve_task("BlindCraftsman")
+    known = dict(registration.tasks())
+    monkeypatch.setattr(registration, "tasks", lambda: {**known, "BlindCraftsman": dataclasses.replace(
+        spec, continuous=dataclasses.replace(spec.continuous, max_steps=300))})
+    assert student.run_name() != keys[0]
+    monkeypatch.setattr(registration, "tasks", lambda: {**known, "BlindCraftsman": dataclasses.replace(
+        spec, description="reworded")})
+    assert student.run_name() == keys[0]

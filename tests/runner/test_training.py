@@ -10,8 +10,7 @@ import zipfile
 
 import pytest
 
-from craftsuite.runs import read_csv
-from craftsuite.runs import RunDir
+from craftsuite.runs import RunDir, RunError, load_config, read_csv, settings
 from craftsuite.training import StudentConfig, TeacherConfig, checkpoint_dir, train_student, train_teacher
 
 TINY_DQN = {"learning_starts": 100, "buffer_size": 5_000}
@@ -77,11 +76,11 @@ def test_evaluate_reports_every_step_to_on_step():
             return np.tile([[0.7, -0.4]], (len(obs), 1)).astype(np.float32), None
 
     seen = {}
-    success, mean_return = evaluate(Wanderer(), "CraftSuite/BlindCraftsman-Cont-v0", 3, seed=5, product=False,
-                                    env_kwargs={"max_episode_steps": 40},
-                                    on_step=lambda i, r, info: seen.setdefault(i, []).append(r))
+    success, mean_return, mean_length = evaluate(
+        Wanderer(), "CraftSuite/BlindCraftsman-Cont-v0", 3, seed=5, product=False,
+        env_kwargs={"max_episode_steps": 40}, on_step=lambda i, r, info: seen.setdefault(i, []).append(r))
     assert sorted(seen) == [0, 1, 2] and all(len(r) == 40 for r in seen.values())
-    assert success == 0.0
+    assert success == 0.0 and mean_length == 40.0
     assert np.isclose(mean_return, np.mean([sum(r) for r in seen.values()]))
 
 
@@ -114,7 +113,7 @@ def test_a_killed_run_resumes_from_its_checkpoint(tmp_path):
     assert not (run / "result.json").exists(), "the run finished before it could be killed"
     assert (run / ".lock").exists()  # left behind by the killed process
     kept = [(r["step"], r["return"]) for r in read_csv(run / "episodes.csv")]
-    config = StudentConfig(**json.loads((run / "config.json").read_text()))
+    config = load_config(StudentConfig, run)
     with zipfile.ZipFile(checkpoint_dir(RunDir(run, config)) / "model.zip") as z:
         checkpoint_step = json.loads(z.read("data"))["num_timesteps"]
     assert checkpoint_step >= 1_000  # so the resumed run must keep some episodes
@@ -161,9 +160,33 @@ def test_a_resumed_run_drops_what_tensorboard_logged_after_its_checkpoint(tmp_pa
     monkeypatch.setattr(training.RunCallback, "_on_step", on_step)
     train_student(config, tmp_path, progress=False)  # resumes from step 200
     steps = _scalar_steps(log_dir)
-    assert steps["eval/success"] == [200, 400, 600]  # each at its evaluation's step, none twice
+    # SB3's evaluation tags, each at its evaluation's step, none twice
+    for tag in ("eval/mean_reward", "eval/success_rate", "eval/mean_ep_length"):
+        assert steps[tag] == [200, 400, 600]
     assert steps["rollout/ep_rew_mean"] == [160, 360, 520]  # the killed run's 320 is gone
     assert all(s == sorted(set(s)) for s in steps.values())
+    [hparams] = _hparams(log_dir)  # logged once, by the session that started the run
+    assert hparams["method"] == "td3" and hparams["steps"] == 600
+    assert hparams["hyperparameters.learning_rate"] == 1e-4  # the default, as it ran
+    assert hparams["hyperparameters.policy_kwargs.net_arch"] == "[16]"  # the override
+    assert hparams["method.target"] == "null" and hparams["world.id"] == "CraftSuite/BlindCraftsman-Cont-v0"
+
+
+def _hparams(log_dir) -> list[dict]:
+    """The HParams sessions TensorBoard shows for a run: one dict per session start."""
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+    from tensorboard.plugins.hparams import plugin_data_pb2
+
+    events = EventAccumulator(str(log_dir))
+    events.Reload()
+    out = []
+    for content in events.PluginTagToContent("hparams").values():
+        data = plugin_data_pb2.HParamsPluginData.FromString(content)
+        if data.HasField("session_start_info"):
+            out.append({k: v.number_value if v.HasField("number_value") else
+                        v.bool_value if v.HasField("bool_value") else v.string_value
+                        for k, v in data.session_start_info.hparams.items()})
+    return out
 
 
 def test_a_student_trains_and_is_evaluated_in_the_world_its_config_names(tmp_path, monkeypatch):
@@ -189,18 +212,17 @@ def test_a_student_trains_and_is_evaluated_in_the_world_its_config_names(tmp_pat
         StudentConfig(world_kwargs={"product": False})
 
 
-def test_runs_made_before_world_kwargs_existed_keep_their_directories(tmp_path):
-    import hashlib
-
+def test_a_field_at_its_default_is_left_out_of_the_key_and_old_records_load_but_are_not_resumed(tmp_path):
     plain, skipped = StudentConfig(), StudentConfig(world_kwargs={"frame_skip": 10})
     assert plain.run_name() != skipped.run_name() != StudentConfig(n_envs=4).run_name()
-    # as older versions wrote it: no world_kwargs nor n_envs field
+    assert not {"world_kwargs", "n_envs"} & set(settings(plain))  # fields added later, at their default
+    # a record as CraftSuite wrote it before runs recorded their effective settings
     saved = {k: v for k, v in dataclasses.asdict(plain).items() if k not in ("world_kwargs", "n_envs")}
-    before = hashlib.sha256(json.dumps(saved, sort_keys=True).encode()).hexdigest()[:10]  # the old key
-    assert plain.run_name().endswith(before)
     old = tmp_path / plain.run_name()
     old.mkdir()
     (old / "config.json").write_text(json.dumps(saved))
-    with RunDir(old, plain):  # the same configuration: taken, not refused
-        pass
-    assert StudentConfig(**json.loads((old / "config.json").read_text())) == plain
+    assert load_config(StudentConfig, old) == plain  # it loads
+    with pytest.raises(RunError, match="recorded by an older CraftSuite, without its effective settings"):
+        with RunDir(old, plain):  # but is not taken for a run of these settings
+            pass
+    assert json.loads((old / "config.json").read_text()) == saved  # and is left as it was

@@ -28,6 +28,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/grid_steps.py
 	$(PY) benchmarks/cont_steps.py
 	$(PY) benchmarks/student_throughput.py
+	$(PY) benchmarks/interval_coverage.py
 
 clean:
 	rm -rf out .pytest_cache

@@ -258,12 +258,13 @@ def _leaderboard(args) -> int:
     students = root / "students" if (root / "students").is_dir() else root
     if not students.is_dir():
         raise FileNotFoundError(f"no run directory at {root}")
-    entries = leaderboard.build(students)
-    if not entries:
-        raise ValueError(f"no finished student runs under {students}")
+    board = leaderboard.build(students)
+    if not board.entries:
+        raise ValueError(f"no finished student runs under {students}"
+                         + (f" ({len(board.unfinished)} unfinished)" if board.unfinished else ""))
     out = Path(args.out or root)
-    path = leaderboard.write(entries, out)
-    plots = leaderboard.plot_curves(students, out)
+    path = leaderboard.write(board, out)
+    plots = leaderboard.plot_curves(students, out, board)
     print(path.read_text())
     print(f"wrote {path}, {out / 'leaderboard.csv'}" + "".join(f", {p}" for p in plots))
     return 0

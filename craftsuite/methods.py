@@ -134,6 +134,13 @@ def methods_for(world: str) -> list[str]:
     return [name for name, m in METHODS.items() if m.world == kind]
 
 
+def scratch(world: str) -> str | None:
+    """The baseline of a student world: its algorithm from scratch, without the automaton
+    (``td3`` in ``Cont``, ``dqn`` on the grids)."""
+    return next((name for name in methods_for(world)
+                 if not (METHODS[name].product or METHODS[name].distill or METHODS[name].crm)), None)
+
+
 def check_methods(names) -> None:
     """Raise KeyError naming the unknown methods and the known ones."""
     unknown = [n for n in names if n not in METHODS]

@@ -122,6 +122,18 @@ def load_config(cls, run):
     return cls(**{k: v for k, v in read_config(run).items() if k in names})
 
 
+def flatten(data: dict, prefix: str = "") -> dict:
+    """Nested settings as one level of dotted keys: ``{"a": {"b": 1}}`` -> ``{"a.b": 1}``."""
+    out = {}
+    for key, value in data.items():
+        name = f"{prefix}.{key}" if prefix else key
+        if isinstance(value, dict) and value:
+            out.update(flatten(value, name))
+        else:
+            out[name] = value
+    return out
+
+
 def run_settings(record: dict) -> dict:
     """The settings part of a ``config.json`` record (what the run key hashes)."""
     return {k: v for k, v in record.items() if k not in RECORD_KEYS}

@@ -321,7 +321,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
                             teachers=teachers, teacher_root=out / "teachers", log=log)
     board = leaderboard.build(out / "students")
     board_md = leaderboard.write(board, out)
-    plots = leaderboard.plot_curves(out / "students", out)
+    plots = leaderboard.plot_curves(out / "students", out, board)
     log("")
     log(board_md.read_text())
     movie = None

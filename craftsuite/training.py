@@ -214,24 +214,13 @@ class RunCallback(BaseCallback):
 
 def hparams(config) -> dict:
     """A run's settings as TensorBoard's HParams take them: one flat level of numbers,
-    strings and booleans (``hyperparameters.learning_rate``; lists and None as text)."""
-    from .runs import settings
-
-    flat = {}
-
-    def walk(prefix, value):
-        if isinstance(value, dict):
-            for k, v in value.items():
-                walk(f"{prefix}.{k}" if prefix else k, v)
-        elif isinstance(value, (bool, int, float, str)):
-            flat[prefix] = value
-        else:
-            flat[prefix] = json.dumps(value)
+    strings and booleans (``hyperparameters.learning_rate``; lists and None as JSON text).
+    The effective settings come last: where they repeat a field (the overrides), theirs stand."""
+    from .runs import flatten, settings
 
     data = settings(config)
-    walk("", {k: v for k, v in data.items() if k != "effective"})
-    walk("", data.get("effective", {}))
-    return flat
+    flat = {**flatten({k: v for k, v in data.items() if k != "effective"}), **flatten(data.get("effective", {}))}
+    return {k: v if isinstance(v, (bool, int, float, str)) else json.dumps(v) for k, v in flat.items()}
 
 
 def _purge_tensorboard(logger, step: int) -> None:

@@ -19,8 +19,18 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from craftsuite.leaderboard import _rung_order, bootstrap_ci, run_metrics
+from craftsuite.leaderboard import _rung_order, run_metrics
 from craftsuite.methods import METHODS
+
+
+def bootstrap_ci(values) -> tuple[float, float, float]:
+    """The interval the leaderboard printed when this experiment ran: a percentile
+    bootstrap of the mean over seeds (2,000 resamples)."""
+    x = np.asarray(values, dtype=float)
+    if len(x) < 2 or x.std() == 0:
+        return float(x.mean()), float(x.mean()), float(x.mean())
+    ci = stats.bootstrap((x,), np.mean, n_resamples=2_000, method="percentile", rng=0).confidence_interval
+    return float(x.mean()), float(ci.low), float(ci.high)
 
 
 def t_interval(values, level: float = 0.95) -> tuple[float, float, float]:

@@ -1,0 +1,153 @@
+"""Statistics of record, honest at the handful of seeds a benchmark can afford.
+
+Following Agarwal et al. (2021), "Deep reinforcement learning at the edge of the
+statistical precipice" (the ``rliable`` library):
+
+* per task and method, the seeds' values and a Student t-interval of their mean
+  (``t_interval``). Below ``MIN_SEEDS`` there is no interval, only the seeds. A percentile
+  bootstrap over 5 seeds covers the true mean in about 85% of normal cases, not the 95%
+  it is labelled with; the t-interval keeps its level (``benchmarks/interval_coverage.py``);
+* across tasks, each method's interquartile mean (``aggregate_iqm``), the probability
+  that it improves on a baseline (``probability_of_improvement``) and its performance
+  profile (``performance_profile``), with stratified-bootstrap intervals.
+
+The stratified bootstrap is ``scipy.stats.bootstrap`` with one sample per task (and per
+method, for a comparison): each is resampled on its own, which is what stratifying by task
+means, and tasks may have different numbers of seeds. ``rliable`` computes the same
+estimates (the test suite checks them against it), but it needs ``arch``, ``statsmodels``,
+``pandas`` and ``seaborn`` (about 170 MB; its import took 1.8 s against scipy.stats' 0.8 s
+here) and an equal number of runs on every task. Intervals are percentile intervals, as
+rliable's are, from ``RESAMPLES`` resamples with a fixed seed, so a page regenerates
+identically. At 4 tasks x 5 seeds they run narrow: the IQM's covered the truth in 89% of
+simulated cases, not 95% (``benchmarks/interval_coverage.py``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from statistics import median
+
+import numpy as np
+
+LEVEL = 0.95
+MIN_SEEDS = 3  # fewer seeds: the values, and no interval
+RESAMPLES = 2_000
+SEED = 0
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """A point estimate and its interval (``low``/``high`` NaN: no interval)."""
+
+    value: float
+    low: float = math.nan
+    high: float = math.nan
+
+    @property
+    def has_interval(self) -> bool:
+        return not (math.isnan(self.low) or math.isnan(self.high))
+
+
+def t_interval(values, level: float = LEVEL, bounds: tuple[float, float] = (-math.inf, math.inf)) -> Estimate:
+    """The mean of ``values`` (one per seed) and its Student t-interval, clipped to
+    ``bounds`` (a success rate's [0, 1]: the true mean lies inside them, so clipping loses
+    no coverage). Fewer than ``MIN_SEEDS`` values: the mean alone."""
+    from scipy import stats
+
+    x = np.asarray(values, dtype=float)
+    if len(x) == 0:
+        return Estimate(math.nan)
+    mean = float(x.mean())
+    if len(x) < MIN_SEEDS:
+        return Estimate(mean)
+    half = float(stats.t.ppf(0.5 + level / 2, len(x) - 1) * x.std(ddof=1) / math.sqrt(len(x)))
+    return Estimate(mean, max(bounds[0], mean - half), min(bounds[1], mean + half))
+
+
+def iqm(values) -> float:
+    """The interquartile mean: the mean of the middle 50% of ``values`` (all runs of all
+    tasks, flattened), as rliable defines it (``scipy.stats.trim_mean`` cutting 25% from
+    each end)."""
+    from scipy import stats
+
+    return float(stats.trim_mean(np.asarray(values, dtype=float).ravel(), 0.25))
+
+
+def _bootstrap(samples: list[np.ndarray], statistic, level: float = LEVEL):
+    """Percentile interval of ``statistic(*samples, axis=-1)`` over independent resamples
+    of each sample (the stratified bootstrap)."""
+    from scipy import stats
+
+    short = [len(s) for s in samples if len(s) < 2]
+    if short:
+        raise ValueError("a stratified bootstrap needs at least 2 runs per task and method")
+    result = stats.bootstrap(samples, statistic, n_resamples=RESAMPLES, confidence_level=level,
+                             method="percentile", vectorized=True, paired=False, rng=SEED)
+    return result.confidence_interval.low, result.confidence_interval.high
+
+
+def aggregate_iqm(per_task: list) -> Estimate:
+    """IQM over every run of every task (one array of runs per task), with a
+    stratified-bootstrap interval."""
+    samples = [np.asarray(s, dtype=float) for s in per_task]
+
+    def statistic(*xs, axis=-1):
+        from scipy import stats
+
+        return stats.trim_mean(np.concatenate(xs, axis=axis), 0.25, axis=axis)
+
+    low, high = _bootstrap(samples, statistic)
+    return Estimate(iqm(np.concatenate(samples)), float(low), float(high))
+
+
+def probability_of_improvement(x_per_task: list, y_per_task: list) -> Estimate:
+    """P(X > Y): the probability that a run of method X scores higher than a run of Y on
+    the same task (ties count half: the Mann-Whitney U over the pairs), averaged over the
+    tasks, with a stratified-bootstrap interval (X's and Y's runs resampled per task)."""
+    if len(x_per_task) != len(y_per_task) or not x_per_task:
+        raise ValueError("probability of improvement: give both methods' runs on the same, non-empty list of tasks")
+    samples = [np.asarray(s, dtype=float) for pair in zip(x_per_task, y_per_task) for s in pair]
+
+    def statistic(*xs, axis=-1):
+        from scipy import stats
+
+        return np.mean([stats.mannwhitneyu(x, y, axis=axis).statistic / (x.shape[axis] * y.shape[axis])
+                        for x, y in zip(xs[::2], xs[1::2])], axis=0)
+
+    low, high = _bootstrap(samples, statistic)
+    return Estimate(float(statistic(*samples)), float(low), float(high))
+
+
+def performance_profile(per_task: list, taus) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The fraction of runs scoring above each threshold in ``taus`` (averaged over tasks,
+    so that each task weighs the same), with its stratified-bootstrap band: (values, low, high)."""
+    samples = [np.asarray(s, dtype=float) for s in per_task]
+    taus = np.asarray(taus, dtype=float)
+
+    def statistic(*xs, axis=-1):
+        return np.stack([np.mean([np.mean(x > tau, axis=axis) for x in xs], axis=0) for tau in taus])
+
+    low, high = _bootstrap(samples, statistic)
+    return statistic(*samples), np.asarray(low), np.asarray(high)
+
+
+@dataclass(frozen=True)
+class Reached:
+    """Steps to a threshold over seeds: ``k`` of ``n`` reached it, the ``median`` of those
+    that did (None: none did). Never a mean over the others, whose time is unknown."""
+
+    k: int
+    n: int
+    median: float | None
+
+    def __str__(self) -> str:
+        if self.k == 0:
+            return f"0 of {self.n}"
+        return f"{self.k} of {self.n}; median {self.median:,.0f}"
+
+
+def reached(steps) -> Reached:
+    """``steps``: per seed, the transitions at which it reached the threshold, or None."""
+    done = [s for s in steps if s is not None]
+    return Reached(len(done), len(steps), float(median(done)) if done else None)

@@ -353,7 +353,7 @@ def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = 
     lines = []
     for agg in aggs:
         base = agg.baseline
-        lines += [f"### {agg.world}: {len(agg.tasks)} tasks ({', '.join(agg.tasks)})", "",
+        lines += [f"### {agg.world}: {len(agg.tasks)} task{'s' if len(agg.tasks) > 1 else ''} ({', '.join(agg.tasks)})", "",
                   AGGREGATE_LEGEND.format(baseline=f"`{base}`" if base else "the algorithm from scratch (not run)"),
                   "",
                   "| method | runs | IQM success | IQM AUC | P(improves on " + (base or "scratch") + "): success "
@@ -567,7 +567,7 @@ def plot_profiles(board, out) -> list[Profile]:
             value, low, high = stats.performance_profile(agg.scores[method], taus - 1e-9)  # >= tau: a rate of tau counts
             line, = ax.plot(taus, value, label=f"{method} ({agg.runs[method]} runs)")
             ax.fill_between(taus, low, high, color=line.get_color(), alpha=0.2)
-        ax.set(title=f"{agg.world}: {len(agg.tasks)} tasks", xlabel="final greedy success \u03c4",
+        ax.set(title=f"{agg.world}: {len(agg.tasks)} task{'s' if len(agg.tasks) > 1 else ''}", xlabel="final greedy success \u03c4",
                ylabel="share of runs with success \u2265 \u03c4", ylim=(-0.02, 1.02))
         ax.legend(fontsize=8)
         fig.tight_layout()

@@ -6,7 +6,8 @@ end to end under an output directory::
 
     <out>/teachers/teacher-<Task>-Grid7-s0-<key>/     teacher.zip, table.npz, evals.csv
     <out>/students/student-<Task>-Cont-<method>-s<seed>-<key>/
-    <out>/leaderboard.md, leaderboard.csv, curves-<Task>-<world>[-<settings>].png, best-<...>.mp4
+    <out>/leaderboard.md, leaderboard.csv, curves-<Task>-<world>[-<settings>].png, profile-<world>.png,
+          best-<...>.mp4
 
 Teachers and students share one pool of local processes (``workers`` at a time) or, with
 ``ray``, a Ray cluster (``"local"`` starts one in-process; a real cluster needs ``out`` on

@@ -222,3 +222,13 @@ def test_results_page_names_the_missing_and_the_empty(tmp_path):
     with pytest.raises(ValueError, match="no finished student runs"):
         leaderboard.write_page([tmp_path / "empty"], tmp_path / "results.md")
     assert not (tmp_path / "results.md").exists()
+
+
+def test_a_directory_of_unfinished_runs_only_is_named_as_such(tmp_path):
+    run = tmp_path / "students" / "student-Reach-Cont-td3-s0"
+    run.mkdir(parents=True)
+    (run / "config.json").write_text(json.dumps({"task": "Reach", "world": "Cont", "method": "td3", "seed": 0,
+                                                 "steps": 1000}))
+    with pytest.raises(ValueError, match=r"no finished student runs under .*students \(1 unfinished\)"):
+        leaderboard.write_page([tmp_path], tmp_path / "results.md")
+    assert not (tmp_path / "results.md").exists() and (run / "config.json").exists()

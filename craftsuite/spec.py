@@ -222,6 +222,10 @@ class TaskSpec:
         """A short hash of the rules: everything that changes what an agent experiences, not
         the description, tags, file, colours or symbols. Runs record it and hash it into
         their run key, so a run made under other rules is never reused."""
+        return self._digest
+
+    @cached_property
+    def _digest(self) -> str:  # a spec is frozen: its rules hash once
         import hashlib
         import json
 

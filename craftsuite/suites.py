@@ -246,10 +246,11 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
     workers_ = _Workers(len(configs) + len(teachers), workers, ray)
     with tqdm(total=total, desc=f"{len(configs)} student runs", unit="step", disable=not progress,
               dynamic_ncols=True) as bar:
+        runs = [(c, root / c.run_name()) for c in configs]  # named once: a name hashes the run's settings
+
         def poll():
             done = 0
-            for c in configs:
-                run = root / c.run_name()
+            for c, run in runs:
                 if (run / "result.json").exists():
                     done += c.steps
                 elif (run / "progress.json").exists():

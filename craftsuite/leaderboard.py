@@ -431,7 +431,7 @@ def write_page(run_dirs, path, title: str = "Results") -> Path:
         suite = json.loads((run_dir / "suite.json").read_text()) if (run_dir / "suite.json").exists() else {}
         name = suite.get("name", run_dir.name)
         lines += [f"## {name}" + (f": {suite['description']}" if suite.get("description") else ""), "",
-                  f"Runs in `{run_dir.as_posix()}`.", ""]
+                  f"Runs in `{run_dir.as_posix()}`." + _suite_scope(suite), ""]
         sessions = read(run_dir)
         for s in sessions:
             took = "did not finish" if s.get("seconds") is None else f"{s['seconds'] / 60:.1f} min"
@@ -452,6 +452,22 @@ def write_page(run_dirs, path, title: str = "Results") -> Path:
             lines += [f"Video of the best student: [{video.name}]({(images / video.name).relative_to(path.parent).as_posix()})", ""]
     atomic_write(path, "\n".join(lines))
     return path
+
+
+def _suite_scope(suite: dict) -> str:
+    """What the last transfer into a directory asked for (``suite.json``: the suite as run,
+    with any command-line overrides), e.g. `` As run: rungs tagged easy, medium; worlds Cont; ...``."""
+    parts = []
+    if suite.get("tags") or suite.get("tasks"):
+        parts.append("rungs " + "; ".join(filter(None, [
+            f"tagged {', '.join(suite['tags'])}" if suite.get("tags") else "",
+            ", ".join(suite.get("tasks") or ())])))
+    for key, word in (("worlds", "worlds"), ("methods", "methods")):
+        if suite.get(key):
+            parts.append(f"{word} {', '.join(suite[key])}")
+    if suite.get("seeds"):
+        parts.append(f"{suite['seeds']} seed{'s' if suite['seeds'] > 1 else ''}")
+    return f" As last run: {'; '.join(parts)}." if parts else ""
 
 
 def _curve(values_at, grid):

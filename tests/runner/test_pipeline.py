@@ -180,6 +180,11 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
     page = leaderboard.write_page([tmp_path / "out"], tmp_path / "docs" / "results.md")
     text = page.read_text()
     assert "## quick:" in text and "### Reach (Cont)" in text and session["command"] in text
+    assert "As last run: rungs tagged calibration; worlds Cont; methods td3, td3-dynamic-edges; 1 seed." in text
+    # the runs record their settings and the code that trained them
+    record = json.loads((result.students[0] / "config.json").read_text())
+    assert record["format"] == 2 and record["effective"]["hyperparameters"]["policy_kwargs"]["net_arch"] == [16]
+    assert record["provenance"][0]["versions"]["craftsuite"]
     assert "images/results-out/curves-Reach-Cont.png" in text  # named after the directory
     assert (tmp_path / "docs" / "images" / "results-out" / "curves-Reach-Cont.png").is_file()
     transfer(tiny, tmp_path / "out", workers=2, video=False, progress=False, log=lambda *_: None)  # all reused

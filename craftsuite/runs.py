@@ -62,6 +62,10 @@ def atomic_write(path: Path, text: str) -> None:
 # and ``provenance``). Readers take both; a run directory of layout 1 is never resumed.
 FORMAT = 2
 RECORD_KEYS = ("format", "provenance")  # in config.json, beside the settings: not hashed, not compared
+# fields that say where a file lives, not what the run computes from: recorded, but neither
+# hashed nor compared, so a moved or remounted runs directory keeps its keys (a student's
+# teacher is in its effective settings by the teacher's run name, which hashes the teacher's)
+LOCATIONS = ("table",)
 
 
 def config_dict(config) -> dict:
@@ -87,8 +91,9 @@ def settings(config) -> dict:
 
 
 def config_key(config) -> str:
-    """A short stable hash of a config's settings: equal settings share a run directory."""
-    text = json.dumps(settings(config), sort_keys=True)
+    """A short stable hash of a config's settings (not of its file locations): equal
+    settings share a run directory."""
+    text = json.dumps(run_settings(settings(config)), sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:10]
 
 
@@ -135,8 +140,9 @@ def flatten(data: dict, prefix: str = "") -> dict:
 
 
 def run_settings(record: dict) -> dict:
-    """The settings part of a ``config.json`` record (what the run key hashes)."""
-    return {k: v for k, v in record.items() if k not in RECORD_KEYS}
+    """The settings part of a ``config.json`` record (what the run key hashes): without
+    the record's format and provenance, nor file locations."""
+    return {k: v for k, v in record.items() if k not in RECORD_KEYS + LOCATIONS}
 
 
 class RunDir:
@@ -173,7 +179,7 @@ class RunDir:
                 raise RunError(f"{self.path} holds a run recorded by an older CraftSuite, without its effective "
                                "settings, so it cannot be told to match this configuration; it is not resumed: "
                                "choose another output directory")
-            if run_settings(saved) != mine:
+            if run_settings(saved) != run_settings(mine):
                 raise RunError(f"{self.path} holds a run with another configuration ({path}); "
                                "choose another output directory")
             if self.finished():

@@ -96,8 +96,11 @@ class StudentConfig:
         """The settings the student trains with beyond its fields: its algorithm's defaults
         merged with ``hyperparameters`` (the replay buffer no larger than the budget), its
         method's row and its world (recorded and hashed)."""
-        return _effective(self.method, {"buffer_size": min(self.steps, 1_000_000), **self.hyperparameters},
-                          self.env_id, self.env_kwargs, self.task)
+        out = _effective(self.method, {"buffer_size": min(self.steps, 1_000_000), **self.hyperparameters},
+                         self.env_id, self.env_kwargs, self.task)
+        if self.table is not None:  # the teacher, by its run's name (its settings' hash), not by where it lies
+            out["teacher"] = f"{Path(self.table).parent.name}/{Path(self.table).name}"
+        return out
 
     def run_name(self) -> str:
         return f"student-{self.task}-{self.world}-{self.method}-s{self.seed}-{config_key(self)}"
@@ -164,6 +167,8 @@ class RunCallback(BaseCallback):
         if self.num_timesteps > 0:  # resumed from a checkpoint
             _purge_tensorboard(self.logger, self.num_timesteps)
         else:  # once per run: a resumed run's first session logged them
+            if any((self.run.path / "tb").rglob("events.out.tfevents.*")):  # killed before its first checkpoint
+                _purge_tensorboard(self.logger, 0)  # its scalars and HParams go: this session starts over
             from stable_baselines3.common.logger import HParam
 
             self.logger.record("hparams", HParam(hparams(self.run.config),

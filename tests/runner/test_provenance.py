@@ -60,7 +60,7 @@ def test_a_run_records_its_effective_settings_and_the_code_that_trained_it(tmp_p
         pass
     record = read_config(tmp_path / "r")
     assert record["format"] == FORMAT and load_config(StudentConfig, tmp_path / "r") == config  # the round trip
-    assert run_settings(record) == json.loads(json.dumps(settings(config)))
+    assert run_settings(record) == run_settings(json.loads(json.dumps(settings(config)))) and record["table"] == "t.npz"
     effective = record["effective"]
     assert effective["hyperparameters"]["batch_size"] == 32  # the override
     assert effective["hyperparameters"]["learning_rate"] == TD3_DEFAULTS["learning_rate"]  # the default merged in
@@ -103,3 +103,19 @@ def test_a_change_of_a_default_or_of_the_rules_gives_a_new_run_key(monkeypatch):
     monkeypatch.setattr(registration, "tasks", lambda: {**known, "BlindCraftsman": dataclasses.replace(
         spec, description="reworded")})
     assert student.run_name() == keys[0]
+
+
+def test_where_the_teachers_table_lies_is_recorded_but_not_hashed(tmp_path):
+    from craftsuite.runs import RunDir, read_config
+    from craftsuite.training import StudentConfig
+
+    here = StudentConfig(method="td3-dynamic", table="/mnt/a/runs/teachers/teacher-X-k1/table.npz")
+    moved = StudentConfig(method="td3-dynamic", table="/home/b/runs/teachers/teacher-X-k1/table.npz")
+    other = StudentConfig(method="td3-dynamic", table="/mnt/a/runs/teachers/teacher-X-k2/table.npz")
+    assert here.run_name() == moved.run_name() != other.run_name()  # another teacher is another run
+    with RunDir(tmp_path / "r", here):
+        pass
+    with RunDir(tmp_path / "r", moved):  # the directory moved: the run resumes, and records its new table
+        pass
+    record = read_config(tmp_path / "r")
+    assert record["table"] == moved.table and record["effective"]["teacher"] == "teacher-X-k1/table.npz"

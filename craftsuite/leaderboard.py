@@ -169,13 +169,16 @@ def build(students_root) -> Board:
         try:
             m = run_metrics(run)
             config = read_config(run)
+            if m is None:
+                if not (run / "result.json").exists() and run.name.startswith("student-"):
+                    board.unfinished.append({"task": config["task"], "world": world_label(config),
+                                             "method": config["method"], "seed": config["seed"], "run": run.name})
+                continue
         except RunError as err:
             board.unreadable.append(str(err))
             continue
-        if m is None:
-            if not (run / "result.json").exists() and run.name.startswith("student-"):
-                board.unfinished.append({"task": config["task"], "world": world_label(config),
-                                         "method": config["method"], "seed": config["seed"], "run": run.name})
+        except (ValueError, KeyError, TypeError) as err:  # a record or log that does not read as a run's
+            board.unreadable.append(f"{run}: {type(err).__name__}: {err}")
             continue
         setting = {k: v for k, v in run_settings(config).items() if k != "seed"}
         key = (m["task"], m["world"], m["method"], json.dumps(setting, sort_keys=True))
@@ -187,7 +190,7 @@ def build(students_root) -> Board:
         settings = [flatten(groups[k][0][1]) for k in keys]
         differing = sorted({name for s in settings for name in s
                             if len({json.dumps(t.get(name), sort_keys=True) for t in settings}) > 1})
-        for i, key in enumerate(sorted(keys, key=lambda k: -len(groups[k]))):
+        for i, key in enumerate(sorted(keys, key=lambda k: (-len(groups[k]), k[3]))):  # most runs first
             runs = sorted((m for m, _ in groups[key]), key=lambda m: m["seed"])
             setting = flatten(groups[key][0][1])
             updates = [r["updates"] for r in runs]
@@ -195,7 +198,7 @@ def build(students_root) -> Board:
                 task, world, method, [r["seed"] for r in runs], {m: [r[m] for r in runs] for m in METRICS},
                 stats.reached([r["steps_to_80"] for r in runs]), budget=max(r["budget"] for r in runs),
                 updates=None if None in updates else round(float(np.mean(updates))),
-                variant=string.ascii_lowercase[i] if len(keys) > 1 else "",
+                variant=(string.ascii_lowercase[i] if i < 26 else str(i + 1)) if len(keys) > 1 else "",
                 differs={name: setting.get(name, "(not recorded)") for name in differing},
                 runs=[r["run"] for r in runs]))
     return board
@@ -240,8 +243,10 @@ AGGREGATE_LEGEND = (
     "5 seeds covered 89% of simulated cases, not 95%): read an overlap as no difference.")
 
 
-def to_markdown(board, title: str | None = "# Leaderboard", profiles: dict[str, Path] | None = None) -> str:
-    """The board as Markdown; ``profiles``: per world, a performance-profile image to link."""
+def to_markdown(board, title: str | None = "# Leaderboard", profiles: dict[str, Path] | None = None,
+                aggs: list[Aggregate] | None = None) -> str:
+    """The board as Markdown; ``profiles``: per world, a performance-profile image to link;
+    ``aggs``: the board's ``aggregates``, if already computed."""
     from .methods import METHODS
 
     entries = list(board)
@@ -284,7 +289,7 @@ def to_markdown(board, title: str | None = "# Leaderboard", profiles: dict[str, 
             if (u["task"], u["world"]) == (task, world)), ""]
     for reason in getattr(board, "unreadable", []):
         lines += [f"Not read: {reason}", ""]
-    aggregate_lines = aggregates_markdown(aggregates(entries), profiles)
+    aggregate_lines = aggregates_markdown(aggregates(entries) if aggs is None else aggs, profiles)
     if aggregate_lines:
         lines += ["## Across tasks", "", *aggregate_lines]
     shown = [m for m in METHODS if m in {e.method for e in entries}]
@@ -311,9 +316,14 @@ class Aggregate:
 
 
 def aggregates(entries) -> list[Aggregate]:
-    """Per world, the methods compared across the tasks all of them ran (with 2 seeds or
-    more each, and one setting: variants are not aggregated)."""
+    """Per world, the methods compared across the tasks all of them ran, each with 2 runs
+    or more per task that have a final success, and one setting (variants are not
+    aggregated). A world with nothing to aggregate still says why (an empty aggregate)."""
     from .methods import scratch
+
+    def finite(entry, metric):
+        x = np.asarray(entry.values[metric], dtype=float)
+        return x[np.isfinite(x)]
 
     out = []
     for world in sorted({e.world for e in entries}):
@@ -322,22 +332,31 @@ def aggregates(entries) -> list[Aggregate]:
         variants = sorted({e.method for e in mine if e.variant})
         if variants:
             left_out.append(f"{', '.join(variants)}: runs of more than one setting")
-        few = sorted({e.method for e in mine if len(e.seeds) < 2 and not e.variant})
-        if few:
-            left_out.append(f"{', '.join(few)}: fewer than 2 seeds on some task")
-        methods = sorted({e.method for e in mine} - set(variants) - set(few))
+        methods = sorted({e.method for e in mine} - set(variants))
         cells = {(e.task, e.method): e for e in mine if e.method in methods}
         tasks = sorted({e.task for e in mine}, key=_rung_order)
+        blank = sum(len(e.seeds) - len(finite(e, m)) for e in cells.values() for m in AGGREGATED[:1])
+        if blank:
+            left_out.append(f"{blank} run{'s' if blank > 1 else ''} without an evaluation")
+        # a method short of runs on a task every method ran is left out; the others keep the task
         common = [t for t in tasks if all((t, m) in cells for m in methods)]
+        few = sorted(m for m in methods if any(min(len(finite(cells[(t, m)], metric)) for metric in AGGREGATED) < 2
+                                               for t in common))
+        if few:
+            left_out.append(f"{', '.join(few)}: fewer than 2 runs on some task")
+        methods = [m for m in methods if m not in few]
+        common = [t for t in tasks if methods and all((t, m) in cells for m in methods)]
         for t in tasks:
             if t not in common:
                 ran = sorted(m for m in methods if (t, m) in cells)
                 left_out.append(f"task {t}: run by {', '.join(ran) or 'no aggregated method'} only")
-        if not methods or not common:
-            continue
-        baseline = scratch(world.split(":")[0])
-        baseline = baseline if baseline in methods else None
-        per_task = {m: {metric: [np.asarray(cells[(t, m)].values[metric]) for t in common] for metric in AGGREGATED}
+        if not common:
+            methods = []
+        scratch_method = scratch(world.split(":")[0])
+        baseline = scratch_method if scratch_method in methods else None
+        if scratch_method and not baseline and any(e.method == scratch_method for e in mine):
+            left_out.append(f"the baseline {scratch_method} is not aggregated: no probability of improvement")
+        per_task = {m: {metric: [finite(cells[(t, m)], metric) for t in common] for metric in AGGREGATED}
                     for m in methods}
         out.append(Aggregate(
             world, common, baseline,
@@ -345,7 +364,7 @@ def aggregates(entries) -> list[Aggregate]:
             {m: {metric: stats.probability_of_improvement(per_task[m][metric], per_task[baseline][metric])
                  for metric in AGGREGATED} for m in methods if baseline and m != baseline},
             {m: per_task[m]["success"] for m in methods},
-            {m: sum(len(cells[(t, m)].seeds) for t in common) for m in methods}, left_out))
+            {m: sum(len(x) for x in per_task[m]["success"]) for m in methods}, left_out))
     return out
 
 
@@ -353,6 +372,10 @@ def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = 
     lines = []
     for agg in aggs:
         base = agg.baseline
+        if not agg.iqm:
+            lines += [f"### {agg.world}", "", "Nothing to aggregate: " + "; ".join(agg.left_out or ["no method"]) + ".",
+                      ""]
+            continue
         lines += [f"### {agg.world}: {len(agg.tasks)} task{'s' if len(agg.tasks) > 1 else ''} ({', '.join(agg.tasks)})", "",
                   AGGREGATE_LEGEND.format(baseline=f"`{base}`" if base else "the algorithm from scratch (not run)"),
                   "",
@@ -394,9 +417,10 @@ def write(board, out) -> Path:
     """``leaderboard.md``, ``leaderboard.csv`` and the performance profiles in ``out``;
     returns the Markdown path."""
     out = Path(out)
-    profiles = {p.world: p.path.relative_to(out) for p in plot_profiles(board, out)}
+    aggs = aggregates(list(board))
+    profiles = {p.world: p.path.relative_to(out) for p in plot_profiles(board, out, aggs)}
     atomic_write(out / "leaderboard.csv", to_csv(board))
-    atomic_write(out / "leaderboard.md", to_markdown(board, profiles=profiles))
+    atomic_write(out / "leaderboard.md", to_markdown(board, profiles=profiles, aggs=aggs))
     return out / "leaderboard.md"
 
 
@@ -442,8 +466,9 @@ def write_page(run_dirs, path, title: str = "Results") -> Path:
         # named after the directory, not the suite: two directories of one suite keep their own plots
         images = path.parent / "images" / _file_part(f"results-{run_dir.name}")
         images.mkdir(parents=True, exist_ok=True)
-        profiles = {p.world: p.path.relative_to(path.parent) for p in plot_profiles(board, images)}
-        text = to_markdown(board, title=None, profiles=profiles).replace("\n### ", "\n#### ").replace("\n## ", "\n### ")
+        aggs = aggregates(list(board))
+        profiles = {p.world: p.path.relative_to(path.parent) for p in plot_profiles(board, images, aggs)}
+        text = to_markdown(board, title=None, profiles=profiles, aggs=aggs).replace("\n### ", "\n#### ").replace("\n## ", "\n### ")
         lines += ["", text.strip(), ""]
         for plot in plot_curves(students, images, board):
             lines += [f"![{plot.stem}]({plot.relative_to(path.parent).as_posix()})", ""]
@@ -568,7 +593,7 @@ class Profile:
     path: Path
 
 
-def plot_profiles(board, out) -> list[Profile]:
+def plot_profiles(board, out, aggs: list[Aggregate] | None = None) -> list[Profile]:
     """Per world with an aggregate, the performance profile of final greedy success: the
     share of runs (averaged over tasks) above each threshold, with its stratified-bootstrap
     band (Agarwal et al. 2021, Figure 5); ``profile-<world>.png`` in ``out``."""
@@ -576,7 +601,9 @@ def plot_profiles(board, out) -> list[Profile]:
 
     taus = np.linspace(0, 1, 51)
     out_paths = []
-    for agg in aggregates(list(board)):
+    for agg in aggregates(list(board)) if aggs is None else aggs:
+        if not agg.scores:
+            continue
         fig = Figure(figsize=(6, 3.8))
         ax = fig.subplots()
         for method in sorted(agg.scores, key=lambda m: -agg.iqm[m]["auc"].value):

@@ -70,8 +70,8 @@ LOCATIONS = ("table",)
 
 def config_dict(config) -> dict:
     """A config dataclass as saved and hashed. A field added after runs existed carries
-    ``metadata={"omit_if_default": True}``: at its default it is left out, so the runs made
-    before it keep their directories."""
+    ``metadata={"omit_if_default": True}``: at its default it is left out, so the runs of
+    the same record format made before it keep their directories."""
     out = dataclasses.asdict(config)
     for f in dataclasses.fields(config):
         if f.metadata.get("omit_if_default"):

@@ -56,7 +56,7 @@ from __future__ import annotations
 
 import re
 import tomllib
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field, fields, is_dataclass
 from functools import cache, cached_property
 from pathlib import Path
 from typing import Any
@@ -229,15 +229,18 @@ class TaskSpec:
         import hashlib
         import json
 
+        looks = ("description", "tags", "path", "color", "symbol")  # fields that change no rule
+
         def rules(value):
+            if is_dataclass(value):
+                return {f.name: rules(getattr(value, f.name)) for f in fields(value) if f.name not in looks}
             if isinstance(value, dict):
-                return {k: rules(v) for k, v in value.items() if k not in ("color", "symbol")}
+                return {k: rules(v) for k, v in value.items()}
             if isinstance(value, (list, tuple)):
                 return [rules(v) for v in value]
             return value
 
-        data = {k: v for k, v in asdict(self).items() if k not in ("description", "tags", "path")}
-        return hashlib.sha256(json.dumps(rules(data), sort_keys=True).encode()).hexdigest()[:12]
+        return hashlib.sha256(json.dumps(rules(self), sort_keys=True).encode()).hexdigest()[:12]
 
 
 # Readable defaults for objects a spec gives no colour; the paper's Figure 1c colours first.

@@ -232,3 +232,32 @@ def test_a_directory_of_unfinished_runs_only_is_named_as_such(tmp_path):
     with pytest.raises(ValueError, match=r"no finished student runs under .*students \(1 unfinished\)"):
         leaderboard.write_page([tmp_path], tmp_path / "results.md")
     assert not (tmp_path / "results.md").exists() and (run / "config.json").exists()
+
+
+def test_a_task_only_the_baseline_ran_with_one_seed_does_not_drop_the_baseline(runs):
+    fake_run(runs, "td3", 0, [(1000, 1.0)], [(995, 1.0)], task="Reach")  # one seed, and only td3 ran Reach
+    [agg] = leaderboard.aggregates(list(leaderboard.build(runs)))
+    assert agg.baseline == "td3" and set(agg.improvement) == {"td3-dynamic"}
+    assert agg.tasks == ["BlindCraftsman"] and "task Reach: run by td3 only" in agg.left_out
+
+
+def test_a_run_without_evaluations_is_no_estimate_and_is_left_out_of_the_aggregate_by_name(runs):
+    fake_run(runs, "td3", 2, [], [(995, 1.0)])  # finished, but never evaluated
+    board = leaderboard.build(runs)
+    td3 = {e.method: e for e in board}["td3"]
+    assert np.isnan(td3.stats["success"].value) and not td3.stats["success"].has_interval
+    [agg] = leaderboard.aggregates(list(board))
+    assert "1 run without an evaluation" in agg.left_out and agg.runs["td3"] == 2
+    assert agg.iqm["td3"]["success"].value == pytest.approx(0.4)  # the two evaluated runs: 0.8 and 0.0
+    with open(leaderboard.write(board, runs.parent).with_suffix(".csv")) as f:
+        row = next(r for r in csv.DictReader(f) if r["method"] == "td3")
+    assert row["success"] == row["success_lo"] == row["success_hi"] == ""
+
+
+def test_a_world_with_nothing_to_aggregate_says_why(tmp_path):
+    root = tmp_path / "students"
+    fake_run(root, "td3", 0, [(1000, 1.0)], [(995, 1.0)])
+    fake_run(root, "td3-dynamic", 0, [(1000, 1.0)], [(995, 1.0)])
+    md = leaderboard.to_markdown(leaderboard.build(root))
+    assert "### Cont\n\nNothing to aggregate: td3, td3-dynamic: fewer than 2 runs on some task" in md
+    assert leaderboard.plot_profiles(leaderboard.build(root), tmp_path) == []

@@ -103,6 +103,10 @@ def test_a_change_of_a_default_or_of_the_rules_gives_a_new_run_key(monkeypatch):
     monkeypatch.setattr(registration, "tasks", lambda: {**known, "BlindCraftsman": dataclasses.replace(
         spec, description="reworded")})
     assert student.run_name() == keys[0]
+    wood = dataclasses.replace(spec.items[0], color="#000000", symbol="W")  # another look, the same rules
+    monkeypatch.setattr(registration, "tasks", lambda: {**known, "BlindCraftsman": dataclasses.replace(
+        spec, items=(wood, *spec.items[1:]))})
+    assert student.run_name() == keys[0]
 
 
 def test_where_the_teachers_table_lies_is_recorded_but_not_hashed(tmp_path):

@@ -60,13 +60,10 @@ PAPER_REFERENCE = {
 def world_label(config: dict) -> str:
     """A student's world as a leaderboard shows it: ``Cont``, ``Grid10``, or with the
     settings that change it, e.g. ``Cont: frame_skip=2, max_episode_steps=1000``."""
-    import dataclasses
-
+    from .runs import config_from
     from .training import StudentConfig  # the owner of a student's world settings
 
-    fields = {f.name for f in dataclasses.fields(StudentConfig)}
-    # world_kwargs is absent from configs older than the field
-    settings = StudentConfig(**{k: v for k, v in config.items() if k in fields}).env_kwargs
+    settings = config_from(StudentConfig, config).env_kwargs
     if not settings:
         return config["world"]
     return f"{config['world']}: " + ", ".join(f"{k}={json.dumps(v)}" for k, v in sorted(settings.items()))

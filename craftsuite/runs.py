@@ -120,11 +120,17 @@ def read_config(run) -> dict:
     return data
 
 
-def load_config(cls, run):
-    """The config dataclass (``cls``) a run directory was made with, from its record of any
-    layout this version reads (the effective settings and the provenance are left out)."""
+def config_from(cls, record: dict):
+    """The config dataclass (``cls``) of a ``config.json`` record of any layout: its fields
+    (the effective settings and the provenance are left out; a field a record predates
+    takes its default)."""
     names = {f.name for f in dataclasses.fields(cls)}
-    return cls(**{k: v for k, v in read_config(run).items() if k in names})
+    return cls(**{k: v for k, v in record.items() if k in names})
+
+
+def load_config(cls, run):
+    """The config dataclass (``cls``) a run directory was made with."""
+    return config_from(cls, read_config(run))
 
 
 def flatten(data: dict, prefix: str = "") -> dict:

@@ -31,7 +31,6 @@ from .methods import METHODS, check_methods, methods_for
 from .runs import atomic_write
 from .spec import TaskSpec
 from .task_registry import carried, ladder, resolve_task
-from .training import train_student, train_teacher
 
 
 @dataclass(frozen=True)
@@ -157,12 +156,16 @@ def _student_job(config: dict, root: str, task: str | dict | None = None) -> str
     """One student run in a worker process (one thread: the workers share the cores);
     ``task``: its task as ``task_registry.carried`` gives it (a user task's data)."""
     _start_worker(task)
+    from .training import train_student  # torch: only where runs train, not to list the suites
+
     return str(train_student(StudentConfig(**config), root, progress=False))
 
 
 def _teacher_job(config: dict, root: str, task: str | dict | None = None) -> str:
     """One teacher run (training, then distillation) in a worker process."""
     _start_worker(task)
+    from .training import train_teacher
+
     return str(train_teacher(TeacherConfig(**config), root, progress=False))
 
 

@@ -68,7 +68,8 @@ class StudentConfig:
     def __post_init__(self):
         if not isinstance(self.n_envs, int) or isinstance(self.n_envs, bool) or self.n_envs < 1:
             raise ValueError(f"n_envs must be a positive integer, got {self.n_envs!r}")
-        if layout_kwargs(self.layout_seed) and not self.world.startswith("Grid"):  # also checks the seed
+        ids.world_kind(self.world)  # a ValueError naming the worlds there are
+        if layout_kwargs(self.layout_seed) and ids.world_kind(self.world) != "Grid":  # also checks the seed
             raise ValueError(f"layout_seed fixes a grid instance; the {self.world} world has none "
                              "(its objects are placed anew every episode)")
         if not isinstance(self.world_kwargs, dict):

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .configs import StudentConfig, TeacherConfig
-from .ids import file_stem, world_kind
+from .ids import CONT, file_stem, world_kind
 from .methods import METHODS, check_methods, methods_for
 from .runs import atomic_write
 from .spec import TaskSpec
@@ -102,7 +102,7 @@ class Suite:
                 if not methods:
                     continue
                 steps = self.budget(spec, world)
-                cont = world_kind(world) == "Cont"
+                cont = world_kind(world) == CONT
                 for method in methods:
                     table = None
                     if METHODS[method].needs_table:

@@ -27,3 +27,10 @@ def test_a_configs_env_id_is_built_by_the_id_module():
     teacher = configs.TeacherConfig(task="Reach", size=10)
     assert ids.parse_id(teacher.env_id) == ("Reach", "Grid10")
     assert teacher.run_name().startswith("teacher-Reach-Grid10-s0-")
+
+
+def test_a_config_of_an_unknown_world_is_a_clear_error():
+    import pytest
+
+    with pytest.raises(ValueError, match="unknown world 'Mujoco': use Cont"):
+        configs.StudentConfig(world="Mujoco")

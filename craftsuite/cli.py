@@ -7,8 +7,70 @@ import sys
 from pathlib import Path
 
 
+def _task(argument: str) -> str:
+    """A task argument's task name: a known task's, or a spec file's (``*.toml``, read and
+    registered here, with its ids). Called before anything is written.
+
+    Raises:
+        KeyError: an unknown task name, listing the known ones.
+        SpecError: a spec file that is missing or cannot be used.
+    """
+    from .ids import parse_id
+    from .registration import register_task
+    from .task_registry import is_spec_file, resolve_task
+
+    if is_spec_file(argument):
+        return parse_id(register_task(Path(argument))[0])[0]
+    return resolve_task(argument).name
+
+
+def _registered(task: str, world: str) -> str:
+    """The id of a known task in a world, or a ValueError naming the task's worlds."""
+    import gymnasium as gym
+
+    from .ids import env_id, parse_id
+    from .registration import registered_ids
+
+    name = env_id(task, world)
+    if name not in gym.registry:
+        worlds = [parse_id(i)[1] for i in registered_ids() if parse_id(i)[0] == task]
+        raise ValueError(f"task {task!r} has no {world} world; its worlds: {worlds}")
+    return name
+
+
+def _world(text: str) -> str:
+    """``--world``: Cont or Grid<size> (argparse names a bad one at once)."""
+    from .ids import world_kind
+
+    try:
+        world_kind(text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+    return text
+
+
+def _known_worlds() -> list[str]:
+    """The worlds of the known tasks: Cont, then the grids by size."""
+    from .ids import CONT, grid_world
+    from .task_registry import tasks
+
+    return [CONT] + [grid_world(n) for n in sorted({n for spec in tasks().values() for n in spec.grid.sizes})]
+
+
+class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Every option's help ends with its default, unless it already names it or has none."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if "default" in text or action.default in (None, False, (), argparse.SUPPRESS):
+            return text
+        return super()._get_help_string(action)
+
+
 def _tasks(args) -> int:
-    from .registration import ladder, parse_id, registered_ids
+    from .ids import parse_id
+    from .registration import registered_ids
+    from .task_registry import ladder
 
     if args.markdown:
         from .references import write_tasks_page
@@ -33,7 +95,7 @@ def _tasks(args) -> int:
 
 def _automaton(args) -> int:
     from .automata import write_image
-    from .registration import resolve_task
+    from .task_registry import resolve_task
 
     spec = resolve_task(args.task)
     if args.describe:
@@ -52,15 +114,14 @@ def _demo(args) -> int:
     from tqdm import tqdm
 
     from .automata import write_image
-    from .registration import registered_ids, tasks
+    from .ids import CONT, file_stem, parse_id
+    from .registration import registered_ids
     from .scripted import scripted_policy
+    from .task_registry import tasks
 
+    ids = [i for i in registered_ids() if args.task in (None, parse_id(i)[0])]
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    ids = [i for i in registered_ids() if args.task in (None, i.split("/")[1].split("-")[0])]
-    if not ids:
-        print(f"no registered id for task {args.task!r}", file=sys.stderr)
-        return 2
     rows = []
     for env_id in tqdm(ids, desc="scripted rollouts", unit="env"):
         env = gym.make(env_id, render_mode="rgb_array")
@@ -80,7 +141,7 @@ def _demo(args) -> int:
             successes += bool(info["is_success"])
             lengths.append(steps)
         gap = np.full((first.shape[0], 8, 3), 255, np.uint8)
-        picture = out / f"{env_id.split('/')[1]}.png"
+        picture = out / f"{file_stem(env_id)}.png"
         cv2.imwrite(str(picture), cv2.cvtColor(np.concatenate([first, gap, last], 1), cv2.COLOR_RGB2BGR))
         rows.append((env_id, successes, args.episodes, float(np.mean(lengths)), picture.name))
         env.close()
@@ -94,11 +155,11 @@ def _demo(args) -> int:
     for env_id, ok, n, steps, pic in rows:
         print(f"| {env_id} | {ok}/{n} | {steps:.1f} | {out / pic} |")
     print(f"\nautomata drawn in {out}/<Task>-automaton.png")
-    cont = [i for i in ids if "-Cont-" in i]
+    cont = [i for i in ids if parse_id(i)[1] == CONT]
     if cont:
         from .rollouts import record_video
 
-        rec = record_video(cont[0], "scripted", 1, str(out / f"{cont[0].split('/')[1]}.mp4"), args.seed)
+        rec = record_video(cont[0], "scripted", 1, str(out / f"{file_stem(cont[0])}.mp4"), args.seed)
         print(f"rollout video: {rec.path} ({rec.frames} frames, {rec.codec})")
     return 0
 
@@ -143,17 +204,17 @@ def _teacher(args) -> int:
 
 def _distill(args) -> int:
     from .agents.distillation import static_distillation
-    from .registration import resolve_task
+    from .task_registry import resolve_task
 
     if args.static:
-        spec = resolve_task(args.source)
+        spec = resolve_task(_task(args.source))
         table = static_distillation(spec.automaton, completion_reward=spec.completion_reward)
         automaton = spec.automaton
     else:
         from .agents.methods import distill_from_replay, load_agent
 
         source = Path(args.source)
-        env_id, env_kwargs = args.env_id or f"CraftSuite/{args.task}-Grid7-v0", {}
+        env_id, env_kwargs = args.env_id or _registered(args.task, "Grid7"), {}
         if source.is_dir():  # a teacher run directory: its config names the env, its checkpoint the replay
             from .training import TeacherConfig, checkpoint_dir
             from .runs import RunDir, load_config
@@ -218,7 +279,7 @@ def _transfer(args) -> int:
         raise KeyError(f"unknown suite {args.suite!r}; suites: {sorted(SUITES)}")
     suite = SUITES[args.suite]
     if args.tags is not None or args.tasks is not None:  # the rungs given replace the suite's
-        suite = dataclasses.replace(suite, tags=tuple(args.tags or ()), tasks=tuple(args.tasks or ()))
+        suite = dataclasses.replace(suite, tags=tuple(args.tags or ()), tasks=tuple(map(_task, args.tasks or ())))
     changes = {k: v for k, v in (("worlds", tuple(args.worlds) if args.worlds else None), ("seeds", args.seeds),
                                  ("student_steps", args.steps), ("methods", tuple(args.methods) if args.methods else None),
                                  ("teacher_max_steps", args.teacher_steps), ("eval_every", args.eval_every))
@@ -277,15 +338,40 @@ def _positive(text: str) -> int:
     return value
 
 
-def build_parser() -> argparse.ArgumentParser:
-    from .methods import METHODS
+class _CommandParser(argparse.ArgumentParser):
+    """A command's parser: defaults in its help, and ``--debug`` after the command too."""
 
-    parser = argparse.ArgumentParser(prog="craftsuite", description=__doc__)
-    sub = parser.add_subparsers(dest="command", required=True)
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **{"formatter_class": _HelpFormatter, **kwargs})
+        self.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=DEBUG_HELP)
+
+    def add_argument(self, *args, **kwargs):
+        if "help" not in kwargs and kwargs.get("default") is not None:  # (a help text of its own says more)
+            kwargs["help"] = "(default: %(default)s)"
+        return super().add_argument(*args, **kwargs)
+
+
+DEBUG_HELP = "on an error, show the full traceback instead of one line"
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from . import __version__
+    from .methods import METHODS
+    from .suites import SUITES
+    from .task_registry import SPEC_SUFFIX, ladder
+
+    parser = argparse.ArgumentParser(prog="craftsuite", description=__doc__, formatter_class=_HelpFormatter)
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    parser.add_argument("--debug", action="store_true", help=DEBUG_HELP)
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_CommandParser)
     methods = ", ".join(METHODS)
+    names = ", ".join(s.name for s in ladder())
+    task_help = f"a task: {names}; or a task spec file (path/to/task{SPEC_SUFFIX}), registered for this command"
+    worlds = ", ".join(_known_worlds())
 
     p = sub.add_parser("tasks", help="list the tasks (the ladder's rungs, easiest first), formulas, automata, ids")
-    p.add_argument("--tag", nargs="+", default=(), help="only the tasks with any of these tags (e.g. easy, paper)")
+    p.add_argument("--tag", nargs="+", default=(), help="only the tasks with any of these tags: "
+                   + ", ".join(sorted({t for spec in ladder() for t in spec.tags})))
     p.add_argument("--markdown", metavar="PATH", help="write the tasks page (specs, automata, scripted and random "
                    "references) to PATH instead, e.g. docs/tasks.md")
     p.add_argument("--episodes", type=_positive, default=100,
@@ -293,7 +379,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_tasks)
 
     p = sub.add_parser("automaton", help="draw or print a task's automaton")
-    p.add_argument("task", help="task name, e.g. BlindCraftsman")
+    p.add_argument("task", help=task_help)
     p.add_argument("--out", help="image file (.png, .svg, .pdf or .dot)")
     p.add_argument("--describe", action="store_true", help="print states and guarded transitions")
     p.add_argument("--show-sink", action="store_true", help="also draw the rejecting sink")
@@ -301,13 +387,13 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("demo", help="roll out the scripted policy on every id; write pictures")
     p.add_argument("--out", default="out/demo", help="output directory (default: out/demo)")
-    p.add_argument("--task", help="only this task (default: all)")
+    p.add_argument("--task", help=f"only this task (default: all): {task_help}")
     p.add_argument("--episodes", type=_positive, default=10, help="episodes per id (default: 10)")
     p.add_argument("--seed", type=int, default=0, help="first seed (default: 0)")
     p.set_defaults(run=_demo)
 
     p = sub.add_parser("teacher", help="train a grid DQN teacher until 90%% greedy success; distil it")
-    p.add_argument("task", help="task name, e.g. BlindCraftsman")
+    p.add_argument("task", help=task_help)
     p.add_argument("--out", default="runs/teachers", help="runs directory (default: runs/teachers)")
     p.add_argument("--size", type=int, default=7, help="grid size (default: 7)")
     p.add_argument("--layout-seed", type=int, default=0, help="the fixed grid instance (-1: a new one per episode)")
@@ -324,16 +410,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="the table to write (.npz)")
     p.add_argument("--static", action="store_true", help="value iteration over the automaton alone")
     p.add_argument("--replay", help="the teacher's replay buffer (.pkl), when SOURCE is a .zip")
-    p.add_argument("--task", default="BlindCraftsman", help="the teacher's task, when SOURCE is a .zip")
+    p.add_argument("--task", default="BlindCraftsman", help=f"the teacher's task, when SOURCE is a .zip: {task_help}")
     p.add_argument("--env-id", help="the teacher's env id (default: CraftSuite/<task>-Grid7-v0)")
     p.add_argument("--draw", help="also draw the values on the automaton (.png/.svg/.dot; unseen edges dotted)")
     p.set_defaults(run=_distill)
 
     p = sub.add_parser("student", help="train one student or baseline run (any method, one seed)")
-    p.add_argument("task", help="task name, e.g. BlindCraftsman")
+    p.add_argument("task", help=task_help)
     p.add_argument("--method", default="td3-dynamic", choices=list(METHODS), metavar="METHOD",
                    help=f"one of {methods} (craftsuite.methods.METHODS; default: td3-dynamic)")
-    p.add_argument("--world", default="Cont", help="Cont (MuJoCo, default), Grid10 or Grid7")
+    p.add_argument("--world", default="Cont", type=_world,
+                   help=f"Cont (MuJoCo) or Grid<size>, a world of the task; the known tasks': {worlds}")
     p.add_argument("--table", help="a teacher's table.npz (craftsuite teacher), for the methods that distil one: "
                    + ", ".join(m for m, row in METHODS.items() if row.needs_table))
     p.add_argument("--out", default="runs/students", help="runs directory (default: runs/students)")
@@ -351,11 +438,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_student)
 
     p = sub.add_parser("transfer", help="a suite end to end: teacher, distillation, students, leaderboard, video")
-    p.add_argument("--suite", default="quick", help="quick (default, ~10 min), standard (~3 h) or paper (a cluster)")
+    p.add_argument("--suite", default="quick", help="; ".join(f"{n}: {s.description}" for n, s in SUITES.items()))
     p.add_argument("--out", default="runs/quick", help="output directory (default: runs/quick)")
-    p.add_argument("--tags", nargs="+", help="override the suite's rungs: the tasks with any of these tags")
-    p.add_argument("--tasks", nargs="+", help="override the suite's rungs: these tasks (with --tags: and these)")
-    p.add_argument("--worlds", nargs="+", choices=("Cont", "Grid10", "Grid7"),
+    p.add_argument("--tags", nargs="+", help="override the suite's rungs: the tasks with any of these tags: "
+                   + ", ".join(sorted({t for spec in ladder() for t in spec.tags})))
+    p.add_argument("--tasks", nargs="+", help=f"override the suite's rungs: these tasks (with --tags: and these), "
+                   f"each {task_help}")
+    p.add_argument("--worlds", nargs="+", choices=_known_worlds(),
                    help="override the student worlds (Cont: TD3 methods; Grid10, Grid7: DQN methods)")
     p.add_argument("--methods", nargs="+", metavar="METHOD", help=f"override the suite's methods: any of {methods}")
     p.add_argument("--seeds", type=_positive, help="override the number of seeds")
@@ -401,13 +490,30 @@ def gym_error():
     return gym.error.Error
 
 
+def _check_task(args) -> None:
+    """A command's task (a name, or a spec file registered now) and its world, known good
+    before the command writes anything: ``args.task`` becomes the task's name."""
+    from .ids import grid_world
+
+    if getattr(args, "task", None) is None:
+        return
+    args.task = _task(args.task)
+    if getattr(args, "world", None) is not None:  # student
+        _registered(args.task, args.world)
+    elif args.command == "teacher":
+        _registered(args.task, grid_world(args.size))
+
+
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     try:
+        _check_task(args)
         return args.run(args)
     except BrokenPipeError:  # output piped into `head` and the like
         return 0
     except (KeyError, ValueError, TypeError, RuntimeError, FileNotFoundError, gym_error()) as err:
+        if args.debug:
+            raise
         print(f"craftsuite {args.command}: error: {err.args[0] if isinstance(err, KeyError) else err}",
               file=sys.stderr)
         return 2

@@ -17,7 +17,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-from .registration import WORLD_KINDS
+from .ids import WORLD_KINDS
 
 # the algorithm family of each world kind: DQN needs discrete moves, TD3 continuous thrust
 ALGORITHMS = MappingProxyType({"dqn": "Grid", "td3": "Cont"})
@@ -128,7 +128,7 @@ METHODS = MappingProxyType({m.name: m for m in (
 
 def methods_for(world: str) -> list[str]:
     """The methods that run in a student world (``Cont``, ``Grid10``, ...), in table order."""
-    from .registration import world_kind
+    from .ids import world_kind
 
     kind = world_kind(world)
     return [name for name, m in METHODS.items() if m.world == kind]

@@ -65,11 +65,12 @@ def reference(env_id: str, policy: str, episodes: int = 100, seed: int = 0) -> R
 
 def _ids_of(name: str) -> list[str]:
     """A task's ids: the grids by size, then the MuJoCo world."""
-    from .registration import parse_id, registered_ids
+    from .ids import CONT, grid_size, parse_id
+    from .registration import registered_ids
 
     def order(env_id):
         world = parse_id(env_id)[1]
-        return (world == "Cont", int(world[4:]) if world.startswith("Grid") else 0)
+        return (world == CONT, 0 if world == CONT else grid_size(world))
 
     return sorted((i for i in registered_ids() if parse_id(i)[0] == name), key=order)
 
@@ -78,7 +79,7 @@ def tasks_page(episodes: int = 100, progress: bool = True) -> str:
     """The tasks page in Markdown: the ladder's rungs, easiest first, with their references."""
     from tqdm import tqdm
 
-    from .registration import ladder
+    from .task_registry import ladder
 
     specs = ladder()
     ids = [(spec, env_id) for spec in specs for env_id in _ids_of(spec.name)]

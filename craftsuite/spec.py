@@ -224,6 +224,37 @@ class TaskSpec:
         their run key, so a run made under other rules is never reused."""
         return self._digest
 
+    def to_data(self) -> dict:
+        """The spec as the plain data of its TOML file (``extends`` resolved, every default
+        written out): ``load_spec(spec.to_data())`` rebuilds an equal spec (but for ``path``).
+        JSON-ready, so a spec travels in a gymnasium ``EnvSpec`` or to a worker process.
+        Proposition order is bit order: keep the tables' key order (JSON does)."""
+
+        def proposition(p: Proposition) -> dict:
+            return {p.kind: {p.subject: p.value} if p.kind in ("at_least", "reached") else p.subject}
+
+        def item(i: Item) -> dict:
+            out = {"count": i.count, "reward": i.reward, "requires": dict(i.requires), "excludes": list(i.excludes),
+                   "color": i.color, "symbol": i.symbol}
+            return out if i.capacity is None else {**out, "capacity": i.capacity}
+
+        def recipe(r: Recipe) -> dict:
+            out = {"consume": dict(r.consume), "produce": dict(r.produce), "repeat": r.repeat}
+            return out if r.at is None else {**out, "at": r.at}
+
+        return {
+            "name": self.name, "formula": self.formula, "description": self.description, "tags": list(self.tags),
+            "propositions": {p.name: proposition(p) for p in self.propositions},
+            "items": {i.name: item(i) for i in self.items},
+            "places": {p.name: {"count": p.count, "placement": p.placement, "color": p.color, "symbol": p.symbol}
+                       for p in self.places},
+            "recipes": [recipe(r) for r in self.recipes],
+            "rewards": {"step": self.step_reward, "completion": self.completion_reward},
+            "grid": {"sizes": list(self.grid.sizes), "max_steps": self.grid.max_steps,
+                     "obstacles": [list(c) for c in self.grid.obstacles]},
+            "continuous": {f.name: getattr(self.continuous, f.name) for f in fields(self.continuous)},
+        }
+
     @cached_property
     def _digest(self) -> str:  # a spec is frozen: its rules hash once
         import hashlib
@@ -351,27 +382,61 @@ def load_spec(source: str | Path | dict, *, name_hint: str = "<dict>") -> TaskSp
 
 
 def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
+    """A spec from its TOML data, one section at a time, in the order sections refer to
+    one another: objects, then the inventory they and the recipes make, then what refers
+    to inventory names (items' rules, recipes, propositions), then the formula and worlds."""
     r.keys(data, _TOP_KEYS, "top level")
     name = r.str(data, "name", "top level")
     if not _TASK_NAME.match(name):
         r.fail("name", f"must be CamelCase letters and digits (e.g. 'BlindCraftsman'), got {name!r}")
+    raw_items, raw_places = _object_tables(r, data)
+    raw_recipes, inventory = _inventory(r, data, raw_items)
+    looks = _Looks(r)
+    items = _items(r, raw_items, inventory, looks)
+    places = _places(r, raw_places, looks)
+    recipes = _recipes(r, raw_recipes, raw_places, inventory)
+    props = _propositions(r, data, raw_places, inventory)
+    formula = _formula(r, data, props)
+    rewards = r.table(data.get("rewards", {}), "rewards")
+    r.keys(rewards, {"step", "completion"}, "rewards")
+    n_objects = sum(i.count for i in items) + sum(p.count for p in places)
+    grid = _grid(r, data, n_objects, corner=any(p.placement == "corner" for p in places))
+    continuous = _continuous(r, data, n_objects)
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        r.fail("description", "must be a string")
+    tags = _tags(r, data)
+    return TaskSpec(
+        name=name, formula=formula, propositions=props, items=items, places=places, recipes=recipes,
+        step_reward=r.float(rewards, "step", "rewards", -0.1),
+        completion_reward=r.float(rewards, "completion", "rewards", 100.0),
+        grid=grid, continuous=continuous, description=description.strip(), tags=tags, path=path,
+    )
 
-    palette = iter(_PALETTE * 4)
-    symbols: dict[str, str] = {}
 
-    def looks(table: dict, where: str, obj_name: str) -> tuple[str, str]:
-        color = r.str(table, "color", where, default=next(palette))
+class _Looks:
+    """Colours and symbols of the objects: defaults from the palette and the name's first
+    letter, no symbol used twice (a grid's text view would confuse them)."""
+
+    def __init__(self, r: _Reader):
+        self.r, self.palette, self.symbols = r, iter(_PALETTE * 4), {}
+
+    def __call__(self, table: dict, where: str, obj_name: str) -> tuple[str, str]:
+        r = self.r
+        color = r.str(table, "color", where, default=next(self.palette))
         if not _COLOR.match(color):
             r.fail(f"{where}.color", f"must look like '#rrggbb', got {color!r}")
         symbol = r.str(table, "symbol", where, default=obj_name[0])
         if len(symbol) != 1 or symbol in ".#@":
             r.fail(f"{where}.symbol", f"must be one character other than '.', '#', '@', got {symbol!r}")
-        if symbol in symbols:
-            r.fail(f"{where}.symbol", f"{symbol!r} is already used by {symbols[symbol]!r}; set another")
-        symbols[symbol] = obj_name
+        if symbol in self.symbols:
+            r.fail(f"{where}.symbol", f"{symbol!r} is already used by {self.symbols[symbol]!r}; set another")
+        self.symbols[symbol] = obj_name
         return color, symbol
 
-    # Objects first (items, places), then inventory names, then what refers to them.
+
+def _object_tables(r: _Reader, data: dict) -> tuple[dict, dict]:
+    """The [items] and [places] tables, their names checked."""
     raw_items = r.table(data.get("items", {}), "items")
     raw_places = r.table(data.get("places", {}), "places")
     for obj in (*raw_items, *raw_places):
@@ -382,7 +447,11 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
         r.fail("places", f"{sorted(both)} declared both as item and place")
     if not raw_items and not raw_places:
         r.fail("items", "a task needs at least one item or place")
+    return raw_items, raw_places
 
+
+def _inventory(r: _Reader, data: dict, raw_items: dict) -> tuple[list, set[str]]:
+    """The [[recipes]] array and the inventory names: the items and all recipes produce."""
     raw_recipes = data.get("recipes", [])
     if not isinstance(raw_recipes, list):
         r.fail("recipes", "must be an array of tables ([[recipes]])")
@@ -393,8 +462,10 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
             if not _NAME.match(n):
                 r.fail(f"recipes[{i}].produce", f"{n!r} is not a lower-case identifier")
             produced.add(n)
-    inventory = set(raw_items) | produced
+    return raw_recipes, set(raw_items) | produced
 
+
+def _items(r: _Reader, raw_items: dict, inventory: set[str], looks: _Looks) -> tuple[Item, ...]:
     items = []
     for obj, table in raw_items.items():
         where = f"items.{obj}"
@@ -416,7 +487,10 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
             excludes=tuple(excludes),
             color=color, symbol=symbol,
         ))
+    return tuple(items)
 
+
+def _places(r: _Reader, raw_places: dict, looks: _Looks) -> tuple[Place, ...]:
     places = []
     for obj, table in raw_places.items():
         where = f"places.{obj}"
@@ -433,7 +507,10 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
     corners = [p.name for p in places if p.placement == "corner"]
     if len(corners) > 1:
         r.fail("places", f"only one place can take the corner, got {corners}")
+    return tuple(places)
 
+
+def _recipes(r: _Reader, raw_recipes: list, raw_places: dict, inventory: set[str]) -> tuple[Recipe, ...]:
     recipes = []
     for i, rec in enumerate(raw_recipes):
         where = f"recipes[{i}]"
@@ -451,12 +528,14 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
         if repeat and all(produce.get(n, 0) >= k for n, k in consume.items()):
             r.fail(f"{where}.repeat", "this recipe gives back all it consumes: repeating it would never stop")
         recipes.append(Recipe(consume=consume, produce=produce, at=at, repeat=repeat))
+    return tuple(recipes)
 
+
+def _propositions(r: _Reader, data: dict, raw_places: dict, inventory: set[str]) -> tuple[Proposition, ...]:
     if "propositions" not in data:
         r.fail("propositions", "is required")
-    raw_props = r.table(data["propositions"], "propositions")
     props = []
-    for prop, table in raw_props.items():
+    for prop, table in r.table(data["propositions"], "propositions").items():
         where = f"propositions.{prop}"
         if not _NAME.match(prop):
             r.fail(where, "proposition names must be lower-case identifiers (e.g. 'tools3', 'gold_1')")
@@ -480,7 +559,11 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
             props.append(Proposition(prop, kind, subject, value))
         else:
             r.fail(where, f"unknown kind {kind!r}; use 'obtained', 'arrived', 'at_least' or 'reached'")
+    return tuple(props)
 
+
+def _formula(r: _Reader, data: dict, props: tuple[Proposition, ...]) -> str:
+    """The LTLf formula, parsed, over declared propositions only."""
     formula = r.str(data, "formula", "top level")
     try:
         ast = parse(formula)
@@ -490,10 +573,11 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
     if unknown:
         r.fail("formula", f"uses unknown proposition(s) {sorted(unknown)}; declared in "
                           f"[propositions]: {[p.name for p in props]}")
+    return formula
 
-    rewards = r.table(data.get("rewards", {}), "rewards")
-    r.keys(rewards, {"step", "completion"}, "rewards")
 
+def _grid(r: _Reader, data: dict, n_objects: int, corner: bool) -> GridConfig:
+    """The [grid] section, checked against every size: obstacles inside, objects fit."""
     raw_grid = r.table(data.get("grid", {}), "grid")
     r.keys(raw_grid, {"sizes", "max_steps", "obstacles"}, "grid")
     sizes = raw_grid.get("sizes", [7, 10])
@@ -510,7 +594,6 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
         max_steps=r.int(raw_grid, "max_steps", "grid", default=500, minimum=1),
         obstacles=tuple(tuple(c) for c in obstacles),
     )
-    n_objects = sum(i.count for i in items) + sum(p.count for p in places)
     for size in grid.sizes:
         outside = [c for c in grid.obstacles if not (0 <= c[0] < size and 0 <= c[1] < size)]
         if outside:
@@ -519,9 +602,14 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
         if n_objects > free:
             r.fail("grid.sizes", f"{n_objects} objects do not fit a {size}x{size} grid "
                                  f"({free} free cells besides the agent)")
-        if corners and (0, 0) in set(grid.obstacles):
+        if corner and (0, 0) in set(grid.obstacles):
             r.fail("grid.obstacles", "the corner cell (0, 0) is taken by a 'corner' place")
+    return grid
 
+
+def _continuous(r: _Reader, data: dict, n_objects: int) -> ContinuousConfig:
+    """The [continuous] section: positive sizes, a whole number of physics steps per
+    decision, and room for every object's pickup zone."""
     raw_cont = r.table(data.get("continuous", {}), "continuous")
     r.keys(raw_cont, {"arena", "pickup_radius", "boundary_reward", "control_period", "max_steps"}, "continuous")
     default = ContinuousConfig()
@@ -545,22 +633,16 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
     if n_objects + 1 > per_side * per_side:
         r.fail("continuous", f"{n_objects} objects and the agent cannot get non-overlapping pickup "
                              f"zones in a {continuous.arena} arena (at most {per_side * per_side - 1})")
+    return continuous
 
-    description = data.get("description", "")
-    if not isinstance(description, str):
-        r.fail("description", "must be a string")
+
+def _tags(r: _Reader, data: dict) -> tuple[str, ...]:
     tags = data.get("tags", [])
     if not isinstance(tags, list) or any(not isinstance(t, str) or not _NAME.match(t) for t in tags):
         r.fail("tags", f"must be a list of lower-case identifiers, e.g. [\"easy\", \"paper\"], got {tags!r}")
     if len(set(tags)) != len(tags):
         r.fail("tags", f"lists a tag twice: {tags!r}")
-    return TaskSpec(
-        name=name, formula=formula, propositions=tuple(props), items=tuple(items),
-        places=tuple(places), recipes=tuple(recipes),
-        step_reward=r.float(rewards, "step", "rewards", -0.1),
-        completion_reward=r.float(rewards, "completion", "rewards", 100.0),
-        grid=grid, continuous=continuous, description=description.strip(), tags=tuple(tags), path=path,
-    )
+    return tuple(tags)
 
 
 def builtin_specs() -> dict[str, TaskSpec]:

@@ -25,11 +25,12 @@ from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .configs import StudentConfig, TeacherConfig
+from .ids import CONT, file_stem, world_kind
 from .methods import METHODS, check_methods, methods_for
-from .registration import ladder, resolve_task, world_kind
 from .runs import atomic_write
 from .spec import TaskSpec
-from .training import StudentConfig, TeacherConfig, train_student, train_teacher
+from .task_registry import carried, ladder, resolve_task
 
 
 @dataclass(frozen=True)
@@ -101,7 +102,7 @@ class Suite:
                 if not methods:
                     continue
                 steps = self.budget(spec, world)
-                cont = world_kind(world) == "Cont"
+                cont = world_kind(world) == CONT
                 for method in methods:
                     table = None
                     if METHODS[method].needs_table:
@@ -151,24 +152,37 @@ SUITES = {s.name: s for s in (
 )}
 
 
-def _student_job(config: dict, root: str) -> str:
-    """One student run in a worker process (one thread: the workers share the cores)."""
-    import torch
-
-    torch.set_num_threads(1)
-    import craftsuite  # noqa: F401  (registers the ids in this process)
+def _student_job(config: dict, root: str, task: str | dict | None = None) -> str:
+    """One student run in a worker process (one thread: the workers share the cores);
+    ``task``: its task as ``task_registry.carried`` gives it (a user task's data)."""
+    _start_worker(task)
+    from .training import train_student  # torch: only where runs train, not to list the suites
 
     return str(train_student(StudentConfig(**config), root, progress=False))
 
 
-def _teacher_job(config: dict, root: str) -> str:
+def _teacher_job(config: dict, root: str, task: str | dict | None = None) -> str:
     """One teacher run (training, then distillation) in a worker process."""
+    _start_worker(task)
+    from .training import train_teacher
+
+    return str(train_teacher(TeacherConfig(**config), root, progress=False))
+
+
+def _start_worker(task: str | dict | None) -> None:
+    """One torch thread; the ids registered in this process, with the run's task if it is a
+    user task (a spec file the driver read: a worker, or a Ray node, may not see the file)."""
     import torch
 
     torch.set_num_threads(1)
-    import craftsuite  # noqa: F401
+    import craftsuite  # (registers the built-in ids in this process)
 
-    return str(train_teacher(TeacherConfig(**config), root, progress=False))
+    if isinstance(task, dict):
+        craftsuite.register_task(task)
+
+
+def _carried(task: str) -> str | dict:
+    return carried(resolve_task(task))
 
 
 def _exit_with(driver: int, period: float = 0.5) -> None:
@@ -248,6 +262,9 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
               dynamic_ncols=True) as bar:
         runs = [(c, root / c.run_name()) for c in configs]  # named once: a name hashes the run's settings
 
+        def submit_student(c: StudentConfig) -> Future:
+            return workers_.submit(_student_job, dataclasses.asdict(c), str(root), _carried(c.task))
+
         def poll():
             done = 0
             for c, run in runs:
@@ -261,9 +278,9 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
             bar.update(done - bar.n)
 
         try:
-            pending = {workers_.submit(_teacher_job, dataclasses.asdict(t), str(teacher_root)): task
+            pending = {workers_.submit(_teacher_job, dataclasses.asdict(t), str(teacher_root), _carried(t.task)): task
                        for task, t in teachers.items()}
-            students = {c.run_name(): workers_.submit(_student_job, dataclasses.asdict(c), str(root)) for c in ready}
+            students = {c.run_name(): submit_student(c) for c in ready}
             while pending or not all(f.done() for f in students.values()):
                 time.sleep(0.5)
                 poll()
@@ -276,7 +293,7 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                         f"teacher {task}: {result['steps']:,} steps, greedy success {result['success']:.2f} "
                         f"({reached} {teachers[task].target_success:.0%}) -> {path}")
                     for c in waiting.pop(task):
-                        students[c.run_name()] = workers_.submit(_student_job, dataclasses.asdict(c), str(root))
+                        students[c.run_name()] = submit_student(c)
                 for future in students.values():
                     if future.done() and future.exception() is not None:
                         raise future.exception()  # a worker's error, at once rather than at the end
@@ -370,7 +387,7 @@ def _best_student_video(students: list[Path], out: Path) -> Path | None:
     if not runs:
         return None
     _, run, r = max(runs, key=lambda x: x[0])
-    name = f"best-{r['env_id'].split('/')[1]}-{r['method']}-s{r['seed']}.mp4"
+    name = f"best-{file_stem(r['env_id'])}-{r['method']}-s{r['seed']}.mp4"
     rec = record_video(r["env_id"], str(run / r["model"]), 1, str(out / name), seed=10**8,
                        product=r["product"], progress=False, env_kwargs=r.get("env_kwargs"))
     return Path(rec.path)

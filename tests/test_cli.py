@@ -63,3 +63,131 @@ def test_zero_episodes_is_a_clear_error(capsys):
     with pytest.raises(SystemExit):
         main(["demo", "--episodes", "0"])
     assert "must be at least 1" in capsys.readouterr().err
+
+
+SPEC = """
+name = "CliTreasure"
+formula = "F(coin)"
+
+[propositions]
+coin = { obtained = "coin" }
+
+[items.coin]
+count = 1
+
+[grid]
+sizes = [5]
+max_steps = 30
+"""
+
+
+@pytest.fixture
+def spec_file(tmp_path):
+    """A user spec file; the task it registers is forgotten after the test."""
+    import gymnasium as gym
+
+    from craftsuite import task_registry
+
+    path = tmp_path / "specs" / "cli_treasure.toml"
+    path.parent.mkdir()
+    path.write_text(SPEC)
+    yield path
+    for env_id in [i for i in gym.registry if i.startswith("CraftSuite/CliTreasure-")]:
+        del gym.registry[env_id]
+    task_registry.tasks().pop("CliTreasure", None)
+
+
+def test_version(capsys):
+    import craftsuite
+
+    with pytest.raises(SystemExit) as exit_:
+        main(["--version"])
+    assert exit_.value.code == 0 and capsys.readouterr().out.strip() == f"craftsuite {craftsuite.__version__}"
+
+
+def _helps():
+    from craftsuite.cli import build_parser
+
+    parser = build_parser()
+    [sub] = [a for a in parser._actions if a.choices and "student" in a.choices]
+    return parser, sub.choices
+
+
+def test_help_shows_every_default():
+    _, commands = _helps()
+    for name, command in commands.items():
+        formatter = command._get_formatter()
+        for action in command._actions:
+            if action.option_strings and action.default not in (None, False, (), "==SUPPRESS=="):
+                assert "default" in formatter._expand_help(action), (name, action.option_strings)
+    text = " ".join(commands["student"].format_help().split())
+    assert "--seed SEED (default: 0)" in text and "--eval-every EVAL_EVERY (default: 2000)" in text
+
+
+def test_help_lists_the_choices_of_the_registries():
+    from craftsuite import ids, task_registry
+    from craftsuite.methods import METHODS
+    from craftsuite.suites import SUITES
+
+    _, commands = _helps()
+    helps = {name: " ".join(command.format_help().split()) for name, command in commands.items()}
+    for name in ("automaton", "teacher", "student"):
+        assert all(task in helps[name] for task in task_registry.tasks()), name
+        assert ".toml" in helps[name]
+    assert all(method in helps["student"] for method in METHODS)
+    assert all(f"{suite}:" in helps["transfer"] for suite in SUITES)
+    sizes = {n for spec in task_registry.tasks().values() for n in spec.grid.sizes}
+    for world in [ids.CONT] + [ids.grid_world(n) for n in sizes]:
+        assert world in helps["student"] and world in helps["transfer"]
+
+
+def test_debug_shows_the_traceback(capsys):
+    assert main(["automaton", "Nope"]) == 2
+    assert "Traceback" not in capsys.readouterr().err
+    for argv in (["--debug", "automaton", "Nope"], ["automaton", "Nope", "--debug"]):
+        with pytest.raises(KeyError, match="unknown task 'Nope'"):
+            main(argv)
+
+
+@pytest.mark.parametrize("command", [["student", "Nope"], ["teacher", "Nope"], ["demo", "--task", "Nope"],
+                                     ["student", "Reach", "--world", "Grid5"], ["teacher", "Reach", "--size", "5"]])
+def test_a_bad_task_or_world_is_named_and_nothing_is_written(tmp_path, capsys, command):
+    out = tmp_path / "runs"
+    assert main([*command, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err and "doesn't exist" not in err
+    assert ("unknown task 'Nope'; known tasks: [" in err and "'Reach'" in err) or \
+        "task 'Reach' has no Grid5 world; its worlds: ['Cont', 'Grid10', 'Grid7']" in err
+    assert not out.exists()
+
+
+def test_a_missing_or_bad_spec_file_is_named_and_nothing_is_written(tmp_path, capsys):
+    out = tmp_path / "runs"
+    assert main(["teacher", str(tmp_path / "missing.toml"), "--out", str(out)]) == 2
+    assert "missing.toml: no such task spec file" in capsys.readouterr().err
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "Bad"\nformula = "F(x)"\n[propositions]\nx = { obtained = "gold" }\n[items.coin]\ncount = 1\n')
+    assert main(["student", str(bad), "--out", str(out)]) == 2
+    assert "bad.toml: propositions.x.obtained: unknown inventory name 'gold'" in capsys.readouterr().err
+    assert not out.exists() and not list(tmp_path.glob("teacher-*"))
+
+
+def test_a_spec_file_stands_for_its_task(spec_file, capsys):
+    assert main(["automaton", str(spec_file), "--describe"]) == 0
+    assert "coin" in capsys.readouterr().out
+    assert main(["tasks"]) == 0
+    assert "CraftSuite/CliTreasure-Grid5-v0" in capsys.readouterr().out
+
+
+def test_teacher_and_student_train_on_a_spec_file(spec_file, tmp_path, capsys):
+    import json
+
+    runs = tmp_path / "runs"
+    tiny = ["--eval-every", "100", "--eval-episodes", "1", "--hyper", '{"learning_starts": 50, "buffer_size": 500}']
+    assert main(["teacher", str(spec_file), "--size", "5", "--max-steps", "100", "--out", str(runs), *tiny]) == 0
+    assert main(["student", str(spec_file), "--method", "dqn", "--world", "Grid5", "--steps", "100",
+                 "--out", str(runs), *tiny]) == 0
+    made = sorted(p.name for p in runs.iterdir())
+    assert [n.rsplit("-", 1)[0] for n in made] == ["student-CliTreasure-Grid5-dqn-s0", "teacher-CliTreasure-Grid5-s0"]
+    for run in runs.iterdir():
+        assert json.loads((run / "result.json").read_text())["env_id"] == "CraftSuite/CliTreasure-Grid5-v0"

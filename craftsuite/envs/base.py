@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import gymnasium as gym
 
-from ..registration import resolve_task
+from ..task_registry import resolve_task
 from ..rules import Rules
 from ..spec import TaskSpec
 from ..tracking import ObjectiveTracker

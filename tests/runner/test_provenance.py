@@ -83,7 +83,7 @@ def craftsuite_task_digest(task: str) -> str:
 def test_a_change_of_a_default_or_of_the_rules_gives_a_new_run_key(monkeypatch):
     import dataclasses
 
-    from craftsuite import methods, registration
+    from craftsuite import methods, task_registry
     from craftsuite.training import StudentConfig, TeacherConfig
 
     student, teacher = StudentConfig(method="td3"), TeacherConfig()
@@ -95,16 +95,16 @@ def test_a_change_of_a_default_or_of_the_rules_gives_a_new_run_key(monkeypatch):
     monkeypatch.undo()
     assert (student.run_name(), teacher.run_name()) == keys
     # the task's rules: a longer episode is another benchmark; a new description is not
-    spec = registration.resolve_task("BlindCraftsman")
-    known = dict(registration.tasks())
-    monkeypatch.setattr(registration, "tasks", lambda: {**known, "BlindCraftsman": dataclasses.replace(
+    spec = task_registry.resolve_task("BlindCraftsman")
+    known = dict(task_registry.tasks())
+    monkeypatch.setattr(task_registry, "tasks", lambda: {**known, "BlindCraftsman": dataclasses.replace(
         spec, continuous=dataclasses.replace(spec.continuous, max_steps=300))})
     assert student.run_name() != keys[0]
-    monkeypatch.setattr(registration, "tasks", lambda: {**known, "BlindCraftsman": dataclasses.replace(
+    monkeypatch.setattr(task_registry, "tasks", lambda: {**known, "BlindCraftsman": dataclasses.replace(
         spec, description="reworded")})
     assert student.run_name() == keys[0]
     wood = dataclasses.replace(spec.items[0], color="#000000", symbol="W")  # another look, the same rules
-    monkeypatch.setattr(registration, "tasks", lambda: {**known, "BlindCraftsman": dataclasses.replace(
+    monkeypatch.setattr(task_registry, "tasks", lambda: {**known, "BlindCraftsman": dataclasses.replace(
         spec, items=(wood, *spec.items[1:]))})
     assert student.run_name() == keys[0]
 

@@ -1,0 +1,107 @@
+"""The configurations of teacher and student runs, as dataclasses: what the command line
+fills in, what a run directory records (``config.json``) and hashes into its run key.
+
+Kept apart from ``training`` (which imports torch and stable-baselines3) so that building,
+reading or listing configs stays cheap, e.g. in the suites' driver process and the
+leaderboard.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import ids
+from .envs.grid import layout_kwargs
+from .methods import METHODS, algorithm_settings, check_methods
+from .runs import config_key
+from .task_registry import resolve_task
+
+
+@dataclass(frozen=True)
+class TeacherConfig:
+    task: str = "BlindCraftsman"
+    size: int = 7
+    layout_seed: int | None = 0  # one fixed grid instance, as in the paper (None: a new one per episode)
+    seed: int = 0
+    max_steps: int = 300_000
+    target_success: float = 0.9
+    eval_every: int = 5_000
+    eval_episodes: int = 50
+    hyperparameters: dict = field(default_factory=dict)  # overrides of DQN_DEFAULTS
+
+    @property
+    def env_id(self) -> str:
+        return ids.grid_id(self.task, self.size)
+
+    @property
+    def env_kwargs(self) -> dict:
+        return layout_kwargs(self.layout_seed)
+
+    def effective(self) -> dict:
+        """The settings the teacher trains with beyond its fields: DQN's defaults merged with
+        ``hyperparameters``, its method's row and its world (recorded and hashed)."""
+        return _effective("product-dqn", self.hyperparameters, self.env_id, self.env_kwargs, self.task)
+
+    def run_name(self) -> str:
+        return f"teacher-{self.task}-{ids.grid_world(self.size)}-s{self.seed}-{config_key(self)}"
+
+
+@dataclass(frozen=True)
+class StudentConfig:
+    task: str = "BlindCraftsman"
+    method: str = "td3-dynamic"
+    world: str = "Cont"  # "Cont" (MuJoCo) or "Grid10" / "Grid7"
+    seed: int = 0
+    steps: int = 20_000  # the budget in transitions (env steps over all n_envs envs)
+    table: str | None = None  # a teacher's table.npz (the methods that distil one: Method.needs_table)
+    eval_every: int = 2_000
+    eval_episodes: int = 10
+    hyperparameters: dict = field(default_factory=dict)
+    layout_seed: int | None = None  # grid worlds: one fixed instance (None: a new one per episode)
+    # more gymnasium.make keywords for the student's world, e.g. {"frame_skip": 2, "max_episode_steps": 1000}
+    world_kwargs: dict = field(default_factory=dict, metadata={"omit_if_default": True})
+    # envs stepped side by side: each agent step collects n_envs transitions, then takes
+    # the algorithm's gradient_steps updates (the authors' students used 10)
+    n_envs: int = field(default=1, metadata={"omit_if_default": True})
+
+    def __post_init__(self):
+        if not isinstance(self.n_envs, int) or isinstance(self.n_envs, bool) or self.n_envs < 1:
+            raise ValueError(f"n_envs must be a positive integer, got {self.n_envs!r}")
+        ids.world_kind(self.world)  # a ValueError naming the worlds there are
+        if layout_kwargs(self.layout_seed) and ids.world_kind(self.world) != "Grid":  # also checks the seed
+            raise ValueError(f"layout_seed fixes a grid instance; the {self.world} world has none "
+                             "(its objects are placed anew every episode)")
+        if not isinstance(self.world_kwargs, dict):
+            raise ValueError(f"world_kwargs must be a dict of gymnasium.make keywords, got {self.world_kwargs!r}")
+        owned = sorted({"product", "layout_seed"} & set(self.world_kwargs))
+        if owned:
+            raise ValueError(f"world_kwargs may not set {owned}: the method sets product, layout_seed its own field")
+
+    @property
+    def env_id(self) -> str:
+        return ids.env_id(self.task, self.world)
+
+    @property
+    def env_kwargs(self) -> dict:
+        return {**layout_kwargs(self.layout_seed), **self.world_kwargs}
+
+    def effective(self) -> dict:
+        """The settings the student trains with beyond its fields: its algorithm's defaults
+        merged with ``hyperparameters`` (the replay buffer no larger than the budget), its
+        method's row and its world (recorded and hashed)."""
+        out = _effective(self.method, {"buffer_size": min(self.steps, 1_000_000), **self.hyperparameters},
+                         self.env_id, self.env_kwargs, self.task)
+        if self.table is not None:  # the teacher, by its run's name (its settings' hash), not by where it lies
+            out["teacher"] = f"{Path(self.table).parent.name}/{Path(self.table).name}"
+        return out
+
+    def run_name(self) -> str:
+        return f"student-{self.task}-{self.world}-{self.method}-s{self.seed}-{config_key(self)}"
+
+
+def _effective(method: str, hyperparameters: dict, env_id: str, env_kwargs: dict, task: str) -> dict:
+    check_methods([method])
+    row = METHODS[method]
+    return {"method": row.settings(), "hyperparameters": algorithm_settings(row.algorithm, hyperparameters),
+            "world": {"id": env_id, "kwargs": env_kwargs, "rules": resolve_task(task).digest()}}

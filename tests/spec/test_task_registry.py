@@ -1,0 +1,126 @@
+"""The task registry: apart from gymnasium's registration, and user tasks that travel as data."""
+
+from __future__ import annotations
+
+import ast
+import dataclasses
+import json
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.envs.registration import EnvSpec
+
+import craftsuite
+from craftsuite import task_registry
+from craftsuite.spec import SpecError, builtin_specs, load_spec
+
+from .test_load import GOOD, write
+
+
+def _imports(module: str) -> set[str]:
+    """The modules a craftsuite module imports, relative imports resolved within the package."""
+    tree = ast.parse((Path(craftsuite.__file__).parent / f"{module.replace('.', '/')}.py").read_text())
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            base = f"craftsuite.{module}".rsplit(".", node.level)[0] if node.level else ""
+            name = ".".join(p for p in (base, node.module) if p)
+            out |= {name} | {f"{name}.{a.name}" for a in node.names}
+    return out
+
+
+@pytest.mark.parametrize("module", ["task_registry", "ids", "spec", "envs.base"])
+def test_no_import_circle_between_tasks_registration_and_worlds(module):
+    imported = _imports(module)
+    assert not {i for i in imported if i.startswith(("craftsuite.registration", "gymnasium.envs.registration"))}
+    if module != "envs.base":  # the worlds import the registry, never the other way round
+        assert not {i for i in imported if i.startswith(("craftsuite.envs", "gymnasium"))}
+
+
+def test_registration_re_exports_the_registry():
+    from craftsuite import registration
+
+    assert registration.tasks is task_registry.tasks and registration.resolve_task is task_registry.resolve_task
+    assert craftsuite.tasks is task_registry.tasks
+    assert set(task_registry.builtin_names()) == set(builtin_specs()) <= set(task_registry.tasks())
+
+
+@pytest.mark.parametrize("name", sorted(builtin_specs()))
+def test_a_spec_as_data_rebuilds_itself(name):
+    spec = task_registry.tasks()[name]
+    data = json.loads(json.dumps(spec.to_data()))
+    again = load_spec(data)
+    assert again == dataclasses.replace(spec, path=None) and again.digest() == spec.digest()
+    assert again.proposition_names == spec.proposition_names  # bit order kept
+    assert task_registry.resolve_task(data) is spec  # the registered spec, not a copy
+    assert task_registry.carried(spec) == name
+
+
+def test_unknown_task_names_the_known_ones():
+    with pytest.raises(KeyError, match="unknown task 'Nope'; known tasks: .*'Reach'.*spec file"):
+        task_registry.resolve_task("Nope")
+
+
+def test_bad_data_is_a_spec_error():
+    with pytest.raises(SpecError, match="given as data.*formula"):
+        task_registry.resolve_task({"name": "Bad", "formula": "F(x)", "propositions": {}, "items": {"x": {"count": 1}}})
+
+
+@pytest.fixture
+def user_task(tmp_path):
+    """A user task registered for one test, then forgotten (ids and registry)."""
+    text = GOOD.replace('name = "Treasure"', 'name = "TreasureAsData"')
+    ids = craftsuite.register_task(write(tmp_path, text))
+    yield ids
+    for env_id in ids:
+        del gym.registry[env_id]
+    del task_registry.tasks()["TreasureAsData"]
+
+
+def test_user_task_ids_carry_the_spec_as_data(user_task):
+    spec = task_registry.tasks()["TreasureAsData"]
+    for env_id in user_task:
+        carried = gym.spec(env_id).kwargs["task"]
+        assert carried == spec.to_data() and load_spec(carried).digest() == spec.digest()
+
+
+def test_user_task_specs_round_trip_through_json(user_task):
+    for env_id in user_task:
+        text = gym.spec(env_id).to_json()
+        back = EnvSpec.from_json(text)
+        assert back.to_json() == text and back.max_episode_steps == gym.spec(env_id).max_episode_steps
+        env, reference = gym.make(back, product=True), gym.make(env_id, product=True)
+        obs, _ = env.reset(seed=3)
+        assert np.array_equal(obs, reference.reset(seed=3)[0])
+        assert env.unwrapped.task.digest() == task_registry.tasks()["TreasureAsData"].digest()
+        env.close(), reference.close()
+
+
+def test_a_json_spec_builds_its_world_where_the_task_was_never_registered(user_task):
+    import subprocess
+    import sys
+
+    code = ("import sys, gymnasium as gym, craftsuite; from gymnasium.envs.registration import EnvSpec; "
+            "assert 'TreasureAsData' not in craftsuite.tasks(); "
+            "env = gym.make(EnvSpec.from_json(sys.stdin.read())); env.reset(seed=0); "
+            "print(env.unwrapped.automaton.propositions)")
+    out = subprocess.run([sys.executable, "-c", code], input=gym.spec(user_task[0]).to_json(), text=True,
+                         capture_output=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "('coin', 'trap')"
+
+
+def test_subprocess_vector_env_of_a_user_task(user_task):
+    # spawned workers start afresh: they know the task only from the id's carried data
+    envs = gym.make_vec(user_task[0], num_envs=2, vectorization_mode="async", vector_kwargs={"context": "spawn"})
+    try:
+        obs, _ = envs.reset(seed=0)
+        assert obs.shape[0] == 2
+        obs, reward, term, trunc, info = envs.step(envs.action_space.sample())
+        assert reward.shape == (2,)
+    finally:
+        envs.close()

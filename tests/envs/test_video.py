@@ -81,3 +81,36 @@ def test_bad_input_is_named_and_nothing_is_written(tmp_path):
         with pytest.raises(ValueError, match="frame size 10x8 differs from the video's 8x8"):
             video.write(ramp(8, 10, 0))
     assert read_video(tmp_path / "clip.mp4")[0]["size"] == (8, 8)
+
+
+def test_videos_for_people_carry_the_status_panel(tmp_path, capsys):
+    """The video command and the transfer runner's best-student video ask the world for the
+    status panel, which frames leave out by default."""
+    import json
+
+    import gymnasium as gym
+
+    from craftsuite.agents.methods import make_agent
+    from craftsuite.cli import main
+    from craftsuite.suites import _best_student_video
+
+    env_id = "CraftSuite/DungeonQuest-Grid7-v0"
+    plain = gym.make(env_id).unwrapped.frame_shape
+    shown = gym.make(env_id, status_panel=True).unwrapped.frame_shape
+    assert shown[0] > plain[0]
+    assert main(["video", env_id, "--out", str(tmp_path / "command.mp4")]) == 0
+    assert read_video(tmp_path / "command.mp4")[0]["size"] == (shown[1], shown[0])
+    assert main(["video", env_id, "--out", str(tmp_path / "bare.mp4"), "--env", '{"status_panel": false}']) == 0
+    assert read_video(tmp_path / "bare.mp4")[0]["size"] == (plain[1], plain[0])  # --env still decides
+
+    run = tmp_path / "students" / "run"
+    run.mkdir(parents=True)
+    agent = make_agent("product-dqn", env_id, learning_starts=10, buffer_size=100)
+    agent.learn(20)
+    agent.save(run / "model.zip")
+    (run / "result.json").write_text(json.dumps({
+        "task": "DungeonQuest", "env_id": env_id, "method": "product-dqn", "seed": 0,
+        "model": "model.zip", "product": True, "env_kwargs": {}}))
+    (run / "evals.csv").write_text("step,success,return\n20,0.0,-5.0\n")
+    movie = _best_student_video([run], tmp_path)
+    assert read_video(movie)[0]["size"] == (shown[1], shown[0])

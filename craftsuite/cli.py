@@ -168,8 +168,9 @@ def _video(args) -> int:
     from . import registration  # noqa: F401  (registers the ids)
     from .rollouts import record_video
 
+    # a video is for people: show the inventory and automaton state unless --env says otherwise
     rec = record_video(args.env_id, args.policy, args.episodes, args.out, args.seed, args.fps, args.product,
-                       env_kwargs=_json_object(args.env, "--env"))
+                       env_kwargs={"status_panel": True, **_json_object(args.env, "--env")})
     print(f"wrote {rec.path}: {rec.frames} frames at {rec.fps} fps ({rec.codec}); "
           f"{rec.successes}/{rec.episodes} episodes completed the objective")
     return 0

@@ -18,13 +18,16 @@ from .task_registry import add_task, carried, ladder, resolve_task, tasks  # noq
 
 
 def make_grid(task: str | TaskSpec, size: int, product: bool = False,
-              render_mode: str | None = None, layout_seed: int | None = None) -> gym.Env:
+              render_mode: str | None = None, layout_seed: int | None = None,
+              status_panel: bool = False) -> gym.Env:
     """Entry point of the grid ids; ``product=True`` adds the automaton one-hot,
-    ``layout_seed`` fixes the objects' layout across episodes."""
+    ``layout_seed`` fixes the objects' layout across episodes, ``status_panel=True`` draws
+    the inventory and automaton state under each frame (for videos)."""
     from .envs.grid import GridWorldEnv
     from .wrappers import AutomatonObservation
 
-    env = GridWorldEnv(task, size, render_mode=render_mode, layout_seed=layout_seed)
+    env = GridWorldEnv(task, size, render_mode=render_mode, layout_seed=layout_seed,
+                       status_panel=status_panel)
     return AutomatonObservation(env) if product else env
 
 
@@ -37,15 +40,16 @@ def cont_id(task: str) -> str:
 
 def make_continuous(task: str | TaskSpec, product: bool = False, render_mode: str | None = None,
                     width: int = 240, height: int = 240, frame_skip: int | None = None,
-                    offsets: str | None = None) -> gym.Env:
+                    status_panel: bool = False) -> gym.Env:
     """Entry point of the MuJoCo ids; ``product=True`` adds the automaton one-hot,
     ``frame_skip`` sets the physics steps per action (None: the world's default),
-    ``offsets`` how object offsets are scaled (None: the world's default; see ``ContinuousWorldEnv``)."""
+    ``width`` x ``height`` the frame, ``status_panel=True`` draws the inventory and
+    automaton state under each frame (for videos)."""
     from .envs.continuous import ContinuousWorldEnv
     from .wrappers import AutomatonObservation
 
-    world = {k: v for k, v in {"frame_skip": frame_skip, "offsets": offsets}.items() if v is not None}
-    env = ContinuousWorldEnv(task, render_mode=render_mode, width=width, height=height, **world)
+    env = ContinuousWorldEnv(task, render_mode=render_mode, width=width, height=height,
+                             frame_skip=frame_skip, status_panel=status_panel)
     return AutomatonObservation(env) if product else env
 
 

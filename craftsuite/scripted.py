@@ -13,8 +13,8 @@ from collections import deque
 
 import numpy as np
 
+from .envs.cells import MOVES, WALL
 from .labelling import Labeller
-from .rendering.grid import WALL
 from .rules import Rules
 from .spec import TaskSpec
 
@@ -104,9 +104,6 @@ class GridScriptedPolicy:
         return int(env.np_random.integers(4)) if step is None else step
 
 
-_STEPS = ((0, 0, -1), (1, 1, 0), (2, 0, 1), (3, -1, 0))  # action, dx, dy
-
-
 def _bfs_first_step(size, cells, start, goals, blocked) -> int | None:
     """First action of a shortest path from ``start`` to any goal cell, or None."""
     if not goals:
@@ -116,7 +113,7 @@ def _bfs_first_step(size, cells, start, goals, blocked) -> int | None:
     while queue:
         cell = queue.popleft()
         y, x = divmod(cell, size)
-        for action, dx, dy in _STEPS:
+        for action, (dx, dy) in MOVES.items():
             nx, ny = x + dx, y + dy
             if not (0 <= nx < size and 0 <= ny < size):
                 continue

@@ -389,5 +389,6 @@ def _best_student_video(students: list[Path], out: Path) -> Path | None:
     _, run, r = max(runs, key=lambda x: x[0])
     name = f"best-{file_stem(r['env_id'])}-{r['method']}-s{r['seed']}.mp4"
     rec = record_video(r["env_id"], str(run / r["model"]), 1, str(out / name), seed=10**8,
-                       product=r["product"], progress=False, env_kwargs=r.get("env_kwargs"))
+                       product=r["product"], progress=False,
+                       env_kwargs={"status_panel": True, **(r.get("env_kwargs") or {})})  # for people
     return Path(rec.path)

@@ -15,13 +15,18 @@ class CraftWorld(gym.Env):
     touching objects goes through ``self.rules``, labels through ``self.labeller`` and the
     objective through ``self.tracker``."""
 
-    def __init__(self, task: str | TaskSpec, render_mode: str | None):
+    def __init__(self, task: str | TaskSpec, render_mode: str | None, status_panel: bool = False):
+        if not isinstance(status_panel, bool):
+            raise ValueError(f"status_panel must be True or False, got {status_panel!r}")
         self.task = resolve_task(task)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode {render_mode!r} is not supported; use one of {self.metadata['render_modes']}"
             )
         self.render_mode = render_mode
+        # the inventory and automaton state drawn under each frame: for people, never for
+        # agents that learn from pixels, hence off unless asked for
+        self.status_panel = status_panel
         self.rules = Rules(self.task)
         self.tracker = ObjectiveTracker(self.task)
         self.automaton = self.tracker.automaton

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import numbers
+
 import gymnasium as gym
 import mujoco
 import numpy as np
 
 from ..rendering.gl import gl_error_hint
-from ..rendering.panel import status_panel
+from ..rendering.panel import PANEL_HEIGHT, add_status_panel
 from ..spec import TaskSpec
 from .base import CraftWorld
 from .scene import AGENT_HALF, build_scene
@@ -15,7 +17,17 @@ from .scene import AGENT_HALF, build_scene
 TOP_SPEED = 2.0  # m/s at full thrust (gear 10 / damping 5 in assets/arena.xml)
 _PLACEMENT_TRIES = 200
 _FAR = 1e6  # where consumed objects are parked: never within reach
-OFFSETS = ("linear", "sqrt")  # how object offsets are scaled into the observation
+# Largest frame side: MuJoCo's off-screen framebuffer is grown to the frame asked for, and
+# software GL (OSMesa) renders 8192 x 8192 but cannot allocate a 16384-pixel framebuffer.
+MAX_FRAME_SIDE = 8192
+
+
+def frame_side(name: str, value) -> int:
+    """``value`` if it is a whole number of pixels in [1, MAX_FRAME_SIDE]; else a ValueError
+    naming the argument (checked before any OpenGL work, whose errors would not say so)."""
+    if not isinstance(value, numbers.Integral) or isinstance(value, bool) or not 1 <= value <= MAX_FRAME_SIDE:
+        raise ValueError(f"{name} must be a whole number of pixels in [1, {MAX_FRAME_SIDE}], got {value!r}")
+    return int(value)
 
 
 class ContinuousWorldEnv(CraftWorld):
@@ -45,9 +57,7 @@ class ContinuousWorldEnv(CraftWorld):
     fixed count) its position relative to the agent divided by the arena side and a
     present flag (0 once consumed, its position then 0); inventory counts divided by their
     largest possible value. ``observation_layout`` gives the slices. With ``product=True``
-    the automaton state's one-hot follows. ``offsets="sqrt"`` takes the signed square root
-    of each scaled offset instead, so the pickup radius reads 0.24 rather than 0.06 (an
-    experiment: it did not raise TD3's greedy success, docs/benchmarks.md).
+    the automaton state's one-hot follows.
 
     ## Rewards
     The spec's step reward (-0.1), item rewards on pickup, the completion reward (+100) on
@@ -62,6 +72,15 @@ class ContinuousWorldEnv(CraftWorld):
     Terminated on acceptance (``is_success``) or on reaching the rejecting sink
     (``violation``); truncated at ``continuous.max_steps`` decisions (200) by TimeLimit.
 
+    ## Rendering
+    ``rgb_array``: the top camera's view of the arena, ``(height, width, 3)`` uint8
+    (``gymnasium.make`` keywords ``width`` and ``height``, 240 by default, each a whole
+    number of pixels up to ``MAX_FRAME_SIDE``; ``frame_shape`` says it). With
+    ``status_panel=True`` (for videos people watch) a 40-row strip with the inventory and
+    the automaton state is added below, ``(height + 40, width, 3)``; it is off by default
+    because a frame showing the automaton state would hand it to an agent that learns from
+    pixels.
+
     ## Registered Configurations
     ``CraftSuite/<Task>-Cont-v0`` for every task spec in ``tasks/``, the rungs of the
     ladder and the paper's tasks (``craftsuite tasks`` lists them).
@@ -70,17 +89,14 @@ class ContinuousWorldEnv(CraftWorld):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 4}  # at the default 0.25 s; __init__ sets 1 / period
 
     def __init__(self, task: str | TaskSpec = "BlindCraftsman", render_mode: str | None = None,
-                 width: int = 240, height: int = 240, frame_skip: int | None = None, offsets: str = "linear"):
+                 width: int = 240, height: int = 240, frame_skip: int | None = None,
+                 status_panel: bool = False):
         if frame_skip is not None and (not isinstance(frame_skip, int) or isinstance(frame_skip, bool)
                                        or frame_skip < 1):
             raise ValueError(f"frame_skip must be a positive integer (physics steps per action), got {frame_skip!r}")
-        if offsets not in OFFSETS:
-            raise ValueError(f"offsets must be one of {OFFSETS}, got {offsets!r}")
-        super().__init__(task, render_mode)
-        self.offsets = offsets
-        self._sqrt_offsets = offsets == "sqrt"
+        self.width, self.height = frame_side("width", width), frame_side("height", height)
+        super().__init__(task, render_mode, status_panel)
         spec = self.task
-        self.width, self.height = width, height
         cfg = spec.continuous
         self.arena = cfg.arena
         self.half = cfg.arena / 2
@@ -91,10 +107,14 @@ class ContinuousWorldEnv(CraftWorld):
         self.frame_skip = frame_skip = frame_skip or self._spec_frame_skip()
         self.dt = self.model.opt.timestep * frame_skip  # the control period
         self.metadata = {**self.metadata, "render_fps": round(1 / self.dt)}
+        # arena.xml's off-screen framebuffer (640 x 640) would refuse larger frames
+        offscreen = self.model.vis.global_
+        offscreen.offwidth = max(offscreen.offwidth, self.width)
+        offscreen.offheight = max(offscreen.offheight, self.height)
         # An orthographic fovy is the vertical extent in metres; widen it for tall frames so
         # the whole arena stays in view across the narrower side.
         top = self.model.camera("top").id
-        self.model.cam_fovy[top] *= max(1.0, height / width)
+        self.model.cam_fovy[top] *= max(1.0, self.height / self.width)
         self._view_height = float(self.model.cam_fovy[top])
         self._body_ids = np.array([self.model.body(n).id for n in scene.object_bodies])
         self._geom_ids = np.array([self.model.geom(n).id for n in scene.object_bodies])
@@ -251,8 +271,6 @@ class ContinuousWorldEnv(CraftWorld):
         # consumed objects sit far away with scale 0: their offsets read 0
         view = self._obs_objects[:, :2]
         np.multiply(offsets, self._offset_scale, out=view)
-        if self._sqrt_offsets:
-            np.copysign(np.sqrt(np.abs(view)), view, out=view)
 
     def step(self, action):
         try:
@@ -330,6 +348,11 @@ class ContinuousWorldEnv(CraftWorld):
         self.model.body_pos[self._body_ids[i], 2] = -1.0
 
     # -- rendering -----------------------------------------------------------------------------------
+    @property
+    def frame_shape(self) -> tuple[int, int, int]:
+        """Shape of an ``rgb_array`` frame: ``(rows, columns, 3)``."""
+        return (self.height + (PANEL_HEIGHT if self.status_panel else 0), self.width, 3)
+
     def world_to_pixel(self, x: float, y: float) -> tuple[int, int]:
         """(column, row) of an arena point in the camera image (top-down, orthographic)."""
         tall = self._view_height
@@ -351,9 +374,7 @@ class ContinuousWorldEnv(CraftWorld):
                 raise RuntimeError(gl_error_hint(err)) from err
         self._renderer.update_scene(self.data, camera="top")
         frame = self._renderer.render()
-        panel = status_panel(self.width, self.inventory, self.automaton_state, self.automaton.n_states,
-                             self.tracker.flag)
-        return np.concatenate([frame, panel], axis=0)
+        return add_status_panel(frame, self) if self.status_panel else frame
 
     def close(self):
         if self._renderer is not None:

@@ -5,13 +5,11 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 
-from ..rendering.grid import EMPTY, WALL, draw_grid, grid_text
+from ..rendering.grid import TILE, draw_grid, grid_text
+from ..rendering.panel import PANEL_HEIGHT, add_status_panel
 from ..spec import TaskSpec
 from .base import CraftWorld
-
-# action -> (dx, dy); y grows downwards (row 0 is the top row)
-_MOVES = {0: (0, -1), 1: (1, 0), 2: (0, 1), 3: (-1, 0)}
-ACTION_NAMES = ("up", "right", "down", "left")
+from .cells import ACTION_NAMES, EMPTY, MOVES, WALL
 
 
 def layout_kwargs(layout_seed: int | None) -> dict:
@@ -67,6 +65,15 @@ class GridWorldEnv(CraftWorld):
     ``automaton.propositions[i]``), ``automaton_state`` (after the step),
     ``automaton_transition`` ``(w, sigma, w')``, ``is_success``, ``violation``.
 
+    ## Rendering
+    ``rgb_array``: the grid alone, ``(32*size, 32*size, 3)`` uint8 (32-pixel tiles;
+    ``frame_shape`` says it). With ``status_panel=True`` (``gymnasium.make`` keyword, for
+    videos people watch) a 40-row strip with the inventory and the automaton state is added
+    below, ``(32*size + 40, 32*size, 3)``; it is off by default because a frame showing the
+    automaton state would hand it to an agent that learns from pixels. ``ansi``: one line
+    of text per grid row, plus a line with the inventory and automaton state when
+    ``status_panel=True``.
+
     ## Registered Configurations
     ``CraftSuite/<Task>-Grid<size>-v0`` for every spec in ``tasks/`` and each of its grid
     sizes: BlindCraftsman, DungeonQuest, DiamondMine (7 and 10), BlindCraftsmanObstacles
@@ -76,8 +83,9 @@ class GridWorldEnv(CraftWorld):
     metadata = {"render_modes": ["rgb_array", "ansi"], "render_fps": 8}
 
     def __init__(self, task: str | TaskSpec = "BlindCraftsman", size: int = 7,
-                 render_mode: str | None = None, layout_seed: int | None = None):
-        super().__init__(task, render_mode)
+                 render_mode: str | None = None, layout_seed: int | None = None,
+                 status_panel: bool = False):
+        super().__init__(task, render_mode, status_panel)
         layout_kwargs(layout_seed)  # validates
         self.layout_seed = layout_seed
         if not isinstance(size, int) or size < 2:
@@ -116,6 +124,12 @@ class GridWorldEnv(CraftWorld):
             "inventory_names": self.rules.inventory_names,
             "inventory_scale": tuple(self._inv_scale),
         }
+
+    @property
+    def frame_shape(self) -> tuple[int, int, int]:
+        """Shape of an ``rgb_array`` frame: ``(rows, columns, 3)``."""
+        side = self.size * TILE
+        return (side + (PANEL_HEIGHT if self.status_panel else 0), side, 3)
 
     @property
     def agent_position(self) -> tuple[int, int]:
@@ -181,12 +195,12 @@ class GridWorldEnv(CraftWorld):
 
     def step(self, action):
         try:
-            dx, dy = _MOVES[action]
+            dx, dy = MOVES[action]
         except (KeyError, TypeError):
             # a 0-d integer array (what SB3's predict returns) is a valid Discrete action
             if isinstance(action, np.ndarray) and action.shape == () and action.dtype.kind in "iu" \
-                    and int(action) in _MOVES:
-                dx, dy = _MOVES[int(action)]
+                    and int(action) in MOVES:
+                dx, dy = MOVES[int(action)]
             else:
                 raise ValueError(
                     f"invalid action {action!r} for {self.task.name}: expected an integer in [0, 4) "
@@ -238,9 +252,9 @@ class GridWorldEnv(CraftWorld):
             raise RuntimeError("call reset() before render()")
         if self.render_mode == "ansi":
             text = grid_text(self.size, self._cells, self._agent, self._objects)
+            if not self.status_panel:
+                return f"{text}\n"
             held = ", ".join(f"{k} {v}" for k, v in self.inventory.items() if v) or "nothing"
             return f"{text}\ninventory: {held}; automaton state {self.automaton_state}\n"
-        panel = {"inventory": self.inventory, "automaton_state": self.automaton_state,
-                 "n_states": self.automaton.n_states, "flag": self.tracker.flag}
-        return draw_grid(self.size, self._cells, self._agent, self._objects,
-                         self.rules.is_place, panel)
+        frame = draw_grid(self.size, self._cells, self._agent, self._objects, self.rules.is_place)
+        return add_status_panel(frame, self) if self.status_panel else frame

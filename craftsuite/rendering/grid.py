@@ -1,14 +1,18 @@
-"""Drawing a grid world: RGB frames and ANSI text."""
+"""Drawing a grid world: RGB frames and ANSI text.
+
+The cell codes (``EMPTY``, ``WALL``) belong to the world (``craftsuite.envs.cells``); they
+are imported here, and stay importable from here for older code.
+"""
 
 from __future__ import annotations
 
 import cv2
 import numpy as np
 
-from .panel import hex_to_rgb, status_panel
+from ..envs.cells import EMPTY, WALL
+from .panel import hex_to_rgb
 
-TILE = 32
-EMPTY, WALL = -1, -2
+TILE = 32  # pixels per cell side: a grid of size n draws as an (n*TILE, n*TILE, 3) frame
 _FONT = cv2.FONT_HERSHEY_SIMPLEX
 
 
@@ -16,15 +20,15 @@ def _text_color(rgb) -> tuple[int, int, int]:
     return (0, 0, 0) if sum(rgb) > 380 else (255, 255, 255)
 
 
-def draw_grid(size: int, cells: list[int], agent: int, objects, is_place, panel: dict) -> np.ndarray:
-    """RGB frame: tiles, objects (items as discs, places as squares), the agent, a status strip.
+def draw_grid(size: int, cells: list[int], agent: int, objects, is_place) -> np.ndarray:
+    """RGB frame of the grid alone, ``(size*TILE, size*TILE, 3)``: tiles, objects (items as
+    discs, places as squares) and the agent.
 
     Args:
         cells: kind per cell (row-major), EMPTY or WALL.
         agent: the agent's cell.
         objects: spec objects by kind (colour and symbol).
         is_place: kind -> bool.
-        panel: keyword arguments of ``status_panel`` other than width.
     """
     px = size * TILE
     img = np.full((px, px, 3), 235, dtype=np.uint8)
@@ -50,7 +54,7 @@ def draw_grid(size: int, cells: list[int], agent: int, objects, is_place, panel:
     x0, y0 = x * TILE, y * TILE
     cv2.rectangle(img, (x0 + 7, y0 + 7), (x0 + TILE - 8, y0 + TILE - 8), (20, 20, 20), -1)
     cv2.rectangle(img, (x0 + 7, y0 + 7), (x0 + TILE - 8, y0 + TILE - 8), (255, 255, 255), 2)
-    return np.concatenate([img, status_panel(px, **panel)], axis=0)
+    return img
 
 
 def grid_text(size: int, cells: list[int], agent: int, objects) -> str:

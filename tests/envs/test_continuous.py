@@ -2,18 +2,21 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 
-import cv2
 import gymnasium as gym
 import numpy as np
 import pytest
 
 import craftsuite
 from craftsuite.cli import main as cli
-from craftsuite.envs.continuous import TOP_SPEED, ContinuousWorldEnv
+from craftsuite.envs import continuous
+from craftsuite.envs.continuous import MAX_FRAME_SIDE, TOP_SPEED, ContinuousWorldEnv
 from craftsuite.scripted import ContinuousScriptedPolicy, run_episode
+
+from .test_video import read_video
 
 CONT = [i for i in craftsuite.registered_ids() if "-Cont-" in i]
 
@@ -149,23 +152,22 @@ def _rewrite(path, old, new):
     return path
 
 
-def test_sqrt_offsets_keep_sign_and_order_and_read_zero_once_consumed():
-    linear = gym.make("CraftSuite/BlindCraftsman-Cont-v0").unwrapped
-    rooted = gym.make("CraftSuite/BlindCraftsman-Cont-v0", offsets="sqrt").unwrapped
-    (a, _), (b, _) = linear.reset(seed=3), rooted.reset(seed=3)
-    objects = linear.observation_layout["objects"]
-    lin, root = a[objects].reshape(-1, 3)[:, :2], b[objects].reshape(-1, 3)[:, :2]
-    np.testing.assert_allclose(root, np.sign(lin) * np.sqrt(np.abs(lin)), atol=1e-6)
-    np.testing.assert_array_equal(a[:4], b[:4])  # the agent's own state is not rescaled
-    # the pickup radius reads sqrt(0.4 / 7) = 0.24 rather than 0.06
-    place_agent(rooted, rooted._positions[0] + np.array([-0.4, 0.0]))
-    rooted._write_observation(rooted._positions - rooted.data.qpos[:2])
-    assert rooted._obs_objects[0, 0] == pytest.approx(np.sqrt(0.4 / rooted.arena), rel=1e-5)
-    rooted._remove(0)
-    rooted._write_observation(rooted._positions - rooted.data.qpos[:2])
-    assert rooted._obs_objects[0].tolist() == [0.0, 0.0, 0.0]
-    with pytest.raises(ValueError, match="offsets must be one of"):
-        ContinuousWorldEnv(offsets="log")
+def test_object_offsets_are_divided_by_the_arena_side():
+    env = make()
+    obs, _ = env.reset(seed=3)
+    slots = obs[env.observation_layout["objects"]].reshape(-1, 3)
+    expected = (env._positions - env.data.qpos[:2]) / env.arena
+    np.testing.assert_allclose(slots[:, :2], expected, atol=1e-6)
+    assert np.abs(slots[:, :2]).max() < 1
+
+
+def test_the_offsets_keyword_is_gone():
+    """The square-root offsets experiment did not help students; the world has one scaling."""
+    with pytest.raises(TypeError, match="unexpected keyword argument 'offsets'"):
+        gym.make("CraftSuite/BlindCraftsman-Cont-v0", offsets="sqrt")
+    with pytest.raises(TypeError, match="offsets"):
+        ContinuousWorldEnv(offsets="linear")
+    assert not hasattr(continuous, "OFFSETS")
 
 
 def test_boundary_push_costs_and_walls_hold():
@@ -242,7 +244,7 @@ def test_frame_shows_the_agent_where_it_is(gl_available):
     env = make(render_mode="rgb_array")
     env.reset(seed=0)
     frame = env.render()
-    assert frame.shape == (280, 240, 3) and frame.std() > 10
+    assert frame.shape == env.frame_shape == (240, 240, 3) and frame.std() > 10
     col, row = env.world_to_pixel(*env.data.qpos[:2])
     patch = frame[row - 2:row + 3, col - 2:col + 3].astype(int)
     assert patch.max() < 60  # the agent is a near-black cube
@@ -259,9 +261,10 @@ def test_world_to_pixel_any_frame_shape(gl_available, width, height):
     env.reset(seed=0)
     env._positions[:] = 1e6
     place_agent(env, np.array([-1.0, -1.0]))
-    elsewhere = env.render()[:height].max(axis=2)
+    elsewhere = env.render().max(axis=2)
     place_agent(env, np.array([1.0, 1.0]))
-    here = env.render()[:height].max(axis=2)
+    here = env.render().max(axis=2)
+    assert here.shape == (height, width)
     agent = np.argwhere((here < 40) & (elsewhere > 100))  # pixels the agent moved onto
     row, col = agent.mean(axis=0)
     assert np.allclose((col, row), env.world_to_pixel(1.0, 1.0), atol=3)
@@ -269,6 +272,57 @@ def test_world_to_pixel_any_frame_shape(gl_available, width, height):
         c, r = env.world_to_pixel(*corner)
         assert 0 <= c < width and 0 <= r < height
     env.close()
+
+
+@pytest.mark.parametrize("name", ["width", "height"])
+@pytest.mark.parametrize("value", [0, -240, 2.5, 240.0, True, "240", None, MAX_FRAME_SIDE + 1])
+def test_frame_sides_are_checked_at_construction(name, value, monkeypatch):
+    def no_gl(*args, **kwargs):
+        raise AssertionError("a bad frame size reached OpenGL")
+
+    monkeypatch.setattr(continuous.mujoco, "Renderer", no_gl)
+    for build in (lambda: gym.make("CraftSuite/BlindCraftsman-Cont-v0", render_mode="rgb_array", **{name: value}),
+                  lambda: ContinuousWorldEnv(**{name: value})):
+        with pytest.raises(ValueError, match=rf"^{name} must be a whole number of pixels in \[1, {MAX_FRAME_SIDE}\], "
+                                             rf"got {re.escape(repr(value))}$"):
+            build()
+
+
+def test_numpy_integer_frame_sides_are_accepted():
+    env = make(width=np.int64(320), height=np.uint16(200))
+    assert env.frame_shape == (200, 320, 3) and type(env.width) is int and type(env.height) is int
+
+
+def test_frames_larger_than_the_models_framebuffer_render(gl_available):
+    if not gl_available:
+        pytest.skip(gl_available.reason)
+    offscreen = make().model.vis.global_  # arena.xml's off-screen buffer
+    width = offscreen.offwidth + 160
+    env = make(render_mode="rgb_array", width=width, height=offscreen.offheight + 2)
+    env.reset(seed=0)
+    assert env.render().shape == env.frame_shape == (offscreen.offheight + 2, width, 3)
+    env.close()
+
+
+def test_status_panel_is_drawn_only_when_asked(gl_available):
+    if not gl_available:
+        pytest.skip(gl_available.reason)
+    from craftsuite.rendering.panel import PANEL_HEIGHT
+
+    plain = make(render_mode="rgb_array", width=200, height=160)
+    shown = make(render_mode="rgb_array", width=200, height=160, status_panel=True)
+    plain.reset(seed=4)
+    shown.reset(seed=4)
+    world, framed = plain.render(), shown.render()
+    assert world.shape == plain.frame_shape == (160, 200, 3)
+    assert framed.shape == shown.frame_shape == (160 + PANEL_HEIGHT, 200, 3)
+    np.testing.assert_array_equal(framed[:160], world)  # the same world, the strip under it
+    strip = framed[160:]
+    assert (strip < 128).any() and strip.mean() > 200  # dark text on a light strip
+    with pytest.raises(ValueError, match="status_panel must be True or False, got 'yes'"):
+        make(status_panel="yes")
+    plain.close()
+    shown.close()
 
 
 def test_renderer_closes_cleanly_at_exit(gl_available):
@@ -288,15 +342,15 @@ def test_video_command_writes_a_readable_mp4(tmp_path, env_id, gl_available, cap
         pytest.skip(gl_available.reason)
     out = tmp_path / "rollout.mp4"
     assert cli(["video", env_id, "--policy", "scripted", "--episodes", "2", "--out", str(out)]) == 0
-    env = gym.make(env_id)
+    env = gym.make(env_id, status_panel=True)  # videos are for people: the command draws the panel
     policy = craftsuite.scripted.scripted_policy(env)
     expected = sum(run_episode(env, policy, seed=s)[1] + 1 for s in range(2))  # + reset frames
-    video = cv2.VideoCapture(str(out))
-    frames = 0
-    while video.read()[0]:
-        frames += 1
-    assert frames == expected
-    assert f"{expected} frames" in capsys.readouterr().out
+    meta, frames = read_video(out)
+    assert meta["codec"] == "h264" and meta["pix_fmt"].startswith("yuv420p")
+    rows, columns, _ = env.unwrapped.frame_shape
+    assert meta["size"] == (columns, rows) and len(frames) == expected
+    printed = capsys.readouterr().out
+    assert f"{expected} frames" in printed and "(h264)" in printed
 
 
 def test_video_rejects_a_corrupt_checkpoint(tmp_path, capsys):

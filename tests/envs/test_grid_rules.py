@@ -219,3 +219,63 @@ def test_layout_seed_fixes_the_instance_not_the_start():
     assert repr(other.unwrapped.object_positions()) not in layouts
     with pytest.raises(ValueError, match="layout_seed"):
         gym.make("CraftSuite/DiamondMine-Grid7-v0", layout_seed=-1)
+
+
+def test_moves_are_what_the_action_names_say():
+    """One table of moves (``envs.cells.MOVES``) drives the world and the scripted policy."""
+    from craftsuite.envs.cells import ACTION_NAMES, EMPTY, MOVES, WALL
+    from craftsuite.scripted import _bfs_first_step
+
+    assert set(MOVES) == set(range(len(ACTION_NAMES)))
+    named = {"up": (0, -1), "right": (1, 0), "down": (0, 1), "left": (-1, 0)}  # y grows downwards
+    env = craftsuite.make_grid("BlindCraftsman", 7)
+    u = env.unwrapped
+    for action, name in enumerate(ACTION_NAMES):
+        env.reset(seed=0)
+        u._cells = [EMPTY] * 49  # nothing to touch
+        u._agent = 3 * 7 + 3
+        env.step(action)
+        dx, dy = named[name]
+        assert MOVES[action] == named[name] and u.agent_position == (3 + dx, 3 + dy)
+        # the scripted policy's search takes the same action towards that cell
+        goal = (3 + dy) * 7 + (3 + dx)
+        assert _bfs_first_step(7, [EMPTY] * 49, 3 * 7 + 3, {goal}, lambda k: k == WALL) == action
+    env.reset(seed=0)
+    u._cells = [EMPTY] * 49
+    u._cells[3 * 7 + 4] = WALL
+    u._agent = 3 * 7 + 3
+    env.step(ACTION_NAMES.index("right"))
+    assert u.agent_position == (3, 3)  # walls hold
+
+
+def test_cell_codes_belong_to_the_world_and_drawing_imports_them(tmp_path):
+    import subprocess
+    import sys
+
+    from craftsuite.envs import cells
+    from craftsuite.rendering import grid as drawing
+
+    assert (drawing.EMPTY, drawing.WALL) == (cells.EMPTY, cells.WALL)  # older imports keep working
+    assert cells.EMPTY < 0 and cells.WALL < 0 and cells.EMPTY != cells.WALL  # never an object kind
+    # either side may be imported first in a fresh interpreter
+    for first in ("craftsuite.rendering.grid", "craftsuite.envs.cells", "craftsuite.scripted"):
+        out = subprocess.run([sys.executable, "-c", f"import {first}; import craftsuite.envs.grid"],
+                             capture_output=True, text=True, cwd=tmp_path)
+        assert out.returncode == 0, (first, out.stderr)
+
+
+def test_grid_frame_is_the_grid_alone_unless_the_panel_is_asked_for():
+    from craftsuite.envs.cells import WALL
+    from craftsuite.rendering.grid import TILE
+
+    plain = craftsuite.make_grid("BlindCraftsmanObstacles", 10, render_mode="rgb_array")
+    shown = craftsuite.make_grid("BlindCraftsmanObstacles", 10, render_mode="rgb_array", status_panel=True)
+    plain.reset(seed=1)
+    shown.reset(seed=1)
+    frame = plain.render()
+    assert frame.shape == plain.frame_shape == (10 * TILE, 10 * TILE, 3)
+    assert shown.render().shape == (10 * TILE + 40, 10 * TILE, 3)
+    wall = plain._cells.index(WALL)
+    y, x = divmod(wall, 10)
+    tile = frame[y * TILE + 4:(y + 1) * TILE - 4, x * TILE + 4:(x + 1) * TILE - 4]
+    assert (tile == tile[0, 0]).all() and tile[0, 0].tolist() == [60, 90, 150]  # a wall drawn as one

@@ -12,6 +12,7 @@ from gymnasium.utils.env_checker import check_env as gym_check_env
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import craftsuite
+from craftsuite.rendering.panel import PANEL_HEIGHT
 
 IDS = craftsuite.registered_ids()
 
@@ -87,16 +88,29 @@ def test_render_modes(env_id, gl_available):
     env = gym.make(env_id, render_mode="rgb_array")
     env.reset(seed=0)
     frame = env.render()
-    assert frame.dtype == np.uint8 and frame.ndim == 3 and frame.shape[2] == 3
+    assert frame.dtype == np.uint8 and frame.shape == env.unwrapped.frame_shape
     assert len(np.unique(frame.reshape(-1, 3), axis=0)) > 5  # not blank
-    env.close()
+    # by default the frame is the world alone: what the env documents, nothing of the automaton
     if "ansi" in env.metadata["render_modes"]:
         size = env.unwrapped.size
-        assert frame.shape[1] == size * 32
-        text = gym.make(env_id, render_mode="ansi")
-        text.reset(seed=0)
-        out = text.render()
-        assert out.count("@") == 1 and len(out.splitlines()) == size + 1
+        assert frame.shape == (size * 32, size * 32, 3)
+    else:
+        u = env.unwrapped
+        assert frame.shape == (u.height, u.width, 3) == (240, 240, 3)
+    env.close()
+    shown = gym.make(env_id, render_mode="rgb_array", status_panel=True)
+    shown.reset(seed=0)
+    framed = shown.render()
+    assert framed.shape == shown.unwrapped.frame_shape == (frame.shape[0] + PANEL_HEIGHT,) + frame.shape[1:]
+    np.testing.assert_array_equal(framed[:frame.shape[0]], frame)
+    shown.close()
+    if "ansi" in env.metadata["render_modes"]:
+        for status_panel, lines in ((False, size), (True, size + 1)):
+            text = gym.make(env_id, render_mode="ansi", status_panel=status_panel)
+            text.reset(seed=0)
+            out = text.render()
+            assert out.count("@") == 1 and len(out.splitlines()) == lines
+            assert ("automaton state" in out) == status_panel
 
 
 @pytest.mark.parametrize("env_id", IDS)

@@ -18,8 +18,8 @@ A run directory holds
   purged, as from the CSV logs);
 * ``result.json``: written last; its presence means the run is finished and reusable.
 
-Every whole-file write goes through a temporary file and ``os.replace``, so a killed run
-never leaves a half-written file. An advisory lock (``flock`` on ``.lock``, which names its
+Every whole-file write goes through ``craftsuite.files`` (a temporary file, then
+``os.replace``), so a killed run never leaves a half-written file. An advisory lock (``flock`` on ``.lock``, which names its
 holder) keeps two live runs out of one directory; the kernel drops it when its holder
 dies, so a killed run can be started again at once (it resumes).
 """
@@ -35,27 +35,14 @@ import os
 import socket
 from pathlib import Path
 
+from .files import atomic_write  # also importable from here, where it lived before craftsuite.files
+
 EPISODE_FIELDS = ("step", "return", "length", "success")
 EVAL_FIELDS = ("step", "success", "return", "episodes", "length")  # length: absent from runs before 0.2
 
 
 class RunError(RuntimeError):
     """A run directory that cannot be used (locked by a live run, or holding another config)."""
-
-
-def atomic_write(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` so that readers see the old file or the new one, never half."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        with open(tmp, "w") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
 
 
 # config.json's layout: 1 (before 0.2: the dataclass fields alone) or 2 (with ``effective``

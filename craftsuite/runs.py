@@ -12,11 +12,15 @@ A run directory holds
 * ``episodes.csv``: one row per finished training episode (step, return, length, success);
 * ``evals.csv``: one row per evaluation (step, success rate, mean return, episodes, mean
   episode length);
-* ``checkpoint/``: the last model and replay buffer, written together at each evaluation
-  (a student's is removed when it finishes: its final model is ``model.zip``);
+* ``checkpoint/``: the last model and replay buffer, written together at each evaluation,
+  and ``checkpoint-old/``, the one before, kept until the next is complete so that a
+  damaged newest checkpoint can be resumed from the one before (``training._resume``);
+  a student's are removed when it finishes (its final model is ``model.zip``), a
+  teacher's older one;
 * ``tb/``: TensorBoard logs (on resume, what the killed run logged after its checkpoint is
   purged, as from the CSV logs);
-* ``result.json``: written last; its presence means the run is finished and reusable.
+* ``result.json``: written last; its presence means the run is finished and reusable. It
+  names the agent's ``algorithm`` (as the saved model does, for ``load_agent``).
 
 Every whole-file write goes through ``craftsuite.files`` (a temporary file, then
 ``os.replace``), so a killed run never leaves a half-written file. An advisory lock (``flock`` on ``.lock``, which names its

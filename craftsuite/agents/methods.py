@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import gymnasium as gym
 from stable_baselines3.common.env_util import make_vec_env
-from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv
+from stable_baselines3.common.vec_env import VecEnv
 
 from ..methods import (  # noqa: F401  (METHODS and the defaults re-exported)
     ALGORITHMS, DQN_DEFAULTS, METHODS, TD3_DEFAULTS, Method, algorithm_settings, check_methods)
@@ -57,9 +57,9 @@ def make_agent(method: str, env, *, table: AutomatonQTable | None = None, seed: 
     else:
         if env_kwargs:
             raise ValueError("env_kwargs make an env from an id; this env is made already")
-        env = _suited(method, m, env)
-    n_envs = env.num_envs
-    base = env.get_attr("unwrapped", [0])[0]
+        _check_suited(method, m, env)  # a gymnasium env stays one: SB3 wraps it (Monitor, DummyVecEnv)
+    n_envs = env.num_envs if isinstance(env, VecEnv) else 1
+    base = _unwrapped(env)
     automaton = base.automaton
     if isinstance(kwargs.get("action_noise"), dict):
         kwargs["action_noise"] = make_action_noise(kwargs["action_noise"], env.action_space.shape[0], seed, n_envs)
@@ -78,19 +78,22 @@ def make_agent(method: str, env, *, table: AutomatonQTable | None = None, seed: 
     return CLASSES[m.algorithm]("MlpPolicy", env, seed=seed, verbose=verbose, **kwargs)
 
 
-def _suited(name: str, method: Method, env) -> VecEnv:
-    """``env`` (a gymnasium env or a VecEnv) as a VecEnv, once it is known to be a CraftSuite
-    world of the method's kind, with the automaton state in its observation exactly when the
-    method is a product method."""
-    if not isinstance(env, VecEnv):
-        if not isinstance(env, gym.Env):
-            raise TypeError(f"make_agent takes a CraftSuite id, a gymnasium env or a VecEnv, not {env!r}")
-        env = DummyVecEnv([lambda e=env: e])
-    base = env.get_attr("unwrapped", [0])[0]
+def _unwrapped(env):
+    """The world under a gymnasium env or under a VecEnv's first env."""
+    return env.get_attr("unwrapped", [0])[0] if isinstance(env, VecEnv) else env.unwrapped
+
+
+def _check_suited(name: str, method: Method, env) -> None:
+    """Raise unless ``env`` (a gymnasium env or a VecEnv) is a CraftSuite world of the
+    method's kind, with the automaton state in its observation exactly when the method is a
+    product method."""
+    if not isinstance(env, (VecEnv, gym.Env)):
+        raise TypeError(f"make_agent takes a CraftSuite id, a gymnasium env or a VecEnv, not {env!r}")
+    base = _unwrapped(env)
     if not isinstance(base, CraftWorld):
         raise ValueError(f"method {name!r} needs a CraftSuite world, not {type(base).__name__}")
     kind = "Grid" if isinstance(base, GridWorldEnv) else "Cont"  # the world kinds: WORLD_KINDS
-    spec = env.get_attr("spec", [0])[0]
+    spec = env.get_attr("spec", [0])[0] if isinstance(env, VecEnv) else env.spec
     where = spec.id if spec is not None else f"this {type(base).__name__}"
     if kind != method.world:
         raise ValueError(f"method {name!r} is for {method.world} worlds, not {where}")
@@ -98,7 +101,6 @@ def _suited(name: str, method: Method, env) -> VecEnv:
     if product != method.product:
         raise ValueError(f"method {name!r} {'needs' if method.product else 'must not see'} the automaton state in "
                          f"its observation: make {where} with product={method.product}")
-    return env
 
 
 def distill_from_replay(teacher: AutomatonDQN, chunk: int = 4096) -> AutomatonQTable:

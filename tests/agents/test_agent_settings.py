@@ -10,6 +10,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from stable_baselines3.common.env_util import make_vec_env
+from stable_baselines3.common.monitor import Monitor
 
 import craftsuite  # noqa: F401  (registers the ids)
 from craftsuite.agents import AutomatonQTable, DistillationError
@@ -33,7 +34,7 @@ def test_make_agent_takes_a_vec_env_or_a_gym_env():
     agent.learn(60)
     assert agent.num_timesteps == 60
     single = make_agent("dqn", gym.make(GRID), **SMALL_DQN)
-    assert single.n_envs == 1
+    assert single.n_envs == 1 and isinstance(single.get_env().envs[0], Monitor)  # episodes are logged
     single.learn(30)
     assert single.replay_buffer.pos == 30
 

@@ -190,13 +190,20 @@ def _json_object(text: str | None, flag: str = "--hyper") -> dict:
     return value
 
 
+def _hyper(text: str | None, algorithm: str) -> dict:
+    """``--hyper``'s JSON, checked by name and type against ``algorithm``'s settings before anything runs."""
+    from .methods import check_hyperparameters
+
+    return check_hyperparameters(algorithm, _json_object(text), source="--hyper")
+
+
 def _teacher(args) -> int:
     from .training import TeacherConfig, train_teacher
 
     config = TeacherConfig(task=args.task, size=args.size, layout_seed=None if args.layout_seed < 0 else args.layout_seed,
                            seed=args.seed, max_steps=args.max_steps, target_success=args.target_success,
                            eval_every=args.eval_every, eval_episodes=args.eval_episodes,
-                           hyperparameters=_json_object(args.hyper))
+                           hyperparameters=_hyper(args.hyper, "dqn"))
     path = train_teacher(config, args.out)
     print((path / "result.json").read_text().strip())
     print(f"teacher run: {path}\n  teacher: {path / 'teacher.zip'}\n  dynamic table: {path / 'table.npz'}")
@@ -259,7 +266,7 @@ def _student(args) -> int:
 
     config = StudentConfig(task=args.task, method=args.method, world=args.world, seed=args.seed, steps=args.steps,
                            table=str(Path(args.table).resolve()) if args.table else None, eval_every=args.eval_every,
-                           eval_episodes=args.eval_episodes, hyperparameters=_json_object(args.hyper),
+                           eval_episodes=args.eval_episodes, hyperparameters=_hyper(args.hyper, METHODS[args.method].algorithm),
                            layout_seed=args.layout_seed, world_kwargs=_json_object(args.env, "--env"),
                            n_envs=args.n_envs)
     if METHODS[args.method].needs_table and not args.table:

@@ -40,7 +40,8 @@ from pathlib import Path
 import numpy as np
 
 from . import stats
-from .runs import RunError, atomic_write, flatten, read_config, read_csv, run_settings
+from .files import atomic_path, atomic_write
+from .runs import RunError, flatten, read_config, read_csv, run_settings
 
 # metrics with a mean and an interval per task and method; a rate lies in [0, 1]
 METRICS = {"success": (0.0, 1.0), "return": (-math.inf, math.inf), "train_success": (0.0, 1.0),
@@ -562,9 +563,8 @@ def plot_curves(students_root, out, board: Board | None = None) -> list[Path]:
         if any(p.stem == name for p in paths):  # two settings that read alike once in a file name
             name += "-" + hashlib.sha256(world.encode()).hexdigest()[:6]
         path = Path(out) / f"{name}.png"
-        tmp = path.with_name(f".{path.name}.tmp.png")
-        fig.savefig(tmp, dpi=110)
-        tmp.replace(path)
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110)
         paths.append(path)
     return paths
 
@@ -613,8 +613,7 @@ def plot_profiles(board, out, aggs: list[Aggregate] | None = None) -> list[Profi
         fig.tight_layout()
         path = Path(out) / f"profile-{_file_part(agg.world)}.png"
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.name}.tmp.png")
-        fig.savefig(tmp, dpi=110)
-        tmp.replace(path)
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110)
         out_paths.append(Profile(agg.world, path))
     return out_paths

@@ -42,14 +42,100 @@ TD3_DEFAULTS = dict(learning_rate=1e-4, buffer_size=1_000_000, batch_size=64, le
                     policy_kwargs=dict(net_arch=[400, 300]))
 
 
+
+
+class OneOf(tuple):
+    """Examples of the forms a setting takes, e.g. ``train_freq``: 4 or [4, "step"]."""
+
+
+# The settings a run may also override, beyond its algorithm's defaults above, each with
+# an example (the library's default) whose type a value must have: SB3's keywords of DQN
+# and TD3 that are plain data, and CraftSuite's own (agents/dqn.py, agents/td3.py).
+# With the defaults, these are every name ``check_hyperparameters`` accepts.
+_OFF_POLICY = dict(tau=1.0, train_freq=OneOf((1, [1, "step"])), gradient_steps=1, n_steps=1,
+                   optimize_memory_usage=False, replay_buffer_kwargs={}, stats_window_size=100, device="auto",
+                   prioritized=True)
+DQN_MORE = MappingProxyType(dict(_OFF_POLICY, max_grad_norm=10.0, double=True, dueling=True))
+TD3_MORE = MappingProxyType(dict(_OFF_POLICY, tau=0.005, policy_delay=2,
+                                 delay_schedule=[[20_000, 4], [None, 2]]))
+
+
+class HyperparameterError(ValueError, TypeError):
+    """Hyperparameters that name no setting of their algorithm or hold a value of the wrong
+    type. A TypeError too: an unknown keyword was the algorithm constructor's TypeError before
+    settings were checked by name, and callers may still catch that."""
+
+
+def _forms(example) -> tuple[tuple[type, ...], str]:
+    """The types a value may have, by the example's, and their description."""
+    if isinstance(example, OneOf):
+        forms = [_forms(e) for e in example]
+        return tuple(t for types, _ in forms for t in types), " or ".join(text for _, text in forms)
+    if isinstance(example, bool):
+        return (bool,), "true or false"
+    if isinstance(example, int):
+        return (int,), "an integer"
+    if isinstance(example, float):
+        return (int, float), "a number"  # 1 stands for 1.0
+    if isinstance(example, str):
+        return (str,), "a string"
+    if isinstance(example, (list, tuple)):
+        return (list, tuple), "a list"
+    if isinstance(example, dict):
+        return (dict, type(None)), "an object (or null)"  # SB3 reads None as no keywords
+    raise TypeError(f"no type rule for the example {example!r}")
+
+
+def hyperparameter_examples(algorithm: str) -> dict:
+    """Every setting ``algorithm`` takes from a run, with an example value of each: its
+    CraftSuite default, else the library's."""
+    if algorithm not in ALGORITHMS:
+        raise KeyError(f"unknown algorithm {algorithm!r}; algorithms: {list(ALGORITHMS)}")
+    return {**(TD3_MORE if algorithm == "td3" else DQN_MORE), **(TD3_DEFAULTS if algorithm == "td3" else DQN_DEFAULTS)}
+
+
+def check_hyperparameters(algorithm: str, overrides: Mapping | None, source: str = "hyperparameters") -> dict:
+    """``overrides`` of ``algorithm``'s settings, checked by name and by type before
+    anything runs; returned as given. ``source`` names where they came from in the message
+    (``--hyper`` on the command line).
+
+    Types follow each setting's example (``hyperparameter_examples``): an integer where it
+    is an integer (never true/false), a number (an integer too) where it is a float, true or
+    false strictly, a list, an object.
+
+    Raises:
+        HyperparameterError: an unknown setting (the message lists the valid ones) or a
+            value of the wrong type (the message names the setting and what it takes).
+    """
+    examples = hyperparameter_examples(algorithm)
+    more = TD3_MORE if algorithm == "td3" else DQN_MORE
+    overrides = dict(overrides or {})
+    unknown = sorted(set(overrides) - set(examples))
+    if unknown:
+        raise HyperparameterError(f"{source}: {algorithm.upper()} has no setting {', '.join(map(repr, unknown))}; "
+                                  f"its settings: {', '.join(sorted(examples))}")
+    for name, value in overrides.items():
+        # a setting of several forms says so in its row of *_MORE, though its default has one
+        types, text = _forms(more[name] if isinstance(more.get(name), OneOf) else examples[name])
+        if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
+            default = examples[name][0] if isinstance(examples[name], OneOf) else examples[name]
+            raise HyperparameterError(f"{source}: {name} must be {text} (default {default!r}), "
+                                      f"got {value!r}")
+    return overrides
+
+
 def algorithm_settings(algorithm: str, overrides: Mapping | None = None) -> dict:
     """The keywords ``algorithm`` (``"dqn"`` or ``"td3"``) is built with: its defaults,
     then ``overrides`` (a key replaces the default's whole value), as plain JSON data: what
-    a run records as its effective hyperparameters and hashes into its run key."""
+    a run records as its effective hyperparameters and hashes into its run key.
+
+    Raises:
+        HyperparameterError: ``overrides`` name an unknown setting or hold a value of the
+            wrong type (``check_hyperparameters``).
+    """
     import copy
 
-    if algorithm not in ALGORITHMS:
-        raise KeyError(f"unknown algorithm {algorithm!r}; algorithms: {list(ALGORITHMS)}")
+    overrides = check_hyperparameters(algorithm, overrides)
     settings = copy.deepcopy({**(TD3_DEFAULTS if algorithm == "td3" else DQN_DEFAULTS), **(overrides or {})})
     # fused Adam: one kernel per step instead of a Python loop over the parameters, about
     # 25% more updates per second for these small nets on a CPU (benchmarks/student_throughput.py)

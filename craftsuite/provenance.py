@@ -18,7 +18,7 @@ import uuid
 from datetime import datetime, timezone
 from pathlib import Path
 
-from .runs import atomic_write
+from .files import atomic_write
 
 FILE = "provenance.json"
 

@@ -12,14 +12,18 @@ A run directory holds
 * ``episodes.csv``: one row per finished training episode (step, return, length, success);
 * ``evals.csv``: one row per evaluation (step, success rate, mean return, episodes, mean
   episode length);
-* ``checkpoint/``: the last model and replay buffer, written together at each evaluation
-  (a student's is removed when it finishes: its final model is ``model.zip``);
+* ``checkpoint/``: the last model and replay buffer, written together at each evaluation,
+  and ``checkpoint-old/``, the one before, kept until the next is complete so that a
+  damaged newest checkpoint can be resumed from the one before (``training._resume``);
+  a student's are removed when it finishes (its final model is ``model.zip``), a
+  teacher's older one;
 * ``tb/``: TensorBoard logs (on resume, what the killed run logged after its checkpoint is
   purged, as from the CSV logs);
-* ``result.json``: written last; its presence means the run is finished and reusable.
+* ``result.json``: written last; its presence means the run is finished and reusable. It
+  names the agent's ``algorithm`` (as the saved model does, for ``load_agent``).
 
-Every whole-file write goes through a temporary file and ``os.replace``, so a killed run
-never leaves a half-written file. An advisory lock (``flock`` on ``.lock``, which names its
+Every whole-file write goes through ``craftsuite.files`` (a temporary file, then
+``os.replace``), so a killed run never leaves a half-written file. An advisory lock (``flock`` on ``.lock``, which names its
 holder) keeps two live runs out of one directory; the kernel drops it when its holder
 dies, so a killed run can be started again at once (it resumes).
 """
@@ -35,27 +39,14 @@ import os
 import socket
 from pathlib import Path
 
+from .files import atomic_write  # also importable from here, where it lived before craftsuite.files
+
 EPISODE_FIELDS = ("step", "return", "length", "success")
 EVAL_FIELDS = ("step", "success", "return", "episodes", "length")  # length: absent from runs before 0.2
 
 
 class RunError(RuntimeError):
     """A run directory that cannot be used (locked by a live run, or holding another config)."""
-
-
-def atomic_write(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` so that readers see the old file or the new one, never half."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        with open(tmp, "w") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
 
 
 # config.json's layout: 1 (before 0.2: the dataclass fields alone) or 2 (with ``effective``

@@ -21,7 +21,8 @@ import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
 from .configs import StudentConfig, TeacherConfig  # noqa: F401  (defined there, torch-free; re-exported)
-from .runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, read_csv
+from .files import atomic_path
+from .runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, RunError, read_csv
 
 
 class Evaluation(NamedTuple):
@@ -149,26 +150,83 @@ def _purge_tensorboard(logger, step: int) -> None:
             output.writer.file_writer.add_event(Event(step=step + 1, session_log=SessionLog(status=SessionLog.START)))
 
 
+class CheckpointError(RunError):
+    """A checkpoint whose model or replay buffer cannot be read (truncated or damaged)."""
+
+
 def save_checkpoint(agent, run: RunDir) -> None:
-    """Model and replay buffer together: written beside, then swapped in."""
+    """Model and replay buffer together: written beside (each flushed to disk), then swapped
+    in. The checkpoint they replace stays as ``checkpoint-old`` until the next one is
+    complete, so a resume has a complete one to fall back on if the newest is damaged."""
     new, final, old = run.path / "checkpoint-new", run.checkpoint.parent, run.path / "checkpoint-old"
-    shutil.rmtree(new, ignore_errors=True)
-    shutil.rmtree(old, ignore_errors=True)  # left by a kill during the last swap
+    shutil.rmtree(new, ignore_errors=True)  # left by a kill while it was written
     new.mkdir()
-    agent.save(new / "model.zip")
-    agent.save_replay_buffer(new / "replay.pkl")
+    with atomic_path(new / "model.zip") as tmp:
+        agent.save(tmp)
+    with atomic_path(new / "replay.pkl") as tmp:
+        agent.save_replay_buffer(tmp)
     if final.exists():
+        shutil.rmtree(old, ignore_errors=True)
         final.rename(old)
     new.rename(final)
-    shutil.rmtree(old, ignore_errors=True)
+
+
+def checkpoint_dirs(run: RunDir) -> list[Path]:
+    """The run's complete checkpoints (model and replay), newest first: ``checkpoint`` and the
+    one before it, ``checkpoint-old`` (also what a kill in the middle of a swap leaves)."""
+    return [d for d in (run.checkpoint.parent, run.path / "checkpoint-old")
+            if (d / "model.zip").exists() and (d / "replay.pkl").exists()]
 
 
 def checkpoint_dir(run: RunDir) -> Path | None:
     """The directory of the run's last complete checkpoint (model and replay), if any."""
-    for d in (run.checkpoint.parent, run.path / "checkpoint-old"):  # -old: killed mid-swap
-        if (d / "model.zip").exists() and (d / "replay.pkl").exists():
-            return d
+    dirs = checkpoint_dirs(run)
+    return dirs[0] if dirs else None
+
+
+def _drop_old_checkpoint(run: RunDir) -> None:
+    shutil.rmtree(run.path / "checkpoint-old", ignore_errors=True)  # the run is finished: nothing resumes
+
+
+def _resume(run: RunDir, fresh):
+    """The agent of the run's newest checkpoint that loads whole (model and replay buffer,
+    both from one checkpoint), or None when the run has none. A damaged checkpoint (a
+    truncated file, say) is skipped with a warning for the one before it; when none loads,
+    the error names each damaged file and what to do."""
+    import warnings
+
+    damaged = []
+    for saved in checkpoint_dirs(run):
+        try:
+            agent = _load_checkpoint(saved, fresh)
+        except CheckpointError as err:
+            damaged.append(str(err))
+            continue
+        if damaged:
+            warnings.warn(f"{run.path}: resuming from the checkpoint before the newest, which is damaged "
+                          f"({damaged[0]})", RuntimeWarning, stacklevel=3)
+        return agent
+    if damaged:
+        raise CheckpointError(
+            f"{run.path} cannot resume: " + "; ".join(damaged) + ". Delete "
+            + " and ".join(str(run.path / d) for d in ("checkpoint", "checkpoint-old") if (run.path / d).exists())
+            + " to train this run again from step 0 (its logs are trimmed to match), or choose another "
+              "output directory")
     return None
+
+
+def _load_checkpoint(saved: Path, fresh):
+    model, replay = saved / "model.zip", saved / "replay.pkl"
+    try:
+        agent = type(fresh).load(model, env=fresh.get_env(), device=fresh.device)
+    except Exception as err:  # whatever a damaged zip raises inside SB3 (BadZipFile, KeyError, EOFError, ...)
+        raise CheckpointError(f"{model} is damaged ({type(err).__name__}: {err})") from None
+    try:
+        agent.load_replay_buffer(replay)
+    except Exception as err:  # a truncated pickle: UnpicklingError, EOFError, ...
+        raise CheckpointError(f"{replay} is damaged ({type(err).__name__}: {err})") from None
+    agent.replay_buffer.device = agent.device
+    return agent
 
 
 def _learn(run: RunDir, fresh, total: int, eval_every: int, eval_episodes: int, evaluate_fn, stop_at=None,
@@ -176,14 +234,11 @@ def _learn(run: RunDir, fresh, total: int, eval_every: int, eval_episodes: int, 
     """Train ``fresh`` (or the run's checkpoint, if there is one) up to ``total`` steps."""
     import torch
 
-    agent = fresh
-    saved = checkpoint_dir(run)
-    if saved is not None:
-        agent = type(fresh).load(saved / "model.zip", env=fresh.get_env(), device=fresh.device)
-        agent.load_replay_buffer(saved / "replay.pkl")
-        agent.replay_buffer.device = agent.device
+    agent = _resume(run, fresh)
+    if agent is not None:
         run.trim_logs(agent.num_timesteps)
     else:
+        agent = fresh
         run.trim_logs(0)
     agent.tensorboard_log = str(run.path / "tb")
     threads = torch.get_num_threads()
@@ -215,7 +270,8 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
     """A teacher run under ``root``; returns its directory (with teacher.zip and table.npz)."""
     from .agents.methods import distill_from_replay, make_agent
 
-    with RunDir(Path(root) / config.run_name(), config) as run:
+    name = config.run_name()  # checks the hyperparameters before a run directory exists
+    with RunDir(Path(root) / name, config) as run:
         if run.finished():
             return run.path
         start = time.perf_counter()
@@ -229,11 +285,14 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
         agent = _learn(run, fresh, config.max_steps, config.eval_every, config.eval_episodes, evaluate_fn,
                        stop_at=config.target_success,
                        progress=progress, desc=f"teacher {config.task}")
-        agent.save(run.path / "teacher.zip")
+        with atomic_path(run.path / "teacher.zip") as tmp:
+            agent.save(tmp)
         distill_from_replay(agent).save(run.path / "table.npz")
+        _drop_old_checkpoint(run)  # its last checkpoint stays: `craftsuite distill` reads the replay there
         evals = read_csv(run.path / "evals.csv")
         success = float(evals[-1]["success"]) if evals else 0.0
-        run.write_result({"kind": "teacher", "env_id": config.env_id, "steps": int(agent.num_timesteps),
+        run.write_result({"kind": "teacher", "env_id": config.env_id, "algorithm": agent.algorithm,
+                          "steps": int(agent.num_timesteps),
                           "updates": int(agent._n_updates),
                           "success": success, "reached_target": success >= config.target_success,
                           "seconds_this_session": round(time.perf_counter() - start, 1),
@@ -249,11 +308,20 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
     if config.method not in METHODS:
         raise KeyError(f"unknown method {config.method!r}; methods: {sorted(METHODS)}")
     method = METHODS[config.method]
-    with RunDir(Path(root) / config.run_name(), config) as run:
+    # bad input is named before a run directory exists: the settings (run_name checks the
+    # hyperparameters), and the teacher's table, which must be made for this task's automaton
+    name = config.run_name()
+    table = None
+    if method.needs_table and not (Path(root) / name / "result.json").exists():  # a finished run needs none
+        from .registration import resolve_task
+
+        if config.table is None:
+            raise ValueError(f"method {config.method!r} needs a teacher's table (table.npz of a teacher run)")
+        table = AutomatonQTable.load(config.table, resolve_task(config.task).automaton)
+    with RunDir(Path(root) / name, config) as run:
         if run.finished():
             return run.path
         start = time.perf_counter()
-        table = AutomatonQTable.load(config.table) if method.distill == "dynamic" else None
         fresh = make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=config.n_envs,
                            env_kwargs=config.env_kwargs, **config.effective()["hyperparameters"])
 
@@ -264,8 +332,10 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
         agent = _learn(run, fresh, config.steps, config.eval_every, config.eval_episodes, evaluate_fn,
                        progress=progress,
                        desc=f"{config.method} {config.task} s{config.seed}")
-        agent.save(run.path / "model.zip")
+        with atomic_path(run.path / "model.zip") as tmp:
+            agent.save(tmp)
         run.write_result({"kind": "student", "env_id": config.env_id, "method": config.method,
+                          "algorithm": agent.algorithm,
                           "task": config.task, "seed": config.seed, "steps": int(agent.num_timesteps),
                           "updates": int(agent._n_updates), "product": method.product,
                           "env_kwargs": config.env_kwargs, "model": "model.zip",
@@ -273,5 +343,6 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
         # a finished run is reused, never resumed (a larger budget is another run): its replay
         # buffer, up to gigabytes (CRM keeps one row per live automaton state), is dead weight
         shutil.rmtree(run.checkpoint.parent, ignore_errors=True)
+        _drop_old_checkpoint(run)
         return run.path
 

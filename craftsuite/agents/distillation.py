@@ -25,6 +25,7 @@ import numpy as np
 import torch as th
 
 from ..automata import Automaton
+from ..files import atomic_path
 
 FORMAT_VERSION = 1
 
@@ -50,8 +51,9 @@ class AutomatonQTable:
         if self.fingerprint != automaton.fingerprint or self.q.shape != automaton.delta.shape:
             raise DistillationError(
                 f"this {self.kind} table was distilled for automaton {self.fingerprint} over "
-                f"{list(self.propositions)}, not for {automaton.fingerprint} over "
-                f"{list(automaton.propositions)} ({automaton.formula!r})"
+                f"{list(self.propositions)} ({self.q.shape[0]} states x {self.q.shape[1]} labels), not for "
+                f"{automaton.fingerprint} over {list(automaton.propositions)} ({automaton.formula!r}, "
+                f"{automaton.delta.shape[0]} states x {automaton.delta.shape[1]} labels)"
             )
 
     def edge_values(self, automaton: Automaton) -> dict[tuple[int, int], float]:
@@ -75,32 +77,58 @@ class AutomatonQTable:
 
     def save(self, path) -> Path:
         path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + ".tmp")
         meta = {"format": FORMAT_VERSION, "fingerprint": self.fingerprint, "kind": self.kind,
                 "propositions": list(self.propositions)}
-        with open(tmp, "wb") as f:
+        with atomic_path(path) as tmp, open(tmp, "wb") as f:  # a crash never leaves half a table behind
             np.savez(f, q=self.q, counts=self.counts, meta=np.array(json.dumps(meta)))
-        tmp.replace(path)  # atomic: a crash never leaves half a table behind
         return path
 
     @classmethod
     def load(cls, path, automaton: Automaton | None = None) -> "AutomatonQTable":
+        """The table saved at ``path``; with ``automaton``, checked to be made for it.
+
+        Raises:
+            FileNotFoundError: no file at ``path``.
+            DistillationError: the file is no distilled table (not an .npz archive, arrays
+                missing or unreadable, another format) or was made for another automaton;
+                the message names the file and what is wrong.
+        """
         path = Path(path)
         if not path.is_file():
             raise FileNotFoundError(f"no distilled table at {path}")
+        where = f"{path} is not a CraftSuite distilled table"
+        if not zipfile.is_zipfile(path):  # np.load would guess a pickle and advise allow_pickle, which misleads
+            raise DistillationError(f"{where}: not an .npz archive (a table is written by `craftsuite teacher` "
+                                    "or `craftsuite distill`)")
         try:
             with np.load(path, allow_pickle=False) as f:
+                missing = [name for name in ("q", "counts", "meta") if name not in f.files]
+                if missing:
+                    raise DistillationError(f"{where}: it lacks the arrays {missing} (it has {sorted(f.files)})")
                 meta = json.loads(str(f["meta"]))
                 q, counts = f["q"], f["counts"]
-        except (OSError, ValueError, KeyError, zipfile.BadZipFile, json.JSONDecodeError) as err:
-            raise DistillationError(f"{path} is not a CraftSuite distilled table (corrupt?): {err}") from None
-        if meta.get("format") != FORMAT_VERSION or q.shape != counts.shape:
-            raise DistillationError(f"{path}: unsupported table format {meta.get('format')!r}")
-        table = cls(q=q, counts=counts, fingerprint=meta["fingerprint"],
-                    propositions=tuple(meta["propositions"]), kind=meta["kind"])
+        except DistillationError:
+            raise
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as err:  # damaged inside
+            raise DistillationError(f"{where}: its arrays cannot be read ({type(err).__name__}: {err}); "
+                                    "it is damaged: distil the teacher again") from None
+        if not isinstance(meta, dict) or meta.get("format") != FORMAT_VERSION:
+            version = meta.get("format") if isinstance(meta, dict) else None
+            raise DistillationError(f"{path}: unsupported table format {version!r} (this CraftSuite reads "
+                                    f"format {FORMAT_VERSION})")
+        if q.ndim != 2 or q.shape != counts.shape:
+            raise DistillationError(f"{where}: q {q.shape} and counts {counts.shape} must be one matrix shape "
+                                    "(automaton states x labels)")
+        try:
+            table = cls(q=q, counts=counts, fingerprint=meta["fingerprint"],
+                        propositions=tuple(meta["propositions"]), kind=meta["kind"])
+        except (KeyError, TypeError) as err:
+            raise DistillationError(f"{where}: its metadata lacks {err}") from None
         if automaton is not None:
-            table.check(automaton)
+            try:
+                table.check(automaton)
+            except DistillationError as err:
+                raise DistillationError(f"{path} does not fit this task: {err}") from None
         return table
 
 

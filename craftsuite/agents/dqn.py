@@ -20,7 +20,7 @@ from stable_baselines3.dqn.policies import DQNPolicy, QNetwork
 from torch import nn
 
 from .distillation import DistilledTarget
-from .replay import AutomatonReplayBuffer, AutomatonSamples
+from .replay import AutomatonReplayBuffer, AutomatonSamples, NStepOwner, automaton_buffer_kwargs
 
 
 class _DuelingHead(nn.Module):
@@ -51,7 +51,7 @@ class DuelingDQNPolicy(DQNPolicy):
         return DuelingQNetwork(**net_args).to(self.device)
 
 
-class AutomatonDQN(DQN):
+class AutomatonDQN(NStepOwner, DQN):
     """DQN for CraftSuite worlds: dueling, double, prioritized, optionally distilled.
 
     Args (beyond SB3's DQN):
@@ -59,7 +59,10 @@ class AutomatonDQN(DQN):
         dueling: with ``policy="MlpPolicy"``, use ``DuelingDQNPolicy``.
         prioritized: prioritized replay (``AutomatonReplayBuffer``), else uniform.
         distill: a ``DistilledTarget`` for students; None for teachers and baselines.
-        n_steps: n-step returns from the replay buffer (1: the one-step target).
+        n_steps: n-step returns from the replay buffer (1: the one-step target); SB3's own
+            setting, so ``model.n_steps`` is what the buffer uses.
+
+    ``algorithm`` (``"dqn"``) is saved with the model, so that ``load_agent`` knows its class.
     """
 
     def __init__(self, policy, env, *, double: bool = True, dueling: bool = True, prioritized: bool = True,
@@ -68,11 +71,12 @@ class AutomatonDQN(DQN):
         if dueling and policy == "MlpPolicy":
             policy = DuelingDQNPolicy
         kwargs.setdefault("replay_buffer_class", AutomatonReplayBuffer)
-        replay_buffer_kwargs = {"prioritized": prioritized, "n_steps": n_steps, "gamma": kwargs.get("gamma", 0.99),
-                                **(replay_buffer_kwargs or {})}
+        replay_buffer_kwargs = automaton_buffer_kwargs(prioritized, n_steps, kwargs.get("gamma", 0.99),
+                                                       replay_buffer_kwargs)
+        self.algorithm = "dqn"
         self.double = double
         self.distill = distill
-        super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, **kwargs)
+        super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, n_steps=n_steps, **kwargs)
 
     def _td_target(self, data: AutomatonSamples) -> th.Tensor:
         """r + gamma * Q_target(s', a*), a* from the online net when double; then distilled."""

@@ -1,4 +1,4 @@
-"""Every method of ``craftsuite.methods.METHODS`` built into an agent: ``make_agent(method, env_id, ...)``.
+"""Every method of ``craftsuite.methods.METHODS`` built into an agent: ``make_agent(method, env, ...)``.
 
 Grid methods are DQN (``AutomatonDQN``), MuJoCo methods TD3 (``AutomatonTD3``); the table
 says which sees the automaton state and how it uses the automaton. A teacher is
@@ -7,14 +7,19 @@ says which sees the automaton state and how it uses the automaton. A teacher is
 
 from __future__ import annotations
 
+import json
 import zipfile
 from pathlib import Path
 
 import numpy as np
+import gymnasium as gym
 from stable_baselines3.common.env_util import make_vec_env
+from stable_baselines3.common.vec_env import VecEnv
 
 from ..methods import (  # noqa: F401  (METHODS and the defaults re-exported)
     ALGORITHMS, DQN_DEFAULTS, METHODS, TD3_DEFAULTS, Method, algorithm_settings, check_methods)
+from ..envs.base import CraftWorld
+from ..envs.grid import GridWorldEnv
 from ..registration import parse_id, world_kind
 from .crm import CRMReplayBuffer
 from .distillation import AutomatonQTable, DistilledTarget, dynamic_distillation, static_distillation
@@ -26,24 +31,36 @@ CLASSES = {"dqn": AutomatonDQN, "td3": AutomatonTD3}
 assert set(CLASSES) == set(ALGORITHMS), "every algorithm of the methods table needs its class here"
 
 
-def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None, seed: int = 0,
+def make_agent(method: str, env, *, table: AutomatonQTable | None = None, seed: int = 0,
                n_envs: int = 1, rho: float | None = None, self_loops: bool | None = None, verbose: int = 0,
                env_kwargs: dict | None = None, **overrides):
-    """An untrained agent of ``method`` on ``n_envs`` copies of ``env_id``: each step of
-    the agent collects ``n_envs`` transitions, then takes ``gradient_steps`` updates.
+    """An untrained agent of ``method``: each step of the agent collects one transition per
+    env, then takes ``gradient_steps`` updates.
 
-    ``env_kwargs`` go to ``gymnasium.make`` (e.g. ``{"layout_seed": 0}`` for a fixed grid
-    instance); ``rho`` and ``self_loops`` to the distilled target (``DistilledTarget``;
-    None: the method's); ``overrides`` to the algorithm (TD3's ``action_noise`` may be a
-    spec such as ``{"type": "persistent", "sigma": 0.6, "resample": 0.1}``: ``agents/noise.py``)."""
+    ``env`` is a CraftSuite id (the agent gets ``n_envs`` copies of it, made with
+    ``env_kwargs``, e.g. ``{"layout_seed": 0}`` for a fixed grid instance) or an env made
+    already: a gymnasium env or an SB3 VecEnv of a CraftSuite world (``n_envs`` and
+    ``env_kwargs`` are then its own). Either way the method must suit the world (a grid
+    method on a grid, a MuJoCo method in MuJoCo) and see the automaton state exactly when it
+    is a product method (``product=True``). ``rho`` and ``self_loops`` go to the distilled
+    target (``DistilledTarget``; None: the method's); ``overrides`` to the algorithm,
+    checked by name and type (``craftsuite.methods.check_hyperparameters``; TD3's
+    ``action_noise`` may be a spec such as ``{"type": "persistent", "sigma": 0.6,
+    "resample": 0.1}``: ``agents/noise.py``)."""
     check_methods([method])
     m = METHODS[method]
-    if world_kind(parse_id(env_id)[1]) != m.world:
-        raise ValueError(f"method {method!r} is for {m.world} worlds, not {env_id}")
-    env = make_vec_env(env_id, n_envs=n_envs, seed=seed, env_kwargs={**(env_kwargs or {}), "product": m.product})
-    base = env.envs[0].unwrapped
+    kwargs = algorithm_settings(m.algorithm, overrides)  # bad settings are named before an env is made
+    if isinstance(env, str):
+        if world_kind(parse_id(env)[1]) != m.world:
+            raise ValueError(f"method {method!r} is for {m.world} worlds, not {env}")
+        env = make_vec_env(env, n_envs=n_envs, seed=seed, env_kwargs={**(env_kwargs or {}), "product": m.product})
+    else:
+        if env_kwargs:
+            raise ValueError("env_kwargs make an env from an id; this env is made already")
+        _check_suited(method, m, env)  # a gymnasium env stays one: SB3 wraps it (Monitor, DummyVecEnv)
+    n_envs = env.num_envs if isinstance(env, VecEnv) else 1
+    base = _unwrapped(env)
     automaton = base.automaton
-    kwargs = algorithm_settings(m.algorithm, overrides)
     if isinstance(kwargs.get("action_noise"), dict):
         kwargs["action_noise"] = make_action_noise(kwargs["action_noise"], env.action_space.shape[0], seed, n_envs)
     if m.crm:
@@ -61,6 +78,31 @@ def make_agent(method: str, env_id: str, *, table: AutomatonQTable | None = None
     return CLASSES[m.algorithm]("MlpPolicy", env, seed=seed, verbose=verbose, **kwargs)
 
 
+def _unwrapped(env):
+    """The world under a gymnasium env or under a VecEnv's first env."""
+    return env.get_attr("unwrapped", [0])[0] if isinstance(env, VecEnv) else env.unwrapped
+
+
+def _check_suited(name: str, method: Method, env) -> None:
+    """Raise unless ``env`` (a gymnasium env or a VecEnv) is a CraftSuite world of the
+    method's kind, with the automaton state in its observation exactly when the method is a
+    product method."""
+    if not isinstance(env, (VecEnv, gym.Env)):
+        raise TypeError(f"make_agent takes a CraftSuite id, a gymnasium env or a VecEnv, not {env!r}")
+    base = _unwrapped(env)
+    if not isinstance(base, CraftWorld):
+        raise ValueError(f"method {name!r} needs a CraftSuite world, not {type(base).__name__}")
+    kind = "Grid" if isinstance(base, GridWorldEnv) else "Cont"  # the world kinds: WORLD_KINDS
+    spec = env.get_attr("spec", [0])[0] if isinstance(env, VecEnv) else env.spec
+    where = spec.id if spec is not None else f"this {type(base).__name__}"
+    if kind != method.world:
+        raise ValueError(f"method {name!r} is for {method.world} worlds, not {where}")
+    product = env.observation_space.shape[0] == base.observation_space.shape[0] + base.automaton.n_states
+    if product != method.product:
+        raise ValueError(f"method {name!r} {'needs' if method.product else 'must not see'} the automaton state in "
+                         f"its observation: make {where} with product={method.product}")
+
+
 def distill_from_replay(teacher: AutomatonDQN, chunk: int = 4096) -> AutomatonQTable:
     """Dynamic distillation of a DQN teacher: mean Q of the taken action per (w, sigma)."""
     buf = teacher.replay_buffer
@@ -75,9 +117,36 @@ def distill_from_replay(teacher: AutomatonDQN, chunk: int = 4096) -> AutomatonQT
     return dynamic_distillation(automaton, buf.w[:rows].reshape(-1), buf.sigma[:rows].reshape(-1), q_taken)
 
 
+def recorded_algorithm(path) -> str | None:
+    """The algorithm (a key of ``CLASSES``) a saved agent records: the model's own metadata
+    (``algorithm``, saved since CraftSuite's agents carry it), else its run's record beside
+    it (``result.json``'s ``algorithm``, or ``config.json``'s effective method, which runs of
+    record format 2 carry); None when neither says (a plain SB3 checkpoint, an older run)."""
+    path = Path(path)
+    try:
+        with zipfile.ZipFile(path) as z:
+            data = json.loads(z.read("data"))
+        if isinstance(data.get("algorithm"), str):
+            return data["algorithm"]
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
+        pass  # damaged or foreign: the record beside, or loading, will say more
+    for run in (path.parent, path.parent.parent):  # run/model.zip, run/checkpoint/model.zip
+        for record, keys in (("result.json", ("algorithm",)), ("config.json", ("effective", "method", "algorithm"))):
+            try:
+                value = json.loads((run / record).read_text())
+                for key in keys:
+                    value = value[key]
+            except (OSError, ValueError, KeyError, TypeError):
+                continue
+            if isinstance(value, str):
+                return value
+    return None
+
+
 def load_agent(path, env=None):
     """Load a saved agent (any CraftSuite method, or a plain stable-baselines3 checkpoint)
-    with a clear error for missing or corrupt files."""
+    with a clear error for missing or corrupt files. Its class is the one its algorithm
+    names (``recorded_algorithm``)."""
     import stable_baselines3 as sb3
 
     path = Path(path)
@@ -86,10 +155,22 @@ def load_agent(path, env=None):
     if not zipfile.is_zipfile(path):
         raise ValueError(f"{path} is not a saved agent: not a stable-baselines3 checkpoint "
                          "(not a zip archive: corrupt or another file?)")
-    errors = []
-    for algorithm in (AutomatonDQN, AutomatonTD3, sb3.DQN, sb3.TD3, sb3.SAC, sb3.PPO, sb3.A2C, sb3.DDPG):
+    algorithm = recorded_algorithm(path)
+    if algorithm is not None:
+        if algorithm not in CLASSES:
+            raise ValueError(f"{path} is a {algorithm!r} agent, which this CraftSuite does not know "
+                             f"(it knows {list(CLASSES)}): a newer CraftSuite saved it?")
         try:
-            return algorithm.load(path, env=env, device="cpu")
-        except Exception as err:  # a checkpoint of the other algorithm, or damaged inside
-            errors.append(f"{algorithm.__name__}: {type(err).__name__}")
+            return CLASSES[algorithm].load(path, env=env, device="cpu")
+        except Exception as err:  # damaged inside: whatever SB3 raises
+            raise ValueError(f"{path} could not be loaded as {CLASSES[algorithm].__name__}: "
+                             f"{type(err).__name__}: {err}") from None
+    # Neither the model nor a run record names its algorithm: a plain SB3 checkpoint or an
+    # agent saved before CraftSuite recorded it. Only these are tried class by class.
+    errors = []
+    for cls in (AutomatonDQN, AutomatonTD3, sb3.DQN, sb3.TD3, sb3.SAC, sb3.PPO, sb3.A2C, sb3.DDPG):
+        try:
+            return cls.load(path, env=env, device="cpu")
+        except Exception as err:  # a checkpoint of another algorithm, or damaged inside
+            errors.append(f"{cls.__name__}: {type(err).__name__}")
     raise ValueError(f"{path} could not be loaded: {'; '.join(errors)}")

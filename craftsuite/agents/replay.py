@@ -13,6 +13,7 @@ priorities stay those of the first transition.
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -203,3 +204,31 @@ class AutomatonReplayBuffer(ReplayBuffer):
         priorities = np.abs(np.asarray(td_errors, dtype=np.float64).reshape(-1)) + self.epsilon
         self.max_priority = max(self.max_priority, float(priorities.max()))
         self.tree.update(indices, priorities ** self.alpha)
+
+
+def automaton_buffer_kwargs(prioritized: bool, n_steps: int, gamma: float, given: dict | None) -> dict:
+    """The keywords of an ``AutomatonReplayBuffer`` built by ``AutomatonDQN`` or
+    ``AutomatonTD3``: ``n_steps`` is the algorithm's own setting (SB3's ``model.n_steps``),
+    so that what the model says is what its buffer does; ``given`` may not say otherwise."""
+    given = dict(given or {})
+    if given.get("n_steps", n_steps) != n_steps:
+        raise ValueError(f"n_steps is the algorithm's setting: pass n_steps={given['n_steps']}, "
+                         f"not replay_buffer_kwargs={{'n_steps': ...}} (the algorithm's is {n_steps})")
+    return {"prioritized": prioritized, "n_steps": n_steps, "gamma": gamma, **given}
+
+
+class NStepOwner:
+    """Mixin of ``AutomatonDQN`` and ``AutomatonTD3`` (before SB3's class): SB3's ``n_steps``
+    attribute is the one setting of n-step returns, and the ``AutomatonReplayBuffer`` reads it
+    from its keywords (``replay_buffer_kwargs``)."""
+
+    def _setup_model(self) -> None:
+        # checkpoints saved before n_steps reached SB3 recorded SB3's default 1 beside the
+        # buffer's own: the buffer's is the one they trained with
+        self.n_steps = self.replay_buffer_kwargs.get("n_steps", self.n_steps)
+        with warnings.catch_warnings():
+            if isinstance(self.replay_buffer_class, type) and issubclass(self.replay_buffer_class,
+                                                                          AutomatonReplayBuffer):
+                # SB3 warns that n_steps is ignored with a buffer class of one's own; ours takes it
+                warnings.filterwarnings("ignore", message=r"`n_steps=\d+` is ignored")
+            super()._setup_model()

@@ -7,7 +7,8 @@ Where this differs from SB3's TD3, and nowhere else:
   when a ``DistilledTarget`` is given).
 * ``AutomatonTD3.train``: SB3's loop, with the critic loss weighted by importance weights,
   priorities updated from the first critic's TD errors, and the actor delayed by
-  ``policy_delay_at(num_timesteps)`` (4 for the first 20,000 steps, 2 afterwards).
+  ``policy_delay_at(num_timesteps)`` (4 for the first 20,000 steps, 2 afterwards), which it
+  sets as SB3's ``policy_delay`` for each call, so that attribute says the delay in force.
 """
 
 from __future__ import annotations
@@ -19,28 +20,37 @@ from stable_baselines3 import TD3
 from stable_baselines3.common.utils import polyak_update
 
 from .distillation import DistilledTarget
-from .replay import AutomatonReplayBuffer, AutomatonSamples
+from .replay import AutomatonReplayBuffer, AutomatonSamples, NStepOwner, automaton_buffer_kwargs
 
 
-class AutomatonTD3(TD3):
+class AutomatonTD3(NStepOwner, TD3):
     """TD3 for CraftSuite worlds: prioritized, delay-scheduled, optionally distilled.
 
-    Args (beyond SB3's TD3, whose ``policy_delay`` this replaces):
+    Args (beyond SB3's TD3):
         prioritized: prioritized replay (``AutomatonReplayBuffer``), else uniform.
         distill: a ``DistilledTarget``; None for TD3 from scratch and product TD3.
-        delay_schedule: ``((until_step, delay), ..., (None, delay))``.
-        n_steps: n-step returns from the replay buffer (1: SB3's one-step target).
+        delay_schedule: ``((until_step, delay), ..., (None, delay))``: the actor's delay
+            by step (default: 4 until step 20,000, then 2).
+        policy_delay: a constant delay, as in SB3's TD3: the schedule ``((None, policy_delay),)``
+            (give this or ``delay_schedule``). ``model.policy_delay`` is always the delay in
+            force: the schedule's at the last training call.
+        n_steps: n-step returns from the replay buffer (1: SB3's one-step target); SB3's own
+            setting, so ``model.n_steps`` is what the buffer uses.
+
+    ``algorithm`` (``"td3"``) is saved with the model, so that ``load_agent`` knows its class.
     """
 
     def __init__(self, policy, env, *, prioritized: bool = True, distill: DistilledTarget | None = None,
-                 delay_schedule=((20_000, 4), (None, 2)), n_steps: int = 1,
+                 delay_schedule=None, policy_delay: int | None = None, n_steps: int = 1,
                  replay_buffer_kwargs: dict | None = None, **kwargs):
         kwargs.setdefault("replay_buffer_class", AutomatonReplayBuffer)
-        replay_buffer_kwargs = {"prioritized": prioritized, "n_steps": n_steps, "gamma": kwargs.get("gamma", 0.99),
-                                **(replay_buffer_kwargs or {})}
+        replay_buffer_kwargs = automaton_buffer_kwargs(prioritized, n_steps, kwargs.get("gamma", 0.99),
+                                                       replay_buffer_kwargs)
+        self.algorithm = "td3"
         self.distill = distill
-        self.delay_schedule = tuple(delay_schedule)
-        super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, **kwargs)
+        self.delay_schedule = _delay_schedule(delay_schedule, policy_delay)
+        super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, n_steps=n_steps,
+                         policy_delay=self.policy_delay_at(0), **kwargs)
 
     def policy_delay_at(self, step: int) -> int:
         for until, delay in self.delay_schedule:
@@ -64,7 +74,7 @@ class AutomatonTD3(TD3):
     def train(self, gradient_steps: int, batch_size: int = 100) -> None:
         self.policy.set_training_mode(True)
         self._update_learning_rate([self.actor.optimizer, self.critic.optimizer])
-        delay = self.policy_delay_at(self.num_timesteps)
+        self.policy_delay = delay = self.policy_delay_at(self.num_timesteps)  # SB3's attribute tells the truth
         actor_losses, critic_losses = [], []
         for _ in range(gradient_steps):
             self._n_updates += 1
@@ -100,3 +110,22 @@ class AutomatonTD3(TD3):
         self.logger.record("train/critic_loss", np.mean(critic_losses))
         if self.distill is not None:
             self.logger.record("train/teacher_weight", self.distill.last_weight)
+
+
+def _delay_schedule(schedule, policy_delay) -> tuple:
+    """The actor's delay schedule from ``delay_schedule`` or a constant ``policy_delay``."""
+    if schedule is not None and policy_delay is not None:
+        raise ValueError("give delay_schedule or policy_delay (a constant delay), not both")
+    if policy_delay is not None:
+        schedule = ((None, policy_delay),)
+    elif schedule is None:
+        schedule = ((20_000, 4), (None, 2))  # the paper's authors' schedule
+    schedule = tuple(tuple(row) for row in schedule)
+    for i, row in enumerate(schedule):
+        last = i == len(schedule) - 1
+        ok = (len(row) == 2 and isinstance(row[1], int) and not isinstance(row[1], bool) and row[1] >= 1
+              and ((row[0] is None) if last else (isinstance(row[0], int) and not isinstance(row[0], bool))))
+        if not ok:
+            raise ValueError(f"delay_schedule must be ((until_step, delay), ..., (None, delay)) with delays of at "
+                             f"least 1, got {schedule!r}")
+    return schedule

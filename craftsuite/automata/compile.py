@@ -9,12 +9,12 @@ import hashlib
 import logging
 import os
 import re
-import tempfile
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
+from ..files import atomic_path
 from .dfa import MAX_PROPOSITIONS, Automaton, minimize
 from .ltlf import LTLfSyntaxError, atoms, parse
 from .progression import progress_to_dfa
@@ -105,11 +105,9 @@ def _load(path: Path, formula: str, props: tuple[str, ...]) -> Automaton | None:
 
 
 def _save(path: Path, automaton: Automaton) -> None:
-    """Atomic write (temp file + rename in the same directory): safe for parallel processes."""
+    """Atomic write (``craftsuite.files``: a temporary file of its own, then a rename): safe for parallel processes."""
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.stem, suffix=".tmp")
-        with os.fdopen(fd, "wb") as f:
+        with atomic_path(path) as tmp, open(tmp, "wb") as f:
             np.savez(
                 f,
                 formula=np.array(automaton.formula),
@@ -117,7 +115,6 @@ def _save(path: Path, automaton: Automaton) -> None:
                 delta=automaton.delta,
                 accepting=automaton.accepting,
             )
-        os.replace(tmp, path)
     except OSError as err:  # a read-only home must not stop anyone from compiling
         log.warning("could not write automaton cache %s (%s)", path, err)
 

@@ -70,6 +70,34 @@ def test_atomic_write_leaves_no_temporary_files(tmp_path):
     assert (tmp_path / "a.json").read_text() == "[]"
 
 
+def test_atomic_write_takes_bytes_and_keeps_the_old_file_when_a_writer_fails(tmp_path):
+    from craftsuite.files import atomic_path
+
+    path = tmp_path / "model.zip"
+    atomic_write(path, b"\x00old")
+    with pytest.raises(RuntimeError), atomic_path(path) as tmp:
+        tmp.write_bytes(b"half")
+        raise RuntimeError("killed while writing")
+    assert path.read_bytes() == b"\x00old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["model.zip"]
+    with pytest.raises(FileNotFoundError, match="nothing was written"), atomic_path(path):
+        pass  # a writer that wrote nothing does not replace the file with nothing
+    assert path.read_bytes() == b"\x00old"
+
+
+def test_atomic_path_keeps_the_suffix_writers_add_when_it_is_missing(tmp_path):
+    import numpy as np
+
+    from craftsuite.files import atomic_path
+
+    with atomic_path(tmp_path / "table.npz") as tmp:
+        assert tmp.suffix == ".npz" and tmp.parent == tmp_path
+        np.savez(tmp, q=np.arange(3))  # numpy appends .npz only when it is missing
+    with np.load(tmp_path / "table.npz") as f:
+        assert f["q"].tolist() == [0, 1, 2]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["table.npz"]
+
+
 def test_a_run_that_fails_before_training_leaves_no_directory(tmp_path):
     from craftsuite.training import train_student
 

@@ -1,0 +1,64 @@
+"""Hyperparameters checked by name and type (craftsuite.methods) before anything runs."""
+
+from __future__ import annotations
+
+import inspect
+
+import pytest
+
+from craftsuite.methods import (DQN_DEFAULTS, TD3_DEFAULTS, HyperparameterError, algorithm_settings,
+                                check_hyperparameters, hyperparameter_examples)
+
+
+@pytest.mark.parametrize("overrides,message", [
+    ({"batch_size": "big"}, "batch_size must be an integer (default 64), got 'big'"),
+    ({"batch_size": 64.0}, "batch_size must be an integer"),
+    ({"learning_starts": True}, "learning_starts must be an integer"),
+    ({"learning_rate": "fast"}, "learning_rate must be a number"),
+    ({"learning_rate": False}, "learning_rate must be a number"),
+    ({"prioritized": 1}, "prioritized must be true or false"),
+    ({"policy_kwargs": [64]}, "policy_kwargs must be an object"),
+    ({"train_freq": 4.0}, "train_freq must be an integer or a list"),
+])
+def test_a_value_of_the_wrong_type_is_named(overrides, message):
+    with pytest.raises(HyperparameterError, match="^--hyper: " + message.replace("(", r"\(").replace(")", r"\)")):
+        check_hyperparameters("dqn", overrides, source="--hyper")
+
+
+def test_an_unknown_setting_lists_the_valid_ones():
+    with pytest.raises(HyperparameterError) as err:
+        check_hyperparameters("td3", {"learning_rat": 1e-3})
+    text = str(err.value)
+    assert "TD3 has no setting 'learning_rat'" in text
+    assert all(name in text for name in (*TD3_DEFAULTS, "n_steps", "delay_schedule", "prioritized"))
+    assert isinstance(err.value, TypeError)  # as the constructor's unknown keyword was
+
+
+def test_values_of_the_right_type_pass_unchanged():
+    good = {"learning_rate": 1, "batch_size": 32, "prioritized": False, "policy_kwargs": None,
+            "train_freq": [2, "episode"], "n_steps": 3, "double": False}
+    assert check_hyperparameters("dqn", good) == good
+    assert algorithm_settings("dqn", good)["batch_size"] == 32
+    with pytest.raises(HyperparameterError, match="DQN has no setting 'action_noise'"):
+        algorithm_settings("dqn", {"action_noise": None})
+
+
+@pytest.mark.parametrize("algorithm", ["dqn", "td3"])
+def test_every_setting_is_a_keyword_of_the_agent_and_every_data_keyword_a_setting(algorithm):
+    from craftsuite.agents.methods import CLASSES
+
+    cls = CLASSES[algorithm]
+    sb3 = cls.__bases__[-1]  # SB3's DQN or TD3
+    assert sb3.__module__.startswith("stable_baselines3")
+    keywords = {}
+    for klass in (sb3, cls):  # the agent's keywords over SB3's
+        keywords.update({k: p.default for k, p in inspect.signature(klass.__init__).parameters.items()})
+    not_data = {"self", "policy", "env", "kwargs", "replay_buffer_class", "tensorboard_log", "verbose", "seed",
+                "_init_setup_model", "distill", "args"}
+    examples = hyperparameter_examples(algorithm)
+    assert set(examples) - set(keywords) == set()
+    assert set(keywords) - not_data - set(examples) == set()
+    defaults = TD3_DEFAULTS if algorithm == "td3" else DQN_DEFAULTS
+    for name, default in keywords.items():  # the library's default fits each setting's type
+        if name in examples and name not in defaults and default is not None and name != "delay_schedule":
+            check_hyperparameters(algorithm, {name: default})

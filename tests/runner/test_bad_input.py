@@ -1,0 +1,101 @@
+"""Bad input of training named before a run directory exists; damaged checkpoints on resume."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from craftsuite.cli import main
+from craftsuite.methods import HyperparameterError
+from craftsuite.runs import RunDir, read_csv
+from craftsuite.training import CheckpointError, StudentConfig, TeacherConfig, train_student, train_teacher
+
+TINY = {"learning_starts": 50, "buffer_size": 2_000, "policy_kwargs": {"net_arch": [16]}}
+
+
+@pytest.mark.parametrize("hyper,message", [({"batch_size": "big"}, "batch_size must be an integer"),
+                                           ({"batch_sise": 32}, "has no setting 'batch_sise'")])
+def test_bad_hyperparameters_fail_before_a_run_directory_exists(tmp_path, hyper, message):
+    with pytest.raises(HyperparameterError, match=message):
+        train_teacher(TeacherConfig(max_steps=100, hyperparameters=hyper), tmp_path, progress=False)
+    with pytest.raises(HyperparameterError, match=message):
+        train_student(StudentConfig(method="td3", steps=100, hyperparameters=hyper), tmp_path, progress=False)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_cli_names_hyper_and_the_valid_settings(tmp_path, capsys):
+    out = tmp_path / "runs"
+    assert main(["student", "BlindCraftsman", "--method", "dqn", "--world", "Grid7", "--hyper",
+                 '{"batch_size": "big"}', "--out", str(out)]) == 2
+    assert "--hyper: batch_size must be an integer (default 64), got 'big'" in capsys.readouterr().err
+    assert main(["teacher", "BlindCraftsman", "--hyper", '{"learning_rat": 0.1}', "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "--hyper: DQN has no setting 'learning_rat'" in err and "learning_rate" in err
+    assert main(["student", "BlindCraftsman", "--method", "td3", "--hyper", '{"double": false}',
+                 "--out", str(out)]) == 2
+    assert "--hyper: TD3 has no setting 'double'" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
+    bad = tmp_path / "table.npz"
+    bad.write_text("oops")
+    out = tmp_path / "runs"
+    assert main(["student", "BlindCraftsman", "--method", "td3-dynamic", "--table", str(bad),
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert f"{bad} is not a CraftSuite distilled table: not an .npz archive" in err and "allow_pickle" not in err
+    assert not out.exists()
+
+
+# -- damaged checkpoints ----------------------------------------------------------------------------
+CONFIG = StudentConfig(method="dqn", world="Grid7", steps=300, eval_every=100, eval_episodes=1, hyperparameters=TINY)
+
+
+@pytest.fixture
+def interrupted(tmp_path, monkeypatch):
+    """A run killed after its last checkpoint (at 300), with the one before it (at 200)."""
+    monkeypatch.setattr(RunDir, "write_result", lambda self, result: (_ for _ in ()).throw(KeyboardInterrupt))
+    with pytest.raises(KeyboardInterrupt):
+        train_student(CONFIG, tmp_path, progress=False)
+    monkeypatch.undo()
+    [run] = tmp_path.iterdir()
+    assert (run / "checkpoint" / "replay.pkl").is_file() and (run / "checkpoint-old" / "model.zip").is_file()
+    return run
+
+
+def _truncate(path):
+    path.write_bytes(path.read_bytes()[: path.stat().st_size // 3])
+
+
+@pytest.mark.parametrize("name", ["replay.pkl", "model.zip"])
+def test_a_damaged_checkpoint_falls_back_to_the_one_before(interrupted, name):
+    run = interrupted
+    _truncate(run / "checkpoint" / name)
+    with pytest.warns(RuntimeWarning, match=f"checkpoint/{name} is damaged"):
+        assert train_student(CONFIG, run.parent, progress=False) == run
+    result = json.loads((run / "result.json").read_text())
+    assert result["steps"] == 300 and result["algorithm"] == "dqn"
+    # resumed at 200: the evaluation at 300 was made again, once
+    assert [int(r["step"]) for r in read_csv(run / "evals.csv")] == [100, 200, 300]
+    assert not (run / "checkpoint").exists() and not (run / "checkpoint-old").exists()
+
+
+def test_when_no_checkpoint_loads_the_error_says_what_to_delete(interrupted):
+    run = interrupted
+    _truncate(run / "checkpoint" / "replay.pkl")
+    _truncate(run / "checkpoint-old" / "model.zip")
+    with pytest.raises(CheckpointError) as err:
+        train_student(CONFIG, run.parent, progress=False)
+    text = str(err.value)
+    assert f"{run / 'checkpoint' / 'replay.pkl'} is damaged" in text
+    assert f"{run / 'checkpoint-old' / 'model.zip'} is damaged" in text
+    assert f"Delete {run / 'checkpoint'} and {run / 'checkpoint-old'} to train this run again from step 0" in text
+    assert (run / "evals.csv").is_file()  # nothing of the run was removed
+    for d in ("checkpoint", "checkpoint-old"):  # done as told, the run trains again from step 0
+        import shutil
+
+        shutil.rmtree(run / d)
+    assert train_student(CONFIG, run.parent, progress=False) == run
+    assert [int(r["step"]) for r in read_csv(run / "evals.csv")] == [100, 200, 300]

@@ -124,7 +124,7 @@ def _demo(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
     rows = []
     for env_id in tqdm(ids, desc="scripted rollouts", unit="env"):
-        env = gym.make(env_id, render_mode="rgb_array")
+        env = gym.make(env_id, render_mode="rgb_array", status_panel=True)  # pictures for people: inventory shown
         policy = scripted_policy(env)
         successes, lengths = 0, []
         for episode in range(args.episodes):
@@ -146,6 +146,8 @@ def _demo(args) -> int:
         rows.append((env_id, successes, args.episodes, float(np.mean(lengths)), picture.name))
         env.close()
     for name, spec in tasks().items():
+        if args.task not in (None, name):
+            continue
         try:
             write_image(spec.automaton, out / f"{name}-automaton.png", title=f"{name}: {spec.formula}")
         except RuntimeError as err:  # no Graphviz: keep the DOT text
@@ -159,7 +161,8 @@ def _demo(args) -> int:
     if cont:
         from .rollouts import record_video
 
-        rec = record_video(cont[0], "scripted", 1, str(out / f"{file_stem(cont[0])}.mp4"), args.seed)
+        rec = record_video(cont[0], "scripted", 1, str(out / f"{file_stem(cont[0])}.mp4"), args.seed,
+                           env_kwargs={"status_panel": True})
         print(f"rollout video: {rec.path} ({rec.frames} frames, {rec.codec})")
     return 0
 
@@ -198,7 +201,8 @@ def _hyper(text: str | None, algorithm: str) -> dict:
 
 
 def _teacher(args) -> int:
-    from .training import TeacherConfig, train_teacher
+    from .configs import TeacherConfig
+    from .training import train_teacher
 
     config = TeacherConfig(task=args.task, size=args.size, layout_seed=None if args.layout_seed < 0 else args.layout_seed,
                            seed=args.seed, max_steps=args.max_steps, target_success=args.target_success,
@@ -262,7 +266,8 @@ def _distill(args) -> int:
 
 def _student(args) -> int:
     from .methods import METHODS
-    from .training import StudentConfig, train_student
+    from .configs import StudentConfig
+    from .training import train_student
 
     config = StudentConfig(task=args.task, method=args.method, world=args.world, seed=args.seed, steps=args.steps,
                            table=str(Path(args.table).resolve()) if args.table else None, eval_every=args.eval_every,

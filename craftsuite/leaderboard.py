@@ -62,7 +62,7 @@ def world_label(config: dict) -> str:
     """A student's world as a leaderboard shows it: ``Cont``, ``Grid10``, or with the
     settings that change it, e.g. ``Cont: frame_skip=2, max_episode_steps=1000``."""
     from .runs import config_from
-    from .training import StudentConfig  # the owner of a student's world settings
+    from .configs import StudentConfig  # the owner of a student's world settings
 
     settings = config_from(StudentConfig, config).env_kwargs
     if not settings:
@@ -219,7 +219,7 @@ def _finite_mean(values) -> float:
 
 def _rung_order(task: str) -> tuple:
     """Sections follow the task ladder, easiest rung first (unknown tasks last, by name)."""
-    from .registration import tasks
+    from .task_registry import tasks
 
     spec = tasks().get(task)
     return spec.rung if spec is not None else (99, True, task)

@@ -139,7 +139,7 @@ def tasks_page(episodes: int = 100, progress: bool = True) -> str:
 
 
 def write_tasks_page(path, episodes: int = 100, progress: bool = True) -> Path:
-    from .runs import atomic_write
+    from .files import atomic_write
 
     path = Path(path)
     atomic_write(path, tasks_page(episodes, progress))

@@ -28,7 +28,7 @@ from pathlib import Path
 from .configs import StudentConfig, TeacherConfig
 from .ids import CONT, file_stem, world_kind
 from .methods import METHODS, check_methods, methods_for
-from .runs import atomic_write
+from .files import atomic_write
 from .spec import TaskSpec
 from .task_registry import carried, ladder, resolve_task
 

@@ -313,7 +313,7 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
     name = config.run_name()
     table = None
     if method.needs_table and not (Path(root) / name / "result.json").exists():  # a finished run needs none
-        from .registration import resolve_task
+        from .task_registry import resolve_task
 
         if config.table is None:
             raise ValueError(f"method {config.method!r} needs a teacher's table (table.npz of a teacher run)")

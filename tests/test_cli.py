@@ -34,6 +34,13 @@ def test_demo_writes_pictures(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "| CraftSuite/DungeonQuest-Grid7-v0 | 2/2 |" in out
     assert (tmp_path / "DungeonQuest-Grid10-v0.png").read_bytes().startswith(b"\x89PNG")
+    drawn = {p.name for p in tmp_path.glob("*-automaton.*")}
+    assert drawn and all(name.startswith("DungeonQuest-") for name in drawn)  # --task draws its automaton only
+    import cv2
+
+    from craftsuite.rendering import PANEL_HEIGHT
+    picture = cv2.imread(str(tmp_path / "DungeonQuest-Grid10-v0.png"))
+    assert picture.shape[0] == 32 * 10 + PANEL_HEIGHT  # start and end pictures show the status panel
 
 
 def test_help_explains_commands(capsys):

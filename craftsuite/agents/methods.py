@@ -20,7 +20,7 @@ from ..methods import (  # noqa: F401  (METHODS and the defaults re-exported)
     ALGORITHMS, DQN_DEFAULTS, METHODS, TD3_DEFAULTS, Method, algorithm_settings, check_methods)
 from ..envs.base import CraftWorld
 from ..envs.grid import GridWorldEnv
-from ..registration import parse_id, world_kind
+from ..ids import parse_id, world_kind
 from .crm import CRMReplayBuffer
 from .distillation import AutomatonQTable, DistilledTarget, dynamic_distillation, static_distillation
 from .dqn import AutomatonDQN

@@ -193,11 +193,11 @@ def _json_object(text: str | None, flag: str = "--hyper") -> dict:
     return value
 
 
-def _hyper(text: str | None, algorithm: str) -> dict:
-    """``--hyper``'s JSON, checked by name and type against ``algorithm``'s settings before anything runs."""
+def _hyper(text: str | None, algorithm: str, flag: str = "--hyper") -> dict:
+    """``flag``'s JSON, checked by name and type against ``algorithm``'s settings before anything runs."""
     from .methods import check_hyperparameters
 
-    return check_hyperparameters(algorithm, _json_object(text), source="--hyper")
+    return check_hyperparameters(algorithm, _json_object(text, flag), source=flag)
 
 
 def _teacher(args) -> int:
@@ -303,7 +303,7 @@ def _transfer(args) -> int:
     if args.env is not None:
         changes["cont_world_kwargs"] = _json_object(args.env, "--env")
     if args.td3_hyper is not None:
-        changes["td3_hyperparameters"] = {**suite.td3_hyperparameters, **_json_object(args.td3_hyper, "--td3-hyper")}
+        changes["td3_hyperparameters"] = {**suite.td3_hyperparameters, **_hyper(args.td3_hyper, "td3", "--td3-hyper")}
     suite = dataclasses.replace(suite, **changes)
     print(f"suite {suite.name}: {suite.description}")
     result = transfer(suite, args.out, workers=args.workers, ray=args.ray, video=not args.no_video,

@@ -76,7 +76,8 @@ def test_cli_errors_name_the_problem(tmp_path, capsys):
     assert main(["transfer", "--env", '{"frame_skp": 10}', "--out", str(tmp_path / "t")]) == 2
     assert "frame_skp" in capsys.readouterr().err and not (tmp_path / "t").exists()
     assert main(["transfer", "--td3-hyper", '{"learning_rat": 0.001}', "--out", str(tmp_path / "t")]) == 2
-    assert "learning_rat" in capsys.readouterr().err and not (tmp_path / "t").exists()
+    err = capsys.readouterr().err
+    assert "--td3-hyper" in err and "learning_rat" in err and not (tmp_path / "t").exists()
     assert main(["transfer", "--worlds", "Grid10", "--methods", "dqn", "--env", '{"frame_skip": 10}',
                  "--out", str(tmp_path / "t")]) == 2
     assert "these worlds have none: ['Grid10']" in capsys.readouterr().err

@@ -90,8 +90,20 @@ def describe(doc: str) -> tuple[str, str]:
     after the Usage line): the docstring stays the one place that explains the benchmark."""
     paragraphs = [p.strip() for p in doc.strip().split("\n\n")]
     title = paragraphs[0].splitlines()[0].rstrip(".")
-    about = [" ".join(p.split()) for p in paragraphs[1:] if not p.startswith("Usage:")]
+    about = [_unwrap(p) for p in paragraphs[1:] if not p.startswith("Usage:")]
     return title, "\n\n".join(about)
+
+
+def _unwrap(paragraph: str) -> str:
+    """One line per sentence run or list item ("* " or "- "), the docstring's wrapping undone."""
+    items: list[str] = []
+    for line in paragraph.splitlines():
+        line = line.strip()
+        if not items or line.startswith(("* ", "- ")):
+            items.append(line)
+        else:
+            items[-1] += " " + line
+    return "\n".join(items)
 
 
 def render_section(name: str, doc: str, body: str, cmd: str, when: datetime.date | None = None) -> str:

@@ -9,6 +9,7 @@ process, one torch thread, side by side, on the same product env:
   dueling head, no double target): the headline ratio, distillation's own cost;
 * CraftSuite's full agent without distillation (prioritized replay, and for DQN the
   dueling head and double target) and with it (``dynamic`` / ``td3-dynamic``).
+
 A static table stands in for a teacher's: the cost per step is the same (one table
 lookup per sampled transition). Each configuration is built afresh and timed
 ``--repeats`` times, interleaved with the others; the best rate counts (single runs on

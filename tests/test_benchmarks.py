@@ -97,3 +97,9 @@ def test_a_benchmark_run_writes_its_figures_beside_the_target(page_module, tmp_p
     rows = [line for line in section.splitlines() if line.startswith("| CraftSuite/")]
     assert rows and all(row.split("|")[4].strip() in ("yes", "**no**") for row in rows)
     sys.modules.pop("grid_steps", None)
+
+
+def test_a_description_keeps_its_list_items(page_module):
+    title, about = page_module.describe("Title.\n\nUsage: x\n\nFirst, two:\n* one,\n  wrapped;\n* two.\n")
+    assert title == "Title"
+    assert about == "First, two:\n* one, wrapped;\n* two."

@@ -1,6 +1,6 @@
 """How often do the leaderboard's 95% intervals cover the truth, and what does rliable cost?
 
-Usage: python benchmarks/interval_coverage.py [--trials N]
+Usage: python benchmarks/interval_coverage.py [--trials N] [--page PATH | --no-page]
 
 Coverage, on simulated normal seeds (mean 0.3, sd 0.2), of a 95% interval of the mean:
 the Student t-interval the leaderboard uses (``craftsuite.stats.t_interval``) beside the
@@ -24,6 +24,7 @@ import numpy as np
 from scipy import stats as scipy_stats
 
 from craftsuite import stats
+from _page import Report, add_page_argument  # benchmarks/ is on sys.path as a script
 
 MEAN, SD = 0.3, 0.2
 
@@ -62,21 +63,30 @@ def import_seconds(statement: str, repeats: int = 3) -> float | None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--trials", type=int, default=2_000)
+    add_page_argument(parser)
     args = parser.parse_args()
     rng = np.random.default_rng(0)
-    print(f"coverage of a 95% interval of the mean over {args.trials:,} simulated cases (reference: 0.95)")
-    print("seeds  t-interval  percentile bootstrap")
+    report = Report()
+    report(f"Coverage of a 95% interval of the mean over {args.trials:,} simulated cases (reference: 0.95; "
+           f"standard error {np.sqrt(0.95 * 0.05 / args.trials):.3f}):")
+    report()
+    report("| seeds | t-interval (the leaderboard's) | percentile bootstrap (before) |")
+    report("|---|---|---|")
     for n in (2, 3, 5, 10):
         t_cov, boot_cov = coverage_of_the_mean(n, args.trials, rng)
-        t_text = f"{t_cov:10.3f}" if n >= stats.MIN_SEEDS else "      none"
-        print(f"{n:5d}  {t_text}  {boot_cov:20.3f}")
-    print(f"\nstratified-bootstrap IQM interval, 4 tasks x 5 seeds: coverage "
-          f"{coverage_of_the_iqm(args.trials, rng):.3f} over {args.trials:,} cases (reference: 0.95)")
-    print("\nimport cost (fastest of 3 fresh processes)")
-    for name, statement in (("scipy.stats", "import scipy.stats"),
+        t_text = f"{t_cov:.3f}" if n >= stats.MIN_SEEDS else "none (below its minimum of seeds)"
+        report(f"| {n} | {t_text} | {boot_cov:.3f} |")
+    report()
+    report(f"Stratified-bootstrap IQM interval, 4 tasks x 5 seeds: coverage "
+           f"{coverage_of_the_iqm(args.trials, rng):.3f} over {args.trials:,} cases (reference: 0.95).")
+    report()
+    report("| import (fastest of 3 fresh processes) | seconds |")
+    report("|---|---|")
+    for name, statement in (("scipy.stats (what CraftSuite imports)", "import scipy.stats"),
                             ("rliable", "from rliable import library, metrics")):
         seconds = import_seconds(statement)
-        print(f"  {name:12s} " + (f"{seconds:.2f} s" if seconds is not None else "not installed"))
+        report(f"| {name} | " + (f"{seconds:.2f}" if seconds is not None else "not installed") + " |")
+    report.save(__file__, __doc__, args)
 
 
 if __name__ == "__main__":

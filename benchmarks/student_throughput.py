@@ -1,6 +1,6 @@
 """Student throughput: transitions and gradient updates per second, per collection regime.
 
-Usage: python benchmarks/student_throughput.py [--seconds 10]
+Usage: python benchmarks/student_throughput.py [--seconds 10] [--page PATH | --no-page]
 
 One process, one torch thread, Blind Craftsman, TD3 in the MuJoCo world and DQN on the
 10x10 grid: the package's defaults (one env, one update per transition; TD3 [400, 300])
@@ -19,6 +19,7 @@ import time
 import craftsuite  # noqa: F401
 from craftsuite.agents.methods import make_agent
 from craftsuite.suites import DQN_REGIME, TD3_REGIME
+from _page import Report, add_page_argument  # benchmarks/ is on sys.path as a script
 
 CONT, GRID = "CraftSuite/BlindCraftsman-Cont-v0", "CraftSuite/BlindCraftsman-Grid10-v0"
 ROWS = [  # (label, method, env id, n_envs, algorithm settings, reference transitions/s)
@@ -49,17 +50,19 @@ def measure(method, env_id, n_envs, settings, fused: bool, seconds: float) -> tu
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0)
+    add_page_argument(parser)
     args = parser.parse_args()
     import torch
 
     torch.set_num_threads(1)
-    print("| student | Adam | transitions/s | updates/s | reference transitions/s |")
-    print("|---|---|---|---|---|")
+    report = Report()
+    report("| student | Adam | transitions/s | updates/s | reference transitions/s |")
+    report("|---|---|---|---|---|")
     for label, method, env_id, n_envs, settings, reference in ROWS:
         for fused in (False, True):
             tps, ups = measure(method, env_id, n_envs, settings, fused, args.seconds)
-            print(f"| {label} | {'fused' if fused else 'SB3 default'} | {tps:,.0f} | {ups:,.0f} | {reference} |",
-                  flush=True)
+            report(f"| {label} | {'fused' if fused else 'SB3 default'} | {tps:,.0f} | {ups:,.0f} | {reference} |")
+    report.save(__file__, __doc__, args)
 
 
 if __name__ == "__main__":

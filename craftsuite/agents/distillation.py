@@ -191,7 +191,7 @@ class DistilledTarget:
     automaton state unchanged, so the teacher speaks only about progress: its self-loop
     values average over every world state of an automaton state and, trusted early, give
     the student flat, optimistic values that gamma takes long to wash out
-    (docs/benchmarks.md, "Self-loops").
+    (``experiments/self-loops``).
     """
 
     def __init__(self, table: AutomatonQTable, automaton: Automaton, rho: float = 0.999,

@@ -17,7 +17,7 @@ class PersistentActionNoise(ActionNoise):
     """One N(0, sigma) draw held across steps, redrawn with probability ``resample`` per
     step and at every reset: straight runs of about 1 / resample steps, where white noise
     jitters the point mass in place (its 0.2 s time constant averages it out; measured in
-    docs/benchmarks.md, "Exploration")."""
+    ``experiments/td3-horizon-exploration-reach``, "Exploration")."""
 
     def __init__(self, sigma: float, resample: float, dim: int = 2, seed: int = 0):
         if not sigma >= 0:

@@ -1,6 +1,6 @@
 """Why a TD3 student that wins its noisy training episodes fails greedy ones.
 
-Usage: python benchmarks/greedy_stalls.py RUN_DIR [RUN_DIR ...] [--episodes N]
+Usage: python experiments/blind-craftsman-500k/greedy_stalls.py RUN_DIR [RUN_DIR ...] [--episodes N]
 
 For each finished (or checkpointed) MuJoCo student run, its last checkpoint plays the same
 fresh episodes five ways: greedy (the leaderboard's success); with N(0, 0.1) or N(0, 0.3)

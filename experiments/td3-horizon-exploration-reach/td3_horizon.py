@@ -1,6 +1,6 @@
 """TD3 students on a shorter horizon: does a coarser control period let them learn?
 
-Usage: python benchmarks/td3_horizon.py TABLE [--task T] [--frame-skip K] [--limit N]
+Usage: python experiments/td3-horizon-exploration-reach/td3_horizon.py TABLE [--task T] [--frame-skip K] [--limit N]
        [--steps N] [--seed S] [--methods td3 td3-dynamic]
 
 Trains each method (one process per method, one torch thread each) on
@@ -20,7 +20,7 @@ from __future__ import annotations
 import argparse
 from concurrent.futures import ProcessPoolExecutor
 
-from _students import train_with_reports  # benchmarks/ is on sys.path when run as a script
+from _students import train_with_reports  # this folder is on sys.path when run as a script
 from random_walk import random_walk
 
 

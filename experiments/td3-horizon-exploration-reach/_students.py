@@ -1,4 +1,5 @@
-"""What the TD3 benchmark scripts (td3_horizon.py, td3_exploration.py, td3_reach.py) share:
+"""What the TD3 experiment scripts (td3_horizon.py, td3_exploration.py, td3_reach.py here; nstep.py in
+blind-craftsman-500k) share:
 a student trained in-process with a report every few thousand steps."""
 
 from __future__ import annotations
@@ -69,3 +70,21 @@ def train_with_reports(method: str, table: str | None, *, task: str, seed: int, 
 
     agent.learn(steps, callback=Report())
     return rows
+
+
+def main(argv=None) -> None:
+    """``python _students.py [--task Reach] [--steps 5000] [--seed 0]``: one TD3 student from
+    scratch with its reports, to try the helper on its own."""
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--task", default="Reach")
+    parser.add_argument("--steps", type=int, default=5_000)
+    parser.add_argument("--every", type=int, default=2_500)
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args(argv)
+    train_with_reports("td3", None, task=args.task, seed=args.seed, steps=args.steps, every=args.every)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,6 +1,6 @@
 """What exploration alone finds in the MuJoCo worlds: a persistent random walk per task.
 
-Usage: python benchmarks/random_walk.py [--tasks T ...] [--episodes N] [--frame-skip K]
+Usage: python experiments/td3-horizon-exploration-reach/random_walk.py [--tasks T ...] [--episodes N] [--frame-skip K]
 
 The walk keeps a uniform random thrust and draws a new one with probability 0.1 per step
 (about what TD3's early, near-constant actor plus noise does, but livelier). Per task it

@@ -1,7 +1,7 @@
 """TD3 exploration in the MuJoCo worlds: what the action noise reaches, and students with
 a persistent noise.
 
-Usage: python benchmarks/td3_exploration.py TABLE [--task T] [--steps N] [--seed S]
+Usage: python experiments/td3-horizon-exploration-reach/td3_exploration.py TABLE [--task T] [--steps N] [--seed S]
        [--methods td3 td3-dynamic] [--hyper JSON] [--env JSON] [--sigma 0.6] [--resample 0.05]
 
 First, with the actor's output held at zero (what a fresh TD3 actor roughly gives), it
@@ -30,7 +30,7 @@ import json
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
-from _students import EVAL_EPISODES, train_with_reports  # benchmarks/ is on sys.path as a script
+from _students import EVAL_EPISODES, train_with_reports  # this folder is on sys.path as a script
 
 from craftsuite.agents.noise import PersistentActionNoise
 

@@ -1,0 +1,160 @@
+"""docs/performance.md, written by the benchmarks: each script owns one section of it.
+
+A benchmark prints its table (figures beside their targets or references) and hands the
+same lines to :func:`write_section`, which replaces that script's section between its
+markers and leaves the other sections as they were, so any one benchmark can be re-run
+alone. Sections follow ``SECTIONS`` whatever order the scripts ran in, and every section
+says how it was made: the command, the date, the commit and the machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import os
+import platform
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PAGE = ROOT / "docs" / "performance.md"
+
+# The page's order: the package's own speed first (automata, worlds, training), then its statistics.
+SECTIONS = ("automata", "grid_steps", "cont_steps", "training_steps", "student_throughput", "teachers",
+            "interval_coverage")
+
+HEADER = """\
+# Performance
+
+How fast CraftSuite's parts are, and how well its statistics keep their level, each beside
+its target or an outside reference. **This page is written by the benchmark scripts**: each
+script in `benchmarks/` replaces its own section (`make bench` runs them all, about 15
+minutes on 2 cores); edit the scripts, not this page. Each section names the command, date,
+commit and machine that made it. Timings depend on what else the machine was doing: the
+load average at the start of each run is given with its machine, and figures taken beside
+other work understate an idle machine.
+"""
+
+_BEGIN = "<!-- begin section: {} -->"
+_END = "<!-- end section: {} -->"
+
+
+def add_page_argument(parser: argparse.ArgumentParser) -> None:
+    """``--page PATH`` (default docs/performance.md) and ``--no-page`` for every benchmark."""
+    parser.add_argument("--page", type=Path, default=PAGE, help="the page whose section this run replaces")
+    parser.add_argument("--no-page", action="store_true", help="print the figures only; write no page")
+
+
+def machine() -> str:
+    """Cores, CPU model, memory, Python and the load average now, in one line."""
+    model = ""
+    try:
+        model = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
+                      if line.startswith("model name")), "")
+    except OSError:
+        pass
+    model = model or platform.processor() or platform.machine()
+    memory = ""
+    try:
+        kib = int(Path("/proc/meminfo").read_text().split()[1])  # MemTotal comes first
+        memory = f", {kib / 2**20:.0f} GiB"
+    except (OSError, ValueError, IndexError):
+        pass
+    load = ", load average {:.2f}".format(os.getloadavg()[0]) if hasattr(os, "getloadavg") else ""
+    return (f"{os.cpu_count()} cores ({model}){memory}, {platform.system()} {platform.release()}, "
+            f"Python {platform.python_version()}{load}")
+
+
+def commit() -> str:
+    """The short commit of the working tree, marked when files differ from it."""
+    def git(*args):
+        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+
+    head = git("rev-parse", "--short", "HEAD")
+    if not head:
+        return "unknown (not a git checkout)"
+    changed = [line for line in git("status", "--porcelain").splitlines()
+               if not line.endswith(PAGE.relative_to(ROOT).as_posix())]
+    return f"`{head}`" + (" with uncommitted changes" if changed else "")
+
+
+def command(script: str, argv: list[str] | None = None) -> str:
+    args = sys.argv[1:] if argv is None else argv
+    return " ".join(["python", f"benchmarks/{Path(script).name}", *args])
+
+
+def describe(doc: str) -> tuple[str, str]:
+    """A script's title (its docstring's first line) and what it measures (the paragraphs
+    after the Usage line): the docstring stays the one place that explains the benchmark."""
+    paragraphs = [p.strip() for p in doc.strip().split("\n\n")]
+    title = paragraphs[0].splitlines()[0].rstrip(".")
+    about = [_unwrap(p) for p in paragraphs[1:] if not p.startswith("Usage:")]
+    return title, "\n\n".join(about)
+
+
+def _unwrap(paragraph: str) -> str:
+    """One line per sentence run or list item ("* " or "- "), the docstring's wrapping undone."""
+    items: list[str] = []
+    for line in paragraph.splitlines():
+        line = line.strip()
+        if not items or line.startswith(("* ", "- ")):
+            items.append(line)
+        else:
+            items[-1] += " " + line
+    return "\n".join(items)
+
+
+def render_section(name: str, doc: str, body: str, cmd: str, when: datetime.date | None = None) -> str:
+    title, about = describe(doc)
+    when = when or datetime.date.today()
+    return "\n".join([
+        _BEGIN.format(name), f"## {title}", "", about, "", "```bash", cmd, "```", "",
+        f"Measured {when.isoformat()} at commit {commit()}, on {machine()}.", "",
+        body.strip(), _END.format(name)])
+
+
+def read_sections(text: str, page: Path) -> dict[str, str]:
+    """The sections of an existing page, by name; a section whose markers do not pair is an error."""
+    sections = {}
+    for name in re.findall(r"<!-- begin section: (\S+) -->", text):
+        begin, end = _BEGIN.format(name), _END.format(name)
+        start, stop = text.find(begin), text.find(end)
+        if stop < start:
+            raise ValueError(f"{page}: section {name!r} has a begin marker but no end marker after it; "
+                             "mend or delete the page and run the benchmarks again")
+        sections[name] = text[start:stop + len(end)]
+    return sections
+
+
+def write_section(script: str, doc: str, body: str, page: Path = PAGE, argv: list[str] | None = None,
+                  when: datetime.date | None = None) -> Path:
+    """Replace ``script``'s section of ``page`` (creating the page if needed) with ``body``."""
+    name = Path(script).stem
+    if name not in SECTIONS:
+        raise ValueError(f"{name!r} has no section on the performance page; known: {', '.join(SECTIONS)}")
+    page = Path(page)
+    sections = read_sections(page.read_text(), page) if page.exists() else {}
+    sections[name] = render_section(name, doc, body, command(script, argv), when)
+    text = HEADER + "".join(f"\n{sections[n]}\n" for n in SECTIONS if n in sections)
+    page.parent.mkdir(parents=True, exist_ok=True)
+    partial = page.with_name(page.name + ".partial")  # a reader never sees half a page
+    partial.write_text(text)
+    partial.replace(page)
+    return page
+
+
+class Report:
+    """Lines printed as they come and kept for the page: ``report(line)``, then ``report.save(...)``."""
+
+    def __init__(self):
+        self.lines: list[str] = []
+
+    def __call__(self, line: str = "") -> None:
+        print(line, flush=True)
+        self.lines.append(line)
+
+    def save(self, script: str, doc: str, args: argparse.Namespace) -> None:
+        if not args.no_page:
+            print(f"\nwrote {write_section(script, doc, chr(10).join(self.lines), args.page)}")

@@ -1,0 +1,105 @@
+"""The performance page is written by the benchmarks, one section each, and make bench runs them all."""
+
+from __future__ import annotations
+
+import datetime
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+BENCHMARKS = ROOT / "benchmarks"
+DOC = '''Widgets per second, beside the target.
+
+Usage: python benchmarks/x.py [--n N]
+
+Target: at least 3 widgets.
+'''
+
+
+@pytest.fixture()
+def page_module(monkeypatch):
+    monkeypatch.syspath_prepend(str(BENCHMARKS))  # the scripts import their helpers as neighbours
+    import _page
+
+    return _page
+
+
+def write(page_module, name, body, page, day=1):
+    return page_module.write_section(f"benchmarks/{name}.py", DOC, body, page, argv=["--n", "5"],
+                                     when=datetime.date(2026, 1, day))
+
+
+def test_a_section_says_what_made_it(page_module, tmp_path):
+    page = write(page_module, "grid_steps", "| a | b |", tmp_path / "docs" / "performance.md")
+    text = page.read_text()
+    assert text.startswith(page_module.HEADER)
+    assert "## Widgets per second, beside the target" in text
+    assert "Target: at least 3 widgets." in text and "Usage:" not in text
+    assert "python benchmarks/grid_steps.py --n 5" in text
+    assert "Measured 2026-01-01 at commit" in text and "cores" in text
+    assert "| a | b |" in text
+
+
+def test_a_run_replaces_only_its_own_section_and_the_page_keeps_its_order(page_module, tmp_path):
+    page = tmp_path / "performance.md"
+    write(page_module, "teachers", "teachers, first run", page)
+    write(page_module, "automata", "automata figures", page)
+    write(page_module, "teachers", "teachers, second run", page, day=2)
+    text = page.read_text()
+    assert "teachers, first run" not in text and "teachers, second run" in text
+    assert "automata figures" in text
+    assert text.index("automata figures") < text.index("teachers, second run")  # SECTIONS' order, not the runs'
+    assert text.count("<!-- begin section: teachers -->") == 1
+
+
+def test_a_damaged_page_is_named_and_left_as_it_was(page_module, tmp_path):
+    page = tmp_path / "performance.md"
+    damaged = "# Performance\n\n<!-- begin section: automata -->\nhalf a section\n"
+    page.write_text(damaged)
+    with pytest.raises(ValueError, match="automata.*no end marker"):
+        write(page_module, "grid_steps", "figures", page)
+    assert page.read_text() == damaged
+
+
+def test_a_script_without_a_section_is_refused(page_module, tmp_path):
+    with pytest.raises(ValueError, match="no section"):
+        write(page_module, "td3_reach", "figures", tmp_path / "performance.md")
+    assert not (tmp_path / "performance.md").exists()
+
+
+def test_every_benchmark_has_a_section_and_a_line_in_make_bench(page_module):
+    scripts = {p.stem for p in BENCHMARKS.glob("*.py") if not p.name.startswith("_")}
+    assert scripts == set(page_module.SECTIONS)
+    make = (ROOT / "Makefile").read_text()
+    bench = make[make.index("\nbench:"):]
+    bench = bench[:bench.index("\n\n")]
+    assert set(re.findall(r"benchmarks/(\w+)\.py", bench)) == scripts
+
+
+def test_every_benchmark_writes_its_section(page_module):
+    for name in page_module.SECTIONS:
+        source = (BENCHMARKS / f"{name}.py").read_text()
+        assert "add_page_argument(parser)" in source and "report.save(__file__, __doc__, args)" in source, name
+
+
+def test_a_benchmark_run_writes_its_figures_beside_the_target(page_module, tmp_path, monkeypatch):
+    page = tmp_path / "performance.md"
+    monkeypatch.setattr(sys, "argv", ["grid_steps.py", "--steps", "200", "--page", str(page)])
+    import grid_steps
+
+    grid_steps.main()
+    text = page.read_text()
+    section = text[text.index("<!-- begin section: grid_steps -->"):]
+    assert f"target >= {grid_steps.TARGET:,}" in section
+    rows = [line for line in section.splitlines() if line.startswith("| CraftSuite/")]
+    assert rows and all(row.split("|")[4].strip() in ("yes", "**no**") for row in rows)
+    sys.modules.pop("grid_steps", None)
+
+
+def test_a_description_keeps_its_list_items(page_module):
+    title, about = page_module.describe("Title.\n\nUsage: x\n\nFirst, two:\n* one,\n  wrapped;\n* two.\n")
+    assert title == "Title"
+    assert about == "First, two:\n* one, wrapped;\n* two."

@@ -37,3 +37,44 @@ def gl_available():
         import os
         return _GL(False, f"no off-screen GL backend (MUJOCO_GL={os.environ.get('MUJOCO_GL')}): {err}")
     return _GL(True)
+
+
+_TREASURE = """
+name = "{name}"
+formula = "F(coin)"
+
+[propositions]
+coin = {{ obtained = "coin" }}
+
+[items.coin]
+count = 1
+
+[grid]
+sizes = [{size}]
+max_steps = {max_steps}
+"""
+
+
+@pytest.fixture
+def treasure_spec(tmp_path):
+    """A factory of user spec files (one coin to pick up on a small grid), written under
+    ``tmp_path/specs``; whatever of them a test registers is forgotten after it (its ids and
+    its registry entry), so user tasks never leak into other tests."""
+    import gymnasium as gym
+
+    from craftsuite import task_registry
+
+    names = []
+
+    def write(name: str, size: int, max_steps: int):
+        path = tmp_path / "specs" / f"{name.lower()}.toml"
+        path.parent.mkdir(exist_ok=True)
+        path.write_text(_TREASURE.format(name=name, size=size, max_steps=max_steps))
+        names.append(name)
+        return path
+
+    yield write
+    for name in names:
+        for env_id in [i for i in gym.registry if i.startswith(f"CraftSuite/{name}-")]:
+            del gym.registry[env_id]
+        task_registry.tasks().pop(name, None)

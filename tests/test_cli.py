@@ -72,36 +72,10 @@ def test_zero_episodes_is_a_clear_error(capsys):
     assert "must be at least 1" in capsys.readouterr().err
 
 
-SPEC = """
-name = "CliTreasure"
-formula = "F(coin)"
-
-[propositions]
-coin = { obtained = "coin" }
-
-[items.coin]
-count = 1
-
-[grid]
-sizes = [5]
-max_steps = 30
-"""
-
-
 @pytest.fixture
-def spec_file(tmp_path):
-    """A user spec file; the task it registers is forgotten after the test."""
-    import gymnasium as gym
-
-    from craftsuite import task_registry
-
-    path = tmp_path / "specs" / "cli_treasure.toml"
-    path.parent.mkdir()
-    path.write_text(SPEC)
-    yield path
-    for env_id in [i for i in gym.registry if i.startswith("CraftSuite/CliTreasure-")]:
-        del gym.registry[env_id]
-    task_registry.tasks().pop("CliTreasure", None)
+def spec_file(treasure_spec):
+    """A user spec file the CLI has not seen; forgotten after the test."""
+    return treasure_spec("CliTreasure", size=5, max_steps=30)
 
 
 def test_version(capsys):

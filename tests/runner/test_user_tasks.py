@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 
-import gymnasium as gym
 import pytest
 
 import craftsuite
@@ -12,31 +11,12 @@ from craftsuite import task_registry
 from craftsuite.configs import StudentConfig
 from craftsuite.suites import run_students
 
-SPEC = """
-name = "WorkerTreasure"
-formula = "F(coin)"
-
-[propositions]
-coin = { obtained = "coin" }
-
-[items.coin]
-count = 1
-
-[grid]
-sizes = [4]
-max_steps = 20
-"""
-
 
 @pytest.fixture
-def user_task(tmp_path):
-    path = tmp_path / "worker_treasure.toml"
-    path.write_text(SPEC)
-    ids = craftsuite.register_task(path)
-    yield path
-    for env_id in ids:
-        del gym.registry[env_id]
-    del task_registry.tasks()["WorkerTreasure"]
+def user_task(treasure_spec):
+    path = treasure_spec("WorkerTreasure", size=4, max_steps=20)
+    craftsuite.register_task(path)
+    return path
 
 
 def test_students_of_a_user_task_run_in_fresh_worker_processes(user_task, tmp_path):

@@ -12,7 +12,7 @@ from pathlib import Path
 import gymnasium as gym
 
 from . import ids
-from .ids import NAMESPACE, WORLD_KINDS, grid_id, parse_id, world_kind  # noqa: F401  (re-exported)
+from .ids import NAMESPACE, WORLD_KINDS, cont_id, grid_id, parse_id, world_kind  # noqa: F401  (re-exported)
 from .spec import TaskSpec
 from .task_registry import add_task, carried, ladder, resolve_task, tasks  # noqa: F401  (re-exported)
 
@@ -32,10 +32,6 @@ def make_grid(task: str | TaskSpec, size: int, product: bool = False,
 
 
 make_grid.metadata = {"render_modes": ["rgb_array", "ansi"], "render_fps": 8}
-
-
-def cont_id(task: str) -> str:
-    return ids.cont_id(task)
 
 
 def make_continuous(task: str | TaskSpec, product: bool = False, render_mode: str | None = None,

@@ -18,6 +18,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from craftsuite.files import atomic_write
+
 ROOT = Path(__file__).resolve().parents[1]
 PAGE = ROOT / "docs" / "performance.md"
 
@@ -138,10 +140,7 @@ def write_section(script: str, doc: str, body: str, page: Path = PAGE, argv: lis
     sections = read_sections(page.read_text(), page) if page.exists() else {}
     sections[name] = render_section(name, doc, body, command(script, argv), when)
     text = HEADER + "".join(f"\n{sections[n]}\n" for n in SECTIONS if n in sections)
-    page.parent.mkdir(parents=True, exist_ok=True)
-    partial = page.with_name(page.name + ".partial")  # a reader never sees half a page
-    partial.write_text(text)
-    partial.replace(page)
+    atomic_write(page, text)  # a reader never sees half a page
     return page
 
 

@@ -306,8 +306,8 @@ def _transfer(args) -> int:
         changes["td3_hyperparameters"] = {**suite.td3_hyperparameters, **_hyper(args.td3_hyper, "td3", "--td3-hyper")}
     suite = dataclasses.replace(suite, **changes)
     print(f"suite {suite.name}: {suite.description}")
-    result = transfer(suite, args.out, workers=args.workers, ray=args.ray, video=not args.no_video,
-                      command=command_line())
+    out = args.out or f"runs/{args.suite}"
+    result = transfer(suite, out, workers=args.workers, ray=args.ray, video=not args.no_video, command=command_line())
     print(f"leaderboard: {result.leaderboard} (and .csv)")
     for plot in result.plots:
         print(f"learning curves: {plot}")
@@ -452,7 +452,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("transfer", help="a suite end to end: teacher, distillation, students, leaderboard, video")
     p.add_argument("--suite", default="quick", help="; ".join(f"{n}: {s.description}" for n, s in SUITES.items()))
-    p.add_argument("--out", default="runs/quick", help="output directory (default: runs/quick)")
+    p.add_argument("--out", help="output directory (default: runs/<suite>, so suites never share one)")
     p.add_argument("--tags", nargs="+", help="override the suite's rungs: the tasks with any of these tags: "
                    + ", ".join(sorted({t for spec in ladder() for t in spec.tags})))
     p.add_argument("--tasks", nargs="+", help=f"override the suite's rungs: these tasks (with --tags: and these), "
@@ -524,7 +524,8 @@ def main(argv=None) -> int:
         return args.run(args)
     except BrokenPipeError:  # output piped into `head` and the like
         return 0
-    except (KeyError, ValueError, TypeError, RuntimeError, FileNotFoundError, gym_error()) as err:
+    # OSError: a path that cannot be read or written (missing, a file where a folder must be, no permission)
+    except (KeyError, ValueError, TypeError, RuntimeError, OSError, gym_error()) as err:
         if args.debug:
             raise
         print(f"craftsuite {args.command}: error: {err.args[0] if isinstance(err, KeyError) else err}",

@@ -17,7 +17,7 @@ VERSION = "v0"
 WORLD_KINDS = ("Grid", "Cont")
 CONT = "Cont"
 
-_TASK = re.compile(r"[A-Z][A-Za-z0-9]*\Z")  # a task spec's name (spec.py checks the same)
+TASK_NAME = re.compile(r"[A-Z][A-Za-z0-9]*\Z")  # a task spec's name: CamelCase, so ids split on "-" and "/"
 _GRID = re.compile(r"Grid([1-9][0-9]*)\Z")
 
 
@@ -60,7 +60,7 @@ def env_id(task: str, world: str) -> str:
         ValueError: a task name that is no task spec's name (CamelCase letters and digits,
             e.g. a path), or an unknown world.
     """
-    if not isinstance(task, str) or not _TASK.match(task):
+    if not isinstance(task, str) or not TASK_NAME.match(task):
         raise ValueError(f"{task!r} is not a task name (CamelCase letters and digits, e.g. BlindCraftsman)")
     world_kind(world)
     return f"{NAMESPACE}/{task}-{world}-{VERSION}"
@@ -84,7 +84,7 @@ def parse_id(value: str) -> tuple[str, str]:
     """
     namespace, _, rest = value.partition("/") if isinstance(value, str) else ("", "", "")
     parts = rest.split("-")
-    ok = namespace == NAMESPACE and len(parts) == 3 and parts[2] == VERSION and _TASK.match(parts[0])
+    ok = namespace == NAMESPACE and len(parts) == 3 and parts[2] == VERSION and TASK_NAME.match(parts[0])
     if not ok or not (parts[1] == CONT or _GRID.match(parts[1])):
         raise ValueError(f"{value!r} is not a CraftSuite id ({NAMESPACE}/<Task>-<World>-{VERSION}, "
                          f"e.g. {cont_id('Reach')} or {grid_id('Reach', 7)})")

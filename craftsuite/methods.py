@@ -56,7 +56,7 @@ _OFF_POLICY = dict(tau=1.0, train_freq=OneOf((1, [1, "step"])), gradient_steps=1
                    optimize_memory_usage=False, replay_buffer_kwargs={}, stats_window_size=100, device="auto",
                    prioritized=True)
 DQN_MORE = MappingProxyType(dict(_OFF_POLICY, max_grad_norm=10.0, double=True, dueling=True))
-TD3_MORE = MappingProxyType(dict(_OFF_POLICY, tau=0.005, policy_delay=2,
+TD3_MORE = MappingProxyType(dict(_OFF_POLICY, tau=0.005, policy_delay=OneOf((2, None)),  # None: the schedule
                                  delay_schedule=[[20_000, 4], [None, 2]]))
 
 
@@ -83,6 +83,8 @@ def _forms(example) -> tuple[tuple[type, ...], str]:
         return (list, tuple), "a list"
     if isinstance(example, dict):
         return (dict, type(None)), "an object (or null)"  # SB3 reads None as no keywords
+    if example is None:
+        return (type(None),), "null"
     raise TypeError(f"no type rule for the example {example!r}")
 
 
@@ -101,7 +103,9 @@ def check_hyperparameters(algorithm: str, overrides: Mapping | None, source: str
 
     Types follow each setting's example (``hyperparameter_examples``): an integer where it
     is an integer (never true/false), a number (an integer too) where it is a float, true or
-    false strictly, a list, an object.
+    false strictly, a list, an object. Only data is checked (what JSON and run records
+    hold): a Python object given to ``make_agent`` (a learning-rate schedule, an
+    ``ActionNoise``) is the algorithm constructor's to judge.
 
     Raises:
         HyperparameterError: an unknown setting (the message lists the valid ones) or a
@@ -114,14 +118,22 @@ def check_hyperparameters(algorithm: str, overrides: Mapping | None, source: str
     if unknown:
         raise HyperparameterError(f"{source}: {algorithm.upper()} has no setting {', '.join(map(repr, unknown))}; "
                                   f"its settings: {', '.join(sorted(examples))}")
+    defaults = TD3_DEFAULTS if algorithm == "td3" else DQN_DEFAULTS
     for name, value in overrides.items():
+        if not isinstance(value, _DATA):
+            continue
         # a setting of several forms says so in its row of *_MORE, though its default has one
         types, text = _forms(more[name] if isinstance(more.get(name), OneOf) else examples[name])
         if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
-            default = examples[name][0] if isinstance(examples[name], OneOf) else examples[name]
-            raise HyperparameterError(f"{source}: {name} must be {text} (default {default!r}), "
-                                      f"got {value!r}")
+            example = examples[name][0] if isinstance(examples[name], OneOf) else examples[name]
+            # CraftSuite's defaults are what a run gets; the other settings' examples are the
+            # library's defaults, which CraftSuite may replace (TD3's policy_delay: its schedule)
+            shown = f"default {example!r}" if name in defaults else f"e.g. {example!r}"
+            raise HyperparameterError(f"{source}: {name} must be {text} ({shown}), got {value!r}")
     return overrides
+
+
+_DATA = (str, int, float, bool, list, tuple, dict, type(None))  # what JSON and a run's record hold
 
 
 def algorithm_settings(algorithm: str, overrides: Mapping | None = None) -> dict:

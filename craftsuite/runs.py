@@ -14,9 +14,9 @@ A run directory holds
   episode length);
 * ``checkpoint/``: the last model and replay buffer, written together at each evaluation,
   and ``checkpoint-old/``, the one before, kept until the next is complete so that a
-  damaged newest checkpoint can be resumed from the one before (``training._resume``);
-  a student's are removed when it finishes (its final model is ``model.zip``), a
-  teacher's older one;
+  damaged newest checkpoint can be resumed from the one before (``training._resume``,
+  which keeps the damaged one aside as ``checkpoint-unloadable/``); a student's are
+  removed when it finishes (its final model is ``model.zip``), a teacher's older one;
 * ``tb/``: TensorBoard logs (on resume, what the killed run logged after its checkpoint is
   purged, as from the CSV logs);
 * ``result.json``: written last; its presence means the run is finished and reusable. It

@@ -63,6 +63,7 @@ from typing import Any
 
 from .automata import Automaton, LTLfSyntaxError, compile_ltlf, parse
 from .automata.ltlf import atoms
+from .ids import TASK_NAME
 from .paths import assets_dir, tasks_dir
 
 __all__ = [
@@ -278,7 +279,6 @@ class TaskSpec:
 _PALETTE = ["#8b5a2b", "#d9822b", "#3d7dd8", "#7b4fb5", "#2ca58d", "#d64550", "#e0c341",
             "#5c6b73", "#9bc53d", "#f28ab2"]
 _NAME = re.compile(r"[a-z_][a-z0-9_]*\Z")
-_TASK_NAME = re.compile(r"[A-Z][A-Za-z0-9]*\Z")
 _COLOR = re.compile(r"#[0-9a-fA-F]{6}\Z")
 _TOP_KEYS = {"name", "formula", "description", "tags", "extends", "propositions", "items", "places",
              "recipes", "rewards", "grid", "continuous"}
@@ -387,7 +387,7 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
     to inventory names (items' rules, recipes, propositions), then the formula and worlds."""
     r.keys(data, _TOP_KEYS, "top level")
     name = r.str(data, "name", "top level")
-    if not _TASK_NAME.match(name):
+    if not TASK_NAME.match(name):
         r.fail("name", f"must be CamelCase letters and digits (e.g. 'BlindCraftsman'), got {name!r}")
     raw_items, raw_places = _object_tables(r, data)
     raw_recipes, inventory = _inventory(r, data, raw_items)

@@ -18,6 +18,7 @@ from typing import NamedTuple
 
 import gymnasium as gym
 import numpy as np
+import torch
 from stable_baselines3.common.callbacks import BaseCallback
 
 from .configs import StudentConfig, TeacherConfig  # noqa: F401  (defined there, torch-free; re-exported)
@@ -158,13 +159,19 @@ def save_checkpoint(agent, run: RunDir) -> None:
     """Model and replay buffer together: written beside (each flushed to disk), then swapped
     in. The checkpoint they replace stays as ``checkpoint-old`` until the next one is
     complete, so a resume has a complete one to fall back on if the newest is damaged."""
-    new, final, old = run.path / "checkpoint-new", run.checkpoint.parent, run.path / "checkpoint-old"
+    new = run.path / "checkpoint-new"
     shutil.rmtree(new, ignore_errors=True)  # left by a kill while it was written
     new.mkdir()
     with atomic_path(new / "model.zip") as tmp:
         agent.save(tmp)
     with atomic_path(new / "replay.pkl") as tmp:
         agent.save_replay_buffer(tmp)
+    _swap_in(run)
+
+
+def _swap_in(run: RunDir) -> None:
+    """``checkpoint-new`` becomes ``checkpoint``, and ``checkpoint`` ``checkpoint-old``."""
+    new, final, old = run.path / "checkpoint-new", run.checkpoint.parent, run.path / "checkpoint-old"
     if final.exists():
         shutil.rmtree(old, ignore_errors=True)
         final.rename(old)
@@ -172,9 +179,10 @@ def save_checkpoint(agent, run: RunDir) -> None:
 
 
 def checkpoint_dirs(run: RunDir) -> list[Path]:
-    """The run's complete checkpoints (model and replay), newest first: ``checkpoint`` and the
-    one before it, ``checkpoint-old`` (also what a kill in the middle of a swap leaves)."""
-    return [d for d in (run.checkpoint.parent, run.path / "checkpoint-old")
+    """The run's complete checkpoints (model and replay), newest first: ``checkpoint-new``
+    (complete only when a kill came between its writing and the swap: each file is written
+    whole), ``checkpoint`` and the one before it, ``checkpoint-old``."""
+    return [d for d in (run.path / "checkpoint-new", run.checkpoint.parent, run.path / "checkpoint-old")
             if (d / "model.zip").exists() and (d / "replay.pkl").exists()]
 
 
@@ -188,30 +196,43 @@ def _drop_old_checkpoint(run: RunDir) -> None:
     shutil.rmtree(run.path / "checkpoint-old", ignore_errors=True)  # the run is finished: nothing resumes
 
 
+UNLOADABLE = "checkpoint-unloadable"  # where a checkpoint that failed to load is kept aside
+# Errors of the machine, not of a checkpoint's files: they are raised as they are, never read as damage
+_RESOURCES = (MemoryError, torch.cuda.OutOfMemoryError)
+
+
 def _resume(run: RunDir, fresh):
     """The agent of the run's newest checkpoint that loads whole (model and replay buffer,
-    both from one checkpoint), or None when the run has none. A damaged checkpoint (a
-    truncated file, say) is skipped with a warning for the one before it; when none loads,
-    the error names each damaged file and what to do."""
+    both from one checkpoint), or None when the run has none. A checkpoint that cannot be
+    loaded (a truncated file, say) is skipped with a warning for the one before it, and kept
+    aside as ``checkpoint-unloadable``, so that the next swap keeps the one resumed from;
+    when none loads, the error names each file, why, and what to do. Nothing is deleted."""
     import warnings
 
-    damaged = []
+    failed = []
     for saved in checkpoint_dirs(run):
         try:
             agent = _load_checkpoint(saved, fresh)
         except CheckpointError as err:
-            damaged.append(str(err))
+            failed.append((saved, str(err)))
             continue
-        if damaged:
-            warnings.warn(f"{run.path}: resuming from the checkpoint before the newest, which is damaged "
-                          f"({damaged[0]})", RuntimeWarning, stacklevel=3)
+        if failed:
+            aside = run.path / UNLOADABLE
+            shutil.rmtree(aside, ignore_errors=True)
+            failed[0][0].rename(aside)  # the newest failure; an older one is never rotated in again
+            for other, _ in failed[1:]:
+                shutil.rmtree(other, ignore_errors=True)  # older than ``aside``, and unloadable too
+            warnings.warn(f"{run.path}: resuming from {saved.name}, the newest checkpoint that loads; "
+                          f"{failed[0][1]} (kept as {aside})", RuntimeWarning, stacklevel=3)
+        if saved.name == "checkpoint-new":
+            _swap_in(run)  # finish the swap a kill interrupted, so the next save keeps this one
         return agent
-    if damaged:
+    if failed:
         raise CheckpointError(
-            f"{run.path} cannot resume: " + "; ".join(damaged) + ". Delete "
-            + " and ".join(str(run.path / d) for d in ("checkpoint", "checkpoint-old") if (run.path / d).exists())
-            + " to train this run again from step 0 (its logs are trimmed to match), or choose another "
-              "output directory")
+            f"{run.path} cannot resume: " + "; ".join(text for _, text in failed) + ". Move "
+            + " and ".join(str(d) for d, _ in failed)
+            + " aside to train this run again from step 0 (its logs are trimmed to match), or choose "
+              "another output directory")
     return None
 
 
@@ -219,12 +240,16 @@ def _load_checkpoint(saved: Path, fresh):
     model, replay = saved / "model.zip", saved / "replay.pkl"
     try:
         agent = type(fresh).load(model, env=fresh.get_env(), device=fresh.device)
-    except Exception as err:  # whatever a damaged zip raises inside SB3 (BadZipFile, KeyError, EOFError, ...)
-        raise CheckpointError(f"{model} is damaged ({type(err).__name__}: {err})") from None
+    except _RESOURCES:
+        raise  # the machine's limits, not the file's fault: the checkpoint stays a candidate
+    except Exception as err:  # a damaged zip (BadZipFile, KeyError, EOFError, ...), or spaces that differ
+        raise CheckpointError(f"{model} cannot be loaded ({type(err).__name__}: {err})") from None
     try:
         agent.load_replay_buffer(replay)
+    except _RESOURCES:
+        raise
     except Exception as err:  # a truncated pickle: UnpicklingError, EOFError, ...
-        raise CheckpointError(f"{replay} is damaged ({type(err).__name__}: {err})") from None
+        raise CheckpointError(f"{replay} cannot be loaded ({type(err).__name__}: {err})") from None
     agent.replay_buffer.device = agent.device
     return agent
 
@@ -232,8 +257,6 @@ def _load_checkpoint(saved: Path, fresh):
 def _learn(run: RunDir, fresh, total: int, eval_every: int, eval_episodes: int, evaluate_fn, stop_at=None,
            progress=True, desc: str = ""):
     """Train ``fresh`` (or the run's checkpoint, if there is one) up to ``total`` steps."""
-    import torch
-
     agent = _resume(run, fresh)
     if agent is not None:
         run.trim_logs(agent.num_timesteps)

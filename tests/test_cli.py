@@ -66,6 +66,14 @@ def test_video_loads_craftsuite_agents(tmp_path, capsys):
     assert "product=True missing" in capsys.readouterr().err
 
 
+def test_an_output_path_that_cannot_be_written_is_one_line(tmp_path, capsys):
+    (tmp_path / "file").write_text("")
+    assert main(["video", "CraftSuite/Reach-Grid7-v0", "--out", str(tmp_path / "file" / "x.mp4")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("craftsuite video: error:") and "Traceback" not in err and len(err.splitlines()) == 1
+    # (before any episode was rolled out: no progress bar came first)
+
+
 def test_zero_episodes_is_a_clear_error(capsys):
     with pytest.raises(SystemExit):
         main(["demo", "--episodes", "0"])

@@ -66,7 +66,7 @@ def make_agent(method: str, env, *, table: AutomatonQTable | None = None, seed: 
     if m.crm:
         kwargs["replay_buffer_class"] = CRMReplayBuffer
         kwargs["replay_buffer_kwargs"] = {"automaton": automaton, "completion_reward": base.task.completion_reward,
-                                          **kwargs.get("replay_buffer_kwargs", {})}
+                                          **(kwargs.get("replay_buffer_kwargs") or {})}
     target = m.target_kwargs(rho=rho, self_loops=self_loops)
     if m.distill == "dynamic":
         if table is None:
@@ -113,7 +113,7 @@ def distill_from_replay(teacher: AutomatonDQN, chunk: int = 4096) -> AutomatonQT
     actions = buf.actions[:rows].reshape(-1).astype(np.int64)
     q = np.concatenate([teacher.q_values(obs[i:i + chunk]) for i in range(0, len(obs), chunk)])
     q_taken = q[np.arange(len(actions)), actions]
-    automaton = teacher.get_env().envs[0].unwrapped.automaton
+    automaton = _unwrapped(teacher.get_env()).automaton
     return dynamic_distillation(automaton, buf.w[:rows].reshape(-1), buf.sigma[:rows].reshape(-1), q_taken)
 
 

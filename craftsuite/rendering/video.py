@@ -36,6 +36,7 @@ class VideoWriter:
             raise ValueError(f"video path must end in .mp4, got {self.path.name!r}")
         if not fps > 0:
             raise ValueError(f"fps must be positive, got {fps!r}")
+        self.path.parent.mkdir(parents=True, exist_ok=True)  # a folder that cannot be made fails before any frame
         self.fps = fps
         self.frames = 0
         self.codec = CODEC
@@ -43,7 +44,6 @@ class VideoWriter:
         self._encoder = None
 
     def _open(self, width: int, height: int):
-        self.path.parent.mkdir(parents=True, exist_ok=True)
         self._encoder = imageio_ffmpeg.write_frames(
             str(self.path), (width, height), fps=float(self.fps), codec=_ENCODER,
             pix_fmt_in="rgb24", pix_fmt_out=_PIXEL_FORMAT,

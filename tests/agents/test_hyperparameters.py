@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import inspect
 
+import numpy as np
+
 import pytest
 
 from craftsuite.methods import (DQN_DEFAULTS, TD3_DEFAULTS, HyperparameterError, algorithm_settings,
@@ -62,3 +64,25 @@ def test_every_setting_is_a_keyword_of_the_agent_and_every_data_keyword_a_settin
     for name, default in keywords.items():  # the library's default fits each setting's type
         if name in examples and name not in defaults and default is not None and name != "delay_schedule":
             check_hyperparameters(algorithm, {name: default})
+
+
+def test_python_objects_are_the_constructors_to_judge_and_nulls_mean_the_default():
+    """make_agent is also a Python API: a schedule or an ActionNoise is no JSON value to type
+    check, and a null setting (policy_delay: the schedule; replay_buffer_kwargs: none)."""
+    from stable_baselines3.common.noise import NormalActionNoise
+
+    from craftsuite.agents.methods import make_agent
+
+    noise = NormalActionNoise(np.zeros(2), np.full(2, 0.1))
+    agent = make_agent("td3", "CraftSuite/Reach-Cont-v0", learning_rate=lambda progress: 1e-4 * progress,
+                       action_noise=noise, policy_delay=None, buffer_size=64)
+    assert isinstance(agent.action_noise, NormalActionNoise) and agent.lr_schedule(1.0) == pytest.approx(1e-4)
+    assert agent.policy_delay == agent.policy_delay_at(0)  # None leaves the schedule in force
+    crm = make_agent("crm", "CraftSuite/Reach-Grid7-v0", replay_buffer_kwargs=None, buffer_size=64)
+    assert crm.replay_buffer.automaton is crm.get_env().get_attr("automaton", [0])[0]
+
+
+def test_a_library_setting_is_shown_by_example_not_as_craftsuites_default():
+    # policy_delay's library default (2) is not what a CraftSuite run gets (its schedule)
+    with pytest.raises(HyperparameterError, match=r"policy_delay must be an integer or null \(e\.g\. 2\)"):
+        check_hyperparameters("td3", {"policy_delay": "often"})

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import warnings
 
 import pytest
 
@@ -73,29 +74,58 @@ def _truncate(path):
 def test_a_damaged_checkpoint_falls_back_to_the_one_before(interrupted, name):
     run = interrupted
     _truncate(run / "checkpoint" / name)
-    with pytest.warns(RuntimeWarning, match=f"checkpoint/{name} is damaged"):
+    with pytest.warns(RuntimeWarning, match=f"resuming from checkpoint-old.*checkpoint/{name} cannot be loaded"):
         assert train_student(CONFIG, run.parent, progress=False) == run
     result = json.loads((run / "result.json").read_text())
     assert result["steps"] == 300 and result["algorithm"] == "dqn"
     # resumed at 200: the evaluation at 300 was made again, once
     assert [int(r["step"]) for r in read_csv(run / "evals.csv")] == [100, 200, 300]
     assert not (run / "checkpoint").exists() and not (run / "checkpoint-old").exists()
+    assert (run / "checkpoint-unloadable" / name).stat().st_size > 0  # kept aside, not deleted
 
 
-def test_when_no_checkpoint_loads_the_error_says_what_to_delete(interrupted):
+def test_after_a_fallback_the_damaged_checkpoint_never_rotates_back_in(interrupted, monkeypatch):
+    run = interrupted
+    _truncate(run / "checkpoint" / "replay.pkl")
+    # resumed from the checkpoint at 200, killed again after its checkpoint at 300
+    monkeypatch.setattr(RunDir, "write_result", lambda self, result: (_ for _ in ()).throw(KeyboardInterrupt))
+    with pytest.warns(RuntimeWarning), pytest.raises(KeyboardInterrupt):
+        train_student(CONFIG, run.parent, progress=False)
+    monkeypatch.undo()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        _truncate(run / "checkpoint" / "model.zip")  # the one before it must be the good one resumed from
+        with pytest.raises(RuntimeWarning, match="resuming from checkpoint-old"):
+            train_student(CONFIG, run.parent, progress=False)
+
+
+def test_a_kill_between_the_swaps_resumes_from_the_complete_new_checkpoint(interrupted, monkeypatch):
+    import craftsuite.training
+
+    run = interrupted
+    (run / "checkpoint").rename(run / "checkpoint-new")  # killed after checkpoint -> -old, before new -> checkpoint
+    saves = []
+    real = craftsuite.training.save_checkpoint
+    monkeypatch.setattr(craftsuite.training, "save_checkpoint", lambda agent, r: saves.append(r) or real(agent, r))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        assert train_student(CONFIG, run.parent, progress=False) == run
+    assert saves == []  # resumed at 300, its budget: nothing trained again
+    assert not (run / "checkpoint-new").exists()
+
+
+def test_when_no_checkpoint_loads_the_error_says_what_to_move_aside(interrupted):
     run = interrupted
     _truncate(run / "checkpoint" / "replay.pkl")
     _truncate(run / "checkpoint-old" / "model.zip")
     with pytest.raises(CheckpointError) as err:
         train_student(CONFIG, run.parent, progress=False)
     text = str(err.value)
-    assert f"{run / 'checkpoint' / 'replay.pkl'} is damaged" in text
-    assert f"{run / 'checkpoint-old' / 'model.zip'} is damaged" in text
-    assert f"Delete {run / 'checkpoint'} and {run / 'checkpoint-old'} to train this run again from step 0" in text
+    assert f"{run / 'checkpoint' / 'replay.pkl'} cannot be loaded" in text
+    assert f"{run / 'checkpoint-old' / 'model.zip'} cannot be loaded" in text
+    assert f"Move {run / 'checkpoint'} and {run / 'checkpoint-old'} aside to train this run again from step 0" in text
     assert (run / "evals.csv").is_file()  # nothing of the run was removed
     for d in ("checkpoint", "checkpoint-old"):  # done as told, the run trains again from step 0
-        import shutil
-
-        shutil.rmtree(run / d)
+        (run / d).rename(run / f"{d}-aside")
     assert train_student(CONFIG, run.parent, progress=False) == run
     assert [int(r["step"]) for r in read_csv(run / "evals.csv")] == [100, 200, 300]

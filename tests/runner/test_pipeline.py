@@ -88,8 +88,11 @@ def test_transfer_flags_reach_the_suite(tmp_path, monkeypatch):
 
     seen = []
 
+    outs = []
+
     def fake_transfer(suite, out, **_):
         seen.append(suite)
+        outs.append(out)
         return craftsuite.suites.TransferResult(Path(out), {}, [], Path(out) / "leaderboard.md", [], None)
 
     monkeypatch.setattr(craftsuite.suites, "transfer", fake_transfer)
@@ -100,6 +103,10 @@ def test_transfer_flags_reach_the_suite(tmp_path, monkeypatch):
     assert (suite.tags, suite.tasks) == (("medium",), ("Reach",))
     # merged over the suite's own TD3 settings, not replacing them
     assert suite.td3_hyperparameters == {**SUITES["quick"].td3_hyperparameters, "learning_rate": 0.0005}
+    # without --out, each suite writes to a directory of its own
+    monkeypatch.chdir(tmp_path)
+    assert main(["transfer", "--suite", "standard", "--tasks", "Reach", "--worlds", "Grid10", "--methods", "dqn"]) == 0
+    assert seen[-1].name == "standard" and outs[-1] == "runs/standard"
 
 
 def test_suites_are_well_formed(tmp_path):

@@ -64,13 +64,14 @@ def reference(env_id: str, policy: str, episodes: int = 100, seed: int = 0) -> R
 
 
 def _ids_of(name: str) -> list[str]:
-    """A task's ids: the grids by size, then the MuJoCo world."""
-    from .ids import CONT, grid_size, parse_id
+    """A task's ids: the grids by size, then the MuJoCo world, then the kinematic one."""
+    from .ids import CONT_WORLDS, grid_size, parse_id
     from .registration import registered_ids
 
     def order(env_id):
         world = parse_id(env_id)[1]
-        return (world == CONT, 0 if world == CONT else grid_size(world))
+        cont = world in CONT_WORLDS
+        return (cont, CONT_WORLDS.index(world) if cont else grid_size(world))
 
     return sorted((i for i in registered_ids() if parse_id(i)[0] == name), key=order)
 

@@ -214,6 +214,55 @@ class ContinuousScriptedPolicy:
         return np.clip(thrust, -1, 1).astype(np.float32)
 
 
+class KinematicScriptedPolicy:
+    """Acts in a ``KinematicWorldEnv``: ``policy(obs) -> displacement``.
+
+    Moves are jumps (only where they end counts), so no path search: jump at the nearest
+    object of the kind the planner names, shortening (or turning) a jump whose end would
+    touch an object that changes the automaton state, or leave the board.
+    """
+
+    def __init__(self, env):
+        self.env = env.unwrapped
+        self.planner = ObjectivePlanner(self.env.task)
+        angles = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+        self._detours = [np.array([np.cos(a), np.sin(a)]) * r for r in (0.5, 0.25, 1.0) for a in angles]
+
+    def __call__(self, observation=None) -> np.ndarray:
+        return self.toward(self.planner.next_kind_in(self.env))
+
+    def _lands_safely(self, move: np.ndarray, avoid: np.ndarray) -> bool:
+        e = self.env
+        end = e.agent_position + e.step_size * move
+        if not e.on_board(end):
+            return False
+        return not len(avoid) or bool((np.linalg.norm(avoid - end, axis=1) >= e.radius + 0.05).all())
+
+    def toward(self, target: int | None) -> np.ndarray:
+        e = self.env
+        if target is None:
+            return np.zeros(2, dtype=np.float32)
+        pos, w, inv = e.agent_position, e.automaton_state, tuple(e.inventory_counts)
+        kinds = np.array(e._kinds)
+        present = e._present
+        unsafe = [i for i in np.flatnonzero(present)
+                  if kinds[i] != target and not self.planner.harmless(w, inv, int(kinds[i]))]
+        # a place acts on entering: an instance we stand in counts once we have left it
+        goals = np.flatnonzero((kinds == target) & present & ~e._inside)
+        avoid = e._positions[unsafe + np.flatnonzero((kinds == target) & e._inside).tolist()]
+        if len(goals):
+            aim = e._positions[goals[np.linalg.norm(e._positions[goals] - pos, axis=1).argmin()]]
+            move = np.clip((aim - pos) / e.step_size, -1, 1)
+            for scale in (1.0, 0.75, 0.5, 0.25):
+                if self._lands_safely(move * scale, avoid) or (scale == 1.0 and np.allclose(move * e.step_size,
+                                                                                             aim - pos)):
+                    return (move * scale).astype(np.float32)
+        for move in self._detours:  # nothing to aim at safely: step somewhere harmless
+            if self._lands_safely(move, avoid):
+                return move.astype(np.float32)
+        return np.zeros(2, dtype=np.float32)
+
+
 def _grid_path(blocked: np.ndarray, goal: np.ndarray, start: tuple[int, int]):
     """Cells of a shortest 8-connected path from ``start`` into ``goal``, or None."""
     if not goal.any():
@@ -241,10 +290,13 @@ def _grid_path(blocked: np.ndarray, goal: np.ndarray, start: tuple[int, int]):
 
 
 def scripted_policy(env):
-    """The scripted policy for a CraftSuite world, grid or MuJoCo."""
-    from .envs.continuous import ContinuousWorldEnv
+    """The scripted policy for a CraftSuite world: grid, MuJoCo or kinematic."""
+    from .envs.grid import GridWorldEnv
+    from .envs.kinematic import KinematicWorldEnv
 
-    return ContinuousScriptedPolicy(env) if isinstance(env.unwrapped, ContinuousWorldEnv) else GridScriptedPolicy(env)
+    if isinstance(env.unwrapped, KinematicWorldEnv):
+        return KinematicScriptedPolicy(env)
+    return GridScriptedPolicy(env) if isinstance(env.unwrapped, GridWorldEnv) else ContinuousScriptedPolicy(env)
 
 
 def run_episode(env, policy, seed: int | None = None, max_steps: int = 10_000):
@@ -259,5 +311,6 @@ def run_episode(env, policy, seed: int | None = None, max_steps: int = 10_000):
     return total, steps, info
 
 
-__all__ = ["ObjectivePlanner", "GridScriptedPolicy", "ContinuousScriptedPolicy", "scripted_policy",
+__all__ = ["ObjectivePlanner", "GridScriptedPolicy", "ContinuousScriptedPolicy", "KinematicScriptedPolicy",
+           "scripted_policy",
            "run_episode"]

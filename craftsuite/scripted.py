@@ -217,26 +217,21 @@ class ContinuousScriptedPolicy:
 class KinematicScriptedPolicy:
     """Acts in a ``KinematicWorldEnv``: ``policy(obs) -> displacement``.
 
-    Moves are jumps (only where they end counts), so no path search: jump at the nearest
-    object of the kind the planner names, shortening (or turning) a jump whose end would
-    touch an object that changes the automaton state, or leave the board.
+    Moves are jumps (only where one ends counts), so no path search: jump onto the nearest
+    object of the kind the planner names when it is in reach, else to the point in reach
+    (on a 25 x 25 lattice of moves) nearest to it (Chebyshev: a jump covers a square) whose
+    end touches no object that would change the automaton state.
     """
 
     def __init__(self, env):
         self.env = env.unwrapped
         self.planner = ObjectivePlanner(self.env.task)
-        angles = np.linspace(0, 2 * np.pi, 16, endpoint=False)
-        self._detours = [np.array([np.cos(a), np.sin(a)]) * r for r in (0.5, 0.25, 1.0) for a in angles]
+        axis = np.linspace(-1.0, 1.0, 25)
+        # float32, the actions' type: ends are checked where the world will put them
+        self._moves = np.array([(x, y) for x in axis for y in axis], dtype=np.float32)
 
     def __call__(self, observation=None) -> np.ndarray:
         return self.toward(self.planner.next_kind_in(self.env))
-
-    def _lands_safely(self, move: np.ndarray, avoid: np.ndarray) -> bool:
-        e = self.env
-        end = e.agent_position + e.step_size * move
-        if not e.on_board(end):
-            return False
-        return not len(avoid) or bool((np.linalg.norm(avoid - end, axis=1) >= e.radius + 0.05).all())
 
     def toward(self, target: int | None) -> np.ndarray:
         e = self.env
@@ -251,16 +246,24 @@ class KinematicScriptedPolicy:
         goals = np.flatnonzero((kinds == target) & present & ~e._inside)
         avoid = e._positions[unsafe + np.flatnonzero((kinds == target) & e._inside).tolist()]
         if len(goals):
-            aim = e._positions[goals[np.linalg.norm(e._positions[goals] - pos, axis=1).argmin()]]
-            move = np.clip((aim - pos) / e.step_size, -1, 1)
-            for scale in (1.0, 0.75, 0.5, 0.25):
-                if self._lands_safely(move * scale, avoid) or (scale == 1.0 and np.allclose(move * e.step_size,
-                                                                                             aim - pos)):
-                    return (move * scale).astype(np.float32)
-        for move in self._detours:  # nothing to aim at safely: step somewhere harmless
-            if self._lands_safely(move, avoid):
-                return move.astype(np.float32)
-        return np.zeros(2, dtype=np.float32)
+            aims = e._positions[goals]
+            # objects on the board's edge (x or y = 0): aim 1e-4 inside, or the float32 action's
+            # rounding (~1e-7 here) could end the jump just off the board, rejecting the move
+            aim = np.clip(aims[np.abs(aims - pos).max(axis=1).argmin()], 1e-4, e.arena - 1e-4)
+            if np.abs(aim - pos).max() <= e.step_size:  # in reach: land on it
+                return ((aim - pos) / e.step_size).astype(np.float32)
+        ends = pos + e.step_size * self._moves.astype(np.float64)
+        ok = (ends >= 0).all(axis=1) & (ends < e.arena).all(axis=1) & ~e._in_obstacle(ends)
+        if len(avoid):
+            ok &= (np.linalg.norm(ends[:, None, :] - avoid[None, :, :], axis=2) >= e.radius + 0.05).all(axis=1)
+        if not ok.any():
+            return np.zeros(2, dtype=np.float32)
+        if len(goals):
+            score = np.abs(ends - aim).max(axis=1) + 1e-3 * np.linalg.norm(ends - aim, axis=1)
+        else:  # only instances we stand in: the shortest safe step out of them
+            score = np.linalg.norm(self._moves, axis=1)
+        score[~ok] = np.inf
+        return self._moves[score.argmin()].copy()
 
 
 def _grid_path(blocked: np.ndarray, goal: np.ndarray, start: tuple[int, int]):

@@ -1,8 +1,8 @@
 """The kinematic world: the authors' continuous toy (no physics, no MuJoCo), the same tasks,
 rules, labels and automaton as the grids and the MuJoCo world.
 
-The step follows the authors' ``MineWorldEnvContinuous.step`` in
-``discrete/lib/env/mineworldenv.py`` (repository adenm-10/Automaton_Distillation): the
+The step follows the authors' discrete/lib/env/mineworldenv.py (``MineWorldEnvContinuous.step``,
+repository adenm-10/Automaton_Distillation): the
 position moves by ``3.0 * action`` on a 7 x 7 board ``[0, 7) x [0, 7)``; a move that would
 leave the board is rejected (the agent stays, -0.1) and touches nothing; objects within 0.4
 (strictly) of the new position are touched; objects sit on the board's integer points

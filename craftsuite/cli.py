@@ -39,7 +39,7 @@ def _registered(task: str, world: str) -> str:
 
 
 def _world(text: str) -> str:
-    """``--world``: Cont or Grid<size> (argparse names a bad one at once)."""
+    """``--world``: Cont, Kinematic or Grid<size> (argparse names a bad one at once)."""
     from .ids import world_kind
 
     try:
@@ -50,11 +50,11 @@ def _world(text: str) -> str:
 
 
 def _known_worlds() -> list[str]:
-    """The worlds of the known tasks: Cont, then the grids by size."""
-    from .ids import CONT, grid_world
+    """The worlds of the known tasks: Cont, Kinematic, then the grids by size."""
+    from .ids import CONT_WORLDS, grid_world
     from .task_registry import tasks
 
-    return [CONT] + [grid_world(n) for n in sorted({n for spec in tasks().values() for n in spec.grid.sizes})]
+    return [*CONT_WORLDS] + [grid_world(n) for n in sorted({n for spec in tasks().values() for n in spec.grid.sizes})]
 
 
 class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
@@ -433,7 +433,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--method", default="td3-dynamic", choices=list(METHODS), metavar="METHOD",
                    help=f"one of {methods} (craftsuite.methods.METHODS; default: td3-dynamic)")
     p.add_argument("--world", default="Cont", type=_world,
-                   help=f"Cont (MuJoCo) or Grid<size>, a world of the task; the known tasks': {worlds}")
+                   help=f"Cont (MuJoCo), Kinematic or Grid<size>, a world of the task; the known tasks': {worlds}")
     p.add_argument("--table", help="a teacher's table.npz (craftsuite teacher), for the methods that distil one: "
                    + ", ".join(m for m, row in METHODS.items() if row.needs_table))
     p.add_argument("--out", default="runs/students", help="runs directory (default: runs/students)")
@@ -458,7 +458,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--tasks", nargs="+", help=f"override the suite's rungs: these tasks (with --tags: and these), "
                    f"each {task_help}")
     p.add_argument("--worlds", nargs="+", choices=_known_worlds(),
-                   help="override the student worlds (Cont: TD3 methods; Grid10, Grid7: DQN methods)")
+                   help="override the student worlds (Cont, Kinematic: TD3 methods; Grid10, Grid7: DQN methods)")
     p.add_argument("--methods", nargs="+", metavar="METHOD", help=f"override the suite's methods: any of {methods}")
     p.add_argument("--seeds", type=_positive, help="override the number of seeds")
     p.add_argument("--steps", type=_positive, help="one student budget for every rung (transitions)")

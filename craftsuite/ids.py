@@ -1,7 +1,8 @@
 """The gymnasium ids of CraftSuite: ``CraftSuite/<Task>-<World>-v0``, built and read here only.
 
-A world is ``Grid<size>`` (e.g. ``Grid7``, ``Grid10``) or ``Cont`` (the MuJoCo world); its
-kind is ``Grid`` or ``Cont``. Everything that names an env calls ``env_id`` (or
+A world is ``Grid<size>`` (e.g. ``Grid7``, ``Grid10``), ``Cont`` (the MuJoCo world) or
+``Kinematic`` (the authors' kinematic toy); its kind is ``Grid`` or ``Cont`` (both continuous
+worlds take the same 2-d actions, so every TD3 method runs in either). Everything that names an env calls ``env_id`` (or
 ``grid_id`` / ``cont_id``) and everything that reads one calls ``parse_id``, so the format
 lives in one place. This module imports nothing of gymnasium or the worlds.
 """
@@ -16,22 +17,25 @@ VERSION = "v0"
 # ``Grid10``) and the MuJoCo world (``Cont``).
 WORLD_KINDS = ("Grid", "Cont")
 CONT = "Cont"
+KINEMATIC = "Kinematic"
+# the worlds of kind Cont, the MuJoCo world first
+CONT_WORLDS = (CONT, KINEMATIC)
 
 TASK_NAME = re.compile(r"[A-Z][A-Za-z0-9]*\Z")  # a task spec's name: CamelCase, so ids split on "-" and "/"
 _GRID = re.compile(r"Grid([1-9][0-9]*)\Z")
 
 
 def world_kind(world: str) -> str:
-    """The kind of a world: ``Grid10`` -> ``Grid``, ``Cont`` -> ``Cont``.
+    """The kind of a world: ``Grid10`` -> ``Grid``, ``Cont`` and ``Kinematic`` -> ``Cont``.
 
     Raises:
-        ValueError: a world that is neither.
+        ValueError: a world that is none of these.
     """
-    if world == CONT:
+    if world in CONT_WORLDS:
         return CONT
     if isinstance(world, str) and _GRID.match(world):
         return "Grid"
-    raise ValueError(f"unknown world {world!r}: use Cont (MuJoCo) or Grid<size>, e.g. Grid10")
+    raise ValueError(f"unknown world {world!r}: use Cont (MuJoCo), Kinematic or Grid<size>, e.g. Grid10")
 
 
 def grid_world(size: int) -> str:
@@ -76,6 +80,11 @@ def cont_id(task: str) -> str:
     return env_id(task, CONT)
 
 
+def kinematic_id(task: str) -> str:
+    """The id of a task in the kinematic world: ``CraftSuite/<task>-Kinematic-v0``."""
+    return env_id(task, KINEMATIC)
+
+
 def parse_id(value: str) -> tuple[str, str]:
     """``CraftSuite/<Task>-<World>-v0`` -> (task, world), e.g. ("Reach", "Grid10").
 
@@ -85,7 +94,7 @@ def parse_id(value: str) -> tuple[str, str]:
     namespace, _, rest = value.partition("/") if isinstance(value, str) else ("", "", "")
     parts = rest.split("-")
     ok = namespace == NAMESPACE and len(parts) == 3 and parts[2] == VERSION and TASK_NAME.match(parts[0])
-    if not ok or not (parts[1] == CONT or _GRID.match(parts[1])):
+    if not ok or not (parts[1] in CONT_WORLDS or _GRID.match(parts[1])):
         raise ValueError(f"{value!r} is not a CraftSuite id ({NAMESPACE}/<Task>-<World>-{VERSION}, "
                          f"e.g. {cont_id('Reach')} or {grid_id('Reach', 7)})")
     return parts[0], parts[1]

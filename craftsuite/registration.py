@@ -2,7 +2,7 @@
 
 The tasks themselves live in ``task_registry`` (names, ladder, user specs), the id format in
 ``ids``; this module registers each task's ids with gymnasium and holds their entry points
-(``make_grid``, ``make_continuous``). Their names stay importable from here.
+(``make_grid``, ``make_continuous``, ``make_kinematic``). Their names stay importable from here.
 """
 
 from __future__ import annotations
@@ -12,8 +12,8 @@ from pathlib import Path
 import gymnasium as gym
 
 from . import ids
-from .ids import NAMESPACE, WORLD_KINDS, cont_id, grid_id, parse_id, world_kind  # noqa: F401  (re-exported)
-from .spec import TaskSpec
+from .ids import NAMESPACE, WORLD_KINDS, cont_id, grid_id, kinematic_id, parse_id, world_kind  # noqa: F401  (re-exported)
+from .spec import KINEMATIC, TaskSpec
 from .task_registry import add_task, carried, ladder, resolve_task, tasks  # noqa: F401  (re-exported)
 
 
@@ -52,6 +52,22 @@ def make_continuous(task: str | TaskSpec, product: bool = False, render_mode: st
 make_continuous.metadata = {"render_modes": ["rgb_array"], "render_fps": 4}  # the default world; each env sets its own
 
 
+def make_kinematic(task: str | TaskSpec, product: bool = False, render_mode: str | None = None,
+                   width: int = 240, height: int = 240, status_panel: bool = False) -> gym.Env:
+    """Entry point of the kinematic ids (the authors' continuous toy, no MuJoCo);
+    ``product=True`` adds the automaton one-hot, ``width`` x ``height`` the frame,
+    ``status_panel=True`` draws the inventory and automaton state under each frame."""
+    from .envs.kinematic import KinematicWorldEnv
+    from .wrappers import AutomatonObservation
+
+    env = KinematicWorldEnv(task, render_mode=render_mode, width=width, height=height,
+                            status_panel=status_panel)
+    return AutomatonObservation(env) if product else env
+
+
+make_kinematic.metadata = {"render_modes": ["rgb_array"], "render_fps": 8}
+
+
 def _register(spec: TaskSpec) -> list[str]:
     # the ids carry the task as plain data (a built-in by name, a user task as its TOML data):
     # worker processes of vector envs need not re-register it, and EnvSpec.to_json works
@@ -59,6 +75,7 @@ def _register(spec: TaskSpec) -> list[str]:
     worlds = [(grid_id(spec.name, size), "make_grid", {"size": size}, spec.grid.max_steps)
               for size in spec.grid.sizes]
     worlds.append((cont_id(spec.name), "make_continuous", {}, spec.continuous.max_steps))
+    worlds.append((kinematic_id(spec.name), "make_kinematic", {}, KINEMATIC.max_steps))
     for env_id, entry, kwargs, max_steps in worlds:
         if env_id in gym.registry:
             del gym.registry[env_id]  # re-registering a task replaces its ids

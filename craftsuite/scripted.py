@@ -214,6 +214,58 @@ class ContinuousScriptedPolicy:
         return np.clip(thrust, -1, 1).astype(np.float32)
 
 
+class KinematicScriptedPolicy:
+    """Acts in a ``KinematicWorldEnv``: ``policy(obs) -> displacement``.
+
+    Moves are jumps (only where one ends counts), so no path search: jump onto the nearest
+    object of the kind the planner names when it is in reach, else to the point in reach
+    (on a 25 x 25 lattice of moves) nearest to it (Chebyshev: a jump covers a square) whose
+    end touches no object that would change the automaton state.
+    """
+
+    def __init__(self, env):
+        self.env = env.unwrapped
+        self.planner = ObjectivePlanner(self.env.task)
+        axis = np.linspace(-1.0, 1.0, 25)
+        # float32, the actions' type: ends are checked where the world will put them
+        self._moves = np.array([(x, y) for x in axis for y in axis], dtype=np.float32)
+
+    def __call__(self, observation=None) -> np.ndarray:
+        return self.toward(self.planner.next_kind_in(self.env))
+
+    def toward(self, target: int | None) -> np.ndarray:
+        e = self.env
+        if target is None:
+            return np.zeros(2, dtype=np.float32)
+        pos, w, inv = e.agent_position, e.automaton_state, tuple(e.inventory_counts)
+        kinds = np.array(e._kinds)
+        present = e._present
+        unsafe = [i for i in np.flatnonzero(present)
+                  if kinds[i] != target and not self.planner.harmless(w, inv, int(kinds[i]))]
+        # a place acts on entering: an instance we stand in counts once we have left it
+        goals = np.flatnonzero((kinds == target) & present & ~e._inside)
+        avoid = e._positions[unsafe + np.flatnonzero((kinds == target) & e._inside).tolist()]
+        if len(goals):
+            aims = e._positions[goals]
+            # objects on the board's edge (x or y = 0): aim 1e-4 inside, or the float32 action's
+            # rounding (~1e-7 here) could end the jump just off the board, rejecting the move
+            aim = np.clip(aims[np.abs(aims - pos).max(axis=1).argmin()], 1e-4, e.arena - 1e-4)
+            if np.abs(aim - pos).max() <= e.step_size:  # in reach: land on it
+                return ((aim - pos) / e.step_size).astype(np.float32)
+        ends = pos + e.step_size * self._moves.astype(np.float64)
+        ok = (ends >= 0).all(axis=1) & (ends < e.arena).all(axis=1) & ~e._in_obstacle(ends)
+        if len(avoid):
+            ok &= (np.linalg.norm(ends[:, None, :] - avoid[None, :, :], axis=2) >= e.radius + 0.05).all(axis=1)
+        if not ok.any():
+            return np.zeros(2, dtype=np.float32)
+        if len(goals):
+            score = np.abs(ends - aim).max(axis=1) + 1e-3 * np.linalg.norm(ends - aim, axis=1)
+        else:  # only instances we stand in: the shortest safe step out of them
+            score = np.linalg.norm(self._moves, axis=1)
+        score[~ok] = np.inf
+        return self._moves[score.argmin()].copy()
+
+
 def _grid_path(blocked: np.ndarray, goal: np.ndarray, start: tuple[int, int]):
     """Cells of a shortest 8-connected path from ``start`` into ``goal``, or None."""
     if not goal.any():
@@ -241,10 +293,13 @@ def _grid_path(blocked: np.ndarray, goal: np.ndarray, start: tuple[int, int]):
 
 
 def scripted_policy(env):
-    """The scripted policy for a CraftSuite world, grid or MuJoCo."""
-    from .envs.continuous import ContinuousWorldEnv
+    """The scripted policy for a CraftSuite world: grid, MuJoCo or kinematic."""
+    from .envs.grid import GridWorldEnv
+    from .envs.kinematic import KinematicWorldEnv
 
-    return ContinuousScriptedPolicy(env) if isinstance(env.unwrapped, ContinuousWorldEnv) else GridScriptedPolicy(env)
+    if isinstance(env.unwrapped, KinematicWorldEnv):
+        return KinematicScriptedPolicy(env)
+    return GridScriptedPolicy(env) if isinstance(env.unwrapped, GridWorldEnv) else ContinuousScriptedPolicy(env)
 
 
 def run_episode(env, policy, seed: int | None = None, max_steps: int = 10_000):
@@ -259,5 +314,6 @@ def run_episode(env, policy, seed: int | None = None, max_steps: int = 10_000):
     return total, steps, info
 
 
-__all__ = ["ObjectivePlanner", "GridScriptedPolicy", "ContinuousScriptedPolicy", "scripted_policy",
+__all__ = ["ObjectivePlanner", "GridScriptedPolicy", "ContinuousScriptedPolicy", "KinematicScriptedPolicy",
+           "scripted_policy",
            "run_episode"]

@@ -162,6 +162,21 @@ class ContinuousConfig:
         return skip
 
 
+@dataclass(frozen=True)
+class KinematicConfig:
+    """The kinematic world's own values, the authors' (their ``MineWorldEnvContinuous`` in
+    ``discrete/lib/env/mineworldenv.py``, adenm-10/Automaton_Distillation): a full action moves
+    the agent ``step`` board units, and an episode lasts ``max_steps`` steps. The board side,
+    pickup radius and off-board penalty are ``ContinuousConfig``'s, which equal theirs.
+    The same for every task (theirs are), hence no spec section."""
+
+    step: float = 3.0
+    max_steps: int = 1000
+
+
+KINEMATIC = KinematicConfig()
+
+
 @cache
 def physics_timestep() -> float:
     """The MuJoCo worlds' physics step in seconds, as ``assets/arena.xml`` sets it; read

@@ -126,7 +126,7 @@ def test_help_lists_the_choices_of_the_registries():
     assert all(method in helps["student"] for method in METHODS)
     assert all(f"{suite}:" in helps["transfer"] for suite in SUITES)
     sizes = {n for spec in task_registry.tasks().values() for n in spec.grid.sizes}
-    for world in [ids.CONT] + [ids.grid_world(n) for n in sizes]:
+    for world in [*ids.CONT_WORLDS] + [ids.grid_world(n) for n in sizes]:
         assert world in helps["student"] and world in helps["transfer"]
 
 
@@ -147,7 +147,7 @@ def test_a_bad_task_or_world_is_named_and_nothing_is_written(tmp_path, capsys, c
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err and "doesn't exist" not in err
     assert ("unknown task 'Nope'; known tasks: [" in err and "'Reach'" in err) or \
-        "task 'Reach' has no Grid5 world; its worlds: ['Cont', 'Grid10', 'Grid7']" in err
+        "task 'Reach' has no Grid5 world; its worlds: ['Cont', 'Grid10', 'Grid7', 'Kinematic']" in err
     assert not out.exists()
 
 

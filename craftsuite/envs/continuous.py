@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import numbers
-
 import gymnasium as gym
 import mujoco
 import numpy as np
 
+from ..rendering.frames import MAX_FRAME_SIDE, frame_side  # noqa: F401  (MAX_FRAME_SIDE re-exported)
 from ..rendering.gl import gl_error_hint
 from ..rendering.panel import PANEL_HEIGHT, add_status_panel
 from ..spec import TaskSpec
@@ -17,19 +16,6 @@ from .scene import AGENT_HALF, build_scene
 TOP_SPEED = 2.0  # m/s at full thrust (gear 10 / damping 5 in assets/arena.xml)
 _PLACEMENT_TRIES = 200
 _FAR = 1e6  # where consumed objects are parked: never within reach
-# Largest frame side: MuJoCo's off-screen framebuffer is grown to the frame asked for, and
-# software GL (OSMesa) renders 8192 x 8192 but cannot allocate a 16384-pixel framebuffer.
-MAX_FRAME_SIDE = 8192
-
-
-def frame_side(name: str, value) -> int:
-    """``value`` if it is a whole number of pixels in [1, MAX_FRAME_SIDE]; else a ValueError
-    naming the argument (checked before any OpenGL work, whose errors would not say so)."""
-    if not isinstance(value, numbers.Integral) or isinstance(value, bool) or not 1 <= value <= MAX_FRAME_SIDE:
-        raise ValueError(f"{name} must be a whole number of pixels in [1, {MAX_FRAME_SIDE}], got {value!r}")
-    return int(value)
-
-
 class ContinuousWorldEnv(CraftWorld):
     """A CraftSuite task in a MuJoCo arena with a point-mass agent.
 

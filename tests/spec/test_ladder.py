@@ -64,7 +64,7 @@ def test_cli_lists_the_rungs_of_a_tag(capsys, tmp_path):
 @pytest.mark.parametrize("name", sorted(BUILTIN))
 def test_every_rung_is_registered_in_every_world(name):
     ids = {parse_id(i)[1] for i in craftsuite.registered_ids() if parse_id(i)[0] == name}
-    assert ids == {"Grid7", "Grid10", "Cont"}
+    assert ids == {"Grid7", "Grid10", "Cont", "Kinematic"}
 
 
 @pytest.mark.parametrize("env_id", BUILTIN_IDS)
@@ -98,9 +98,9 @@ def test_the_committed_tasks_page_lists_every_builtin_rung():
     page = (Path(__file__).resolve().parents[2] / "docs" / "tasks.md").read_text()
     for spec in BUILTIN.values():
         assert f"## {spec.name}" in page, f"docs/tasks.md lacks {spec.name}: run craftsuite tasks --markdown docs/tasks.md"
-        for world in ("Grid7", "Grid10", "Cont"):
+        for world in ("Grid7", "Grid10", "Cont", "Kinematic"):
             assert f"`CraftSuite/{spec.name}-{world}-v0`" in page
     # every id row's episode limit is the registered one (a changed limit or a stale id fails)
     rows = dict(re.findall(r"^\| `(CraftSuite/[\w-]+)` \| (\d+) \|", page, flags=re.M))
-    assert set(rows) == {f"CraftSuite/{n}-{w}-v0" for n in BUILTIN for w in ("Grid7", "Grid10", "Cont")}
+    assert set(rows) == {f"CraftSuite/{n}-{w}-v0" for n in BUILTIN for w in ("Grid7", "Grid10", "Cont", "Kinematic")}
     assert {i: int(limit) for i, limit in rows.items()} == {i: gym.spec(i).max_episode_steps for i in rows}

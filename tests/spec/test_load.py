@@ -136,7 +136,7 @@ def test_extends_cycle(tmp_path):
 
 def test_user_spec_registers_and_runs(tmp_path):
     ids = craftsuite.register_task(write(tmp_path, GOOD))
-    assert ids == ["CraftSuite/Treasure-Grid5-v0", "CraftSuite/Treasure-Cont-v0"]
+    assert ids == ["CraftSuite/Treasure-Grid5-v0", "CraftSuite/Treasure-Cont-v0", "CraftSuite/Treasure-Kinematic-v0"]
     env = gym.make(ids[0], product=True)
     obs, info = env.reset(seed=1)
     assert obs.shape == env.observation_space.shape

@@ -40,3 +40,13 @@ class CraftWorld(gym.Env):
     @property
     def inventory(self) -> dict[str, int]:
         return dict(zip(self.rules.inventory_names, self.inventory_counts))
+
+    def _can_render(self, started: bool) -> bool:
+        """Whether ``render()`` has a frame to draw: False (with gymnasium's warning) without
+        a render mode; before the first ``reset`` (``started`` False), a RuntimeError."""
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode= to make()")
+            return False
+        if not started:
+            raise RuntimeError("call reset() before render()")
+        return True

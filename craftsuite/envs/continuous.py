@@ -2,21 +2,20 @@
 
 from __future__ import annotations
 
-import gymnasium as gym
 import mujoco
 import numpy as np
 
 from ..rendering.frames import MAX_FRAME_SIDE, frame_side  # noqa: F401  (MAX_FRAME_SIDE re-exported)
 from ..rendering.gl import gl_error_hint
-from ..rendering.panel import PANEL_HEIGHT, add_status_panel
+from ..rendering.panel import add_status_panel
 from ..spec import TaskSpec
-from .base import CraftWorld
+from .planar import PlanarWorld
 from .scene import AGENT_HALF, build_scene
 
 TOP_SPEED = 2.0  # m/s at full thrust (gear 10 / damping 5 in assets/arena.xml)
 _PLACEMENT_TRIES = 200
 _FAR = 1e6  # where consumed objects are parked: never within reach
-class ContinuousWorldEnv(CraftWorld):
+class ContinuousWorldEnv(PlanarWorld):
     """A CraftSuite task in a MuJoCo arena with a point-mass agent.
 
     ## Description
@@ -73,6 +72,7 @@ class ContinuousWorldEnv(CraftWorld):
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 4}  # at the default 0.25 s; __init__ sets 1 / period
+    AGENT_FIELDS = {"agent_position": slice(0, 2), "agent_velocity": slice(2, 4)}
 
     def __init__(self, task: str | TaskSpec = "BlindCraftsman", render_mode: str | None = None,
                  width: int = 240, height: int = 240, frame_skip: int | None = None,
@@ -105,26 +105,14 @@ class ContinuousWorldEnv(CraftWorld):
         self._body_ids = np.array([self.model.body(n).id for n in scene.object_bodies])
         self._geom_ids = np.array([self.model.geom(n).id for n in scene.object_bodies])
         self._rgba = self.model.geom_rgba[self._geom_ids].copy()
-        self._kinds = list(scene.object_kinds)
+        self._lay_out(scene.object_kinds)
         n_obj = len(self._kinds)
-        self._is_item = np.array([k < self.rules.n_items for k in self._kinds])
-        self._inv_offset = 4 + 3 * n_obj
-        n_obs = self._inv_offset + len(self.rules.inventory_names)
-        self.observation_space = gym.spaces.Box(-1.0, 1.0, (n_obs,), dtype=np.float32)
-        self.action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
-        self._step_reward = spec.step_reward
-        self._boundary_reward = cfg.boundary_reward
         self._wall_limit = self.half - AGENT_HALF - 0.02  # agent touching the boundary wall
-        self._obs = np.zeros(n_obs, dtype=np.float32)
-        self._positions = np.zeros((n_obj, 2))
-        self._present = np.zeros(n_obj, dtype=bool)
-        self._inside = np.zeros(n_obj, dtype=bool)
         self._any_inside = False
         self._radius2 = self.radius ** 2
         self._offset_scale = np.zeros((n_obj, 1))
         self._obs_objects = self._object_view()
         self._renderer = None
-        self._started = False
         self.inventory_counts = self.rules.new_inventory()
 
     def _spec_frame_skip(self) -> int:
@@ -141,34 +129,8 @@ class ContinuousWorldEnv(CraftWorld):
 
     # -- public views --------------------------------------------------------------------------
     @property
-    def observation_layout(self) -> dict:
-        n_obj = len(self._kinds)
-        return {
-            "agent_position": slice(0, 2), "agent_velocity": slice(2, 4),
-            "objects": slice(4, 4 + 3 * n_obj),  # (dx, dy, present) per slot
-            "object_names": tuple(self.task.objects[k].name for k in self._kinds),
-            "inventory": slice(self._inv_offset, self._inv_offset + len(self.inventory_counts)),
-            "inventory_names": self.rules.inventory_names,
-        }
-
-    @property
     def agent_position(self) -> np.ndarray:
         return self.data.qpos[:2].copy()
-
-    def remaining_counts(self) -> list[int]:
-        """Objects of each kind still in the arena (places are never used up)."""
-        counts = [0] * len(self.task.objects)
-        for i, kind in enumerate(self._kinds):
-            counts[kind] += bool(self._present[i])
-        return counts
-
-    def object_positions(self) -> dict[str, list[tuple[float, float]]]:
-        """Positions of the objects still in the arena, by object name."""
-        out: dict[str, list[tuple[float, float]]] = {o.name: [] for o in self.task.objects}
-        for i, kind in enumerate(self._kinds):
-            if self._present[i]:
-                out[self.task.objects[kind].name].append(tuple(self._positions[i].round(4)))
-        return out
 
     # -- episodes ----------------------------------------------------------------------------------
     def _clear(self, points: np.ndarray, margin: float) -> np.ndarray:
@@ -259,20 +221,7 @@ class ContinuousWorldEnv(CraftWorld):
         np.multiply(offsets, self._offset_scale, out=view)
 
     def step(self, action):
-        try:
-            x, y = action
-            x, y = float(x), float(y)
-        except (TypeError, ValueError):
-            shape = getattr(action, "shape", None)
-            raise ValueError(
-                f"invalid action {action!r}" + (f" of shape {shape}" if shape is not None else "")
-                + ": expected 2 numbers (thrust along x and y) in [-1, 1]"
-            ) from None
-        if not (abs(x) < float("inf") and abs(y) < float("inf")):  # also False for NaN
-            raise ValueError(f"invalid action [{x}, {y}]: NaN or infinite thrust")
-        if not self._started:
-            raise RuntimeError("call reset() before step()")
-        x, y = min(1.0, max(-1.0, x)), min(1.0, max(-1.0, y))
+        x, y = self.planar_action(action, "thrust")
         model, data = self.model, self.data
         data.ctrl[0] = x
         data.ctrl[1] = y
@@ -298,35 +247,7 @@ class ContinuousWorldEnv(CraftWorld):
         bonus, done, info = self.tracker.advance(mask)
         return self._obs.copy(), reward + bonus, done, False, info
 
-    def _touch(self, inside: np.ndarray, mask: int, reward: float) -> tuple[int, float]:
-        """Apply the rules to every object whose zone the agent is in; return (label, reward)."""
-        inv = self.inventory_counts
-        gained, arrived, touched = 0, -1, False
-        for i in np.flatnonzero(inside).tolist():
-            kind = self._kinds[i]
-            entered = not self._inside[i]
-            outcome = self.rules.touch(inv, kind, entered)
-            if entered and not self._is_item[i]:
-                arrived = kind
-            if outcome is None:
-                continue
-            touched = True
-            reward += outcome.reward
-            gained |= outcome.gained
-            if outcome.consumed:
-                self._remove(i)
-                inside[i] = False
-        if touched:
-            off, scale = self._inv_offset, self.rules.scale
-            for s, count in enumerate(inv):
-                self._obs[off + s] = count / scale[s]
-            self._level_mask = self.labeller.levels(inv)
-        if touched or arrived >= 0:
-            mask = self.labeller(inv, gained, arrived)
-        return mask, reward
-
     def _remove(self, i: int):
-        self._present[i] = False
         self._positions[i] = _FAR
         self._offset_scale[i] = 0.0
         self._obs_objects[i, 2] = 0.0
@@ -334,11 +255,6 @@ class ContinuousWorldEnv(CraftWorld):
         self.model.body_pos[self._body_ids[i], 2] = -1.0
 
     # -- rendering -----------------------------------------------------------------------------------
-    @property
-    def frame_shape(self) -> tuple[int, int, int]:
-        """Shape of an ``rgb_array`` frame: ``(rows, columns, 3)``."""
-        return (self.height + (PANEL_HEIGHT if self.status_panel else 0), self.width, 3)
-
     def world_to_pixel(self, x: float, y: float) -> tuple[int, int]:
         """(column, row) of an arena point in the camera image (top-down, orthographic)."""
         tall = self._view_height
@@ -348,11 +264,8 @@ class ContinuousWorldEnv(CraftWorld):
         return int(col), int(row)
 
     def render(self):
-        if self.render_mode is None:
-            gym.logger.warn("render() called without a render_mode; pass render_mode= to make()")
+        if not self._can_render(bool(self._started)):
             return None
-        if not self._started:
-            raise RuntimeError("call reset() before render()")
         if self._renderer is None:
             try:
                 self._renderer = mujoco.Renderer(self.model, self.height, self.width)

@@ -245,11 +245,8 @@ class GridWorldEnv(CraftWorld):
         return obs.copy(), reward + bonus, done, False, info
 
     def render(self):
-        if self.render_mode is None:
-            gym.logger.warn("render() called without a render_mode; pass render_mode= to make()")
+        if not self._can_render(bool(self._cells)):
             return None
-        if not self._cells:
-            raise RuntimeError("call reset() before render()")
         if self.render_mode == "ansi":
             text = grid_text(self.size, self._cells, self._agent, self._objects)
             if not self.status_panel:

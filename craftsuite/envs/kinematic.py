@@ -13,13 +13,12 @@ MuJoCo (nor dm_control): it is the continuous world for machines without it.
 from __future__ import annotations
 
 import cv2
-import gymnasium as gym
 import numpy as np
 
 from ..rendering.frames import frame_side
-from ..rendering.panel import PANEL_HEIGHT, add_status_panel, hex_to_rgb
+from ..rendering.panel import add_status_panel, hex_to_rgb
 from ..spec import KINEMATIC, TaskSpec
-from .base import CraftWorld
+from .planar import PlanarWorld
 
 # The authors' values (``spec.KinematicConfig``); the board side, pickup radius and
 # off-board penalty are the spec's ``[continuous]`` values, which equal theirs (7, 0.4, -0.1).
@@ -27,7 +26,7 @@ STEP = KINEMATIC.step
 MAX_STEPS = KINEMATIC.max_steps
 
 
-class KinematicWorldEnv(CraftWorld):
+class KinematicWorldEnv(PlanarWorld):
     """A CraftSuite task on the authors' kinematic board.
 
     ## Description
@@ -83,7 +82,7 @@ class KinematicWorldEnv(CraftWorld):
         self.half = self.arena / 2
         self.radius = float(cfg.pickup_radius)
         self.step_size = STEP
-        self._kinds = [kind for kind, obj in enumerate(spec.objects) for _ in range(obj.count)]
+        self._lay_out([kind for kind, obj in enumerate(spec.objects) for _ in range(obj.count)])
         n_obj = len(self._kinds)
         self._obstacles = self._obstacle_squares()
         # the authors' object sites: the board's integer points but (0, 0), here also clear
@@ -94,20 +93,8 @@ class KinematicWorldEnv(CraftWorld):
         if len(self._sites) < n_obj:
             raise ValueError(f"{spec.name}: {n_obj} objects do not fit the kinematic board's "
                              f"{len(self._sites)} free integer points (arena {self.arena})")
-        self._is_item = np.array([k < self.rules.n_items for k in self._kinds], dtype=bool)
-        self._inv_offset = 2 + 3 * n_obj
-        n_obs = self._inv_offset + len(self.rules.inventory_names)
-        self.observation_space = gym.spaces.Box(-1.0, 1.0, (n_obs,), dtype=np.float32)
-        self.action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
-        self._step_reward = spec.step_reward
-        self._boundary_reward = cfg.boundary_reward
-        self._obs = np.zeros(n_obs, dtype=np.float32)
         self._position = np.zeros(2)
-        self._positions = np.zeros((n_obj, 2))
-        self._present = np.zeros(n_obj, dtype=bool)
-        self._inside = np.zeros(n_obj, dtype=bool)
         self._level_mask = 0
-        self._started = False
 
     def _obstacle_squares(self) -> np.ndarray:
         """Obstacle cells of the largest grid, scaled to the board: (k, 3) x, y, half side,
@@ -135,35 +122,9 @@ class KinematicWorldEnv(CraftWorld):
 
     # -- public views --------------------------------------------------------------------------
     @property
-    def observation_layout(self) -> dict:
-        n_obj = len(self._kinds)
-        return {
-            "agent_position": slice(0, 2),
-            "objects": slice(2, 2 + 3 * n_obj),  # (dx, dy, present) per slot
-            "object_names": tuple(self.task.objects[k].name for k in self._kinds),
-            "inventory": slice(self._inv_offset, self._inv_offset + len(self.inventory_counts)),
-            "inventory_names": self.rules.inventory_names,
-        }
-
-    @property
     def agent_position(self) -> np.ndarray:
         """Board coordinates, ``[0, arena)`` on each axis."""
         return self._position.copy()
-
-    def remaining_counts(self) -> list[int]:
-        """Objects of each kind still on the board (places are never used up)."""
-        counts = [0] * len(self.task.objects)
-        for i, kind in enumerate(self._kinds):
-            counts[kind] += bool(self._present[i])
-        return counts
-
-    def object_positions(self) -> dict[str, list[tuple[float, float]]]:
-        """Positions of the objects still on the board, by object name."""
-        out: dict[str, list[tuple[float, float]]] = {o.name: [] for o in self.task.objects}
-        for i, kind in enumerate(self._kinds):
-            if self._present[i]:
-                out[self.task.objects[kind].name].append(tuple(float(v) for v in self._positions[i]))
-        return out
 
     # -- episodes ----------------------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
@@ -193,25 +154,10 @@ class KinematicWorldEnv(CraftWorld):
         view = obs[2:2 + 3 * n_obj].reshape(n_obj, 3)
         view[:, :2] = np.where(self._present[:, None], (self._positions - self._position) / self.arena, 0.0)
         view[:, 2] = self._present
-        off, scale = self._inv_offset, self.rules.scale
-        for s, count in enumerate(self.inventory_counts):
-            obs[off + s] = count / scale[s]
+        self._write_inventory()
 
     def step(self, action):
-        try:
-            x, y = action
-            x, y = float(x), float(y)
-        except (TypeError, ValueError):
-            shape = getattr(action, "shape", None)
-            raise ValueError(
-                f"invalid action {action!r}" + (f" of shape {shape}" if shape is not None else "")
-                + ": expected 2 numbers (displacement along x and y) in [-1, 1]"
-            ) from None
-        if not (abs(x) < float("inf") and abs(y) < float("inf")):  # also False for NaN
-            raise ValueError(f"invalid action [{x}, {y}]: NaN or infinite displacement")
-        if not self._started:
-            raise RuntimeError("call reset() before step()")
-        x, y = min(1.0, max(-1.0, x)), min(1.0, max(-1.0, y))
+        x, y = self.planar_action(action, "displacement")
         target = self._position + self.step_size * np.array([x, y])
         reward = self._step_reward
         mask = self._level_mask
@@ -228,47 +174,14 @@ class KinematicWorldEnv(CraftWorld):
         bonus, done, info = self.tracker.advance(mask)
         return self._obs.copy(), reward + bonus, done, False, info
 
-    def _touch(self, inside: np.ndarray, mask: int, reward: float) -> tuple[int, float]:
-        """Apply the rules to every object whose zone the agent is in; return (label, reward).
-        The same reading of the rules as the MuJoCo world (``ContinuousWorldEnv._touch``)."""
-        inv = self.inventory_counts
-        gained, arrived, touched = 0, -1, False
-        for i in np.flatnonzero(inside).tolist():
-            kind = self._kinds[i]
-            entered = not self._inside[i]
-            outcome = self.rules.touch(inv, kind, entered)
-            if entered and not self._is_item[i]:
-                arrived = kind
-            if outcome is None:
-                continue
-            touched = True
-            reward += outcome.reward
-            gained |= outcome.gained
-            if outcome.consumed:
-                self._present[i] = False
-                inside[i] = False
-        if touched:
-            self._level_mask = self.labeller.levels(inv)
-        if touched or arrived >= 0:
-            mask = self.labeller(inv, gained, arrived)
-        return mask, reward
-
     # -- rendering -----------------------------------------------------------------------------------
-    @property
-    def frame_shape(self) -> tuple[int, int, int]:
-        """Shape of an ``rgb_array`` frame: ``(rows, columns, 3)``."""
-        return (self.height + (PANEL_HEIGHT if self.status_panel else 0), self.width, 3)
-
     def world_to_pixel(self, x: float, y: float) -> tuple[int, int]:
         """(column, row) of a board point in the frame (y up, the board filling the frame)."""
         return int(x / self.arena * self.width), int((1.0 - y / self.arena) * self.height)
 
     def render(self):
-        if self.render_mode is None:
-            gym.logger.warn("render() called without a render_mode; pass render_mode= to make()")
+        if not self._can_render(bool(self._started)):
             return None
-        if not self._started:
-            raise RuntimeError("call reset() before render()")
         frame = np.full((self.height, self.width, 3), 235, dtype=np.uint8)
         sx, sy = self.width / self.arena, self.height / self.arena
         for x, y, h in self._obstacles:

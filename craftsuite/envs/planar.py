@@ -1,0 +1,134 @@
+"""What the two continuous worlds share: objects in the plane, touched within a radius.
+
+The MuJoCo world (``ContinuousWorldEnv``) and the kinematic board (``KinematicWorldEnv``)
+differ in how the agent moves; what it touches, and how the task's rules read a touch, is
+one piece of code here, so the worlds cannot drift apart in their labels or rewards.
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+
+from ..rendering.panel import PANEL_HEIGHT
+from .base import CraftWorld
+
+
+class PlanarWorld(CraftWorld):
+    """Base of the continuous worlds. Subclasses set, per object slot, ``_kinds`` (its
+    object kind), ``_is_item``, ``_present``, ``_inside`` (the agent was within reach at the
+    last step) and ``_positions``; ``_obs`` with the inventory from ``_inv_offset``; and
+    ``width`` and ``height`` of a frame. They define ``_remove(i)``: what consuming slot
+    ``i`` changes besides ``_present`` (the MuJoCo world hides its body)."""
+
+    def _lay_out(self, kinds: list[int]) -> None:
+        """The object slots (one per object, of these kinds), the spaces and the buffers, in
+        the shared layout: the agent's fields, (dx, dy, present) per slot, the inventory."""
+        self._kinds = list(kinds)
+        n_obj, first = len(self._kinds), max(f.stop for f in self.AGENT_FIELDS.values())
+        self._is_item = np.array([k < self.rules.n_items for k in self._kinds], dtype=bool)
+        self._inv_offset = first + 3 * n_obj
+        n_obs = self._inv_offset + len(self.rules.inventory_names)
+        self.observation_space = gym.spaces.Box(-1.0, 1.0, (n_obs,), dtype=np.float32)
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
+        self._step_reward = self.task.step_reward
+        self._boundary_reward = self.task.continuous.boundary_reward
+        self._obs = np.zeros(n_obs, dtype=np.float32)
+        self._positions = np.zeros((n_obj, 2))
+        self._present = np.zeros(n_obj, dtype=bool)
+        self._inside = np.zeros(n_obj, dtype=bool)
+        self._started = False
+
+    # the observation's first fields, before the objects' (dx, dy, present) rows
+    AGENT_FIELDS: dict[str, slice] = {"agent_position": slice(0, 2)}
+
+    @property
+    def observation_layout(self) -> dict:
+        """Slices of the observation by field: the agent's fields, ``objects`` ((dx, dy,
+        present) per slot, named in ``object_names``), ``inventory`` (``inventory_names``)."""
+        first = max(f.stop for f in self.AGENT_FIELDS.values())
+        return {
+            **self.AGENT_FIELDS,
+            "objects": slice(first, first + 3 * len(self._kinds)),
+            "object_names": tuple(self.task.objects[k].name for k in self._kinds),
+            "inventory": slice(self._inv_offset, self._inv_offset + len(self.inventory_counts)),
+            "inventory_names": self.rules.inventory_names,
+        }
+
+    def planar_action(self, action, what: str) -> tuple[float, float]:
+        """``action`` as two floats clipped to [-1, 1]; ``what`` names them in errors
+        ("thrust", "displacement").
+
+        Raises:
+            ValueError: not two numbers, or NaN or infinite ones.
+            RuntimeError: before the first ``reset``.
+        """
+        try:
+            x, y = action
+            x, y = float(x), float(y)
+        except (TypeError, ValueError):
+            shape = getattr(action, "shape", None)
+            raise ValueError(
+                f"invalid action {action!r}" + (f" of shape {shape}" if shape is not None else "")
+                + f": expected 2 numbers ({what} along x and y) in [-1, 1]"
+            ) from None
+        if not (abs(x) < float("inf") and abs(y) < float("inf")):  # also False for NaN
+            raise ValueError(f"invalid action [{x}, {y}]: NaN or infinite {what}")
+        if not self._started:
+            raise RuntimeError("call reset() before step()")
+        return min(1.0, max(-1.0, x)), min(1.0, max(-1.0, y))
+
+    def remaining_counts(self) -> list[int]:
+        """Objects of each kind still in the world (places are never used up)."""
+        counts = [0] * len(self.task.objects)
+        for i, kind in enumerate(self._kinds):
+            counts[kind] += bool(self._present[i])
+        return counts
+
+    def object_positions(self) -> dict[str, list[tuple[float, float]]]:
+        """Positions of the objects still in the world, by object name."""
+        out: dict[str, list[tuple[float, float]]] = {o.name: [] for o in self.task.objects}
+        for i, kind in enumerate(self._kinds):
+            if self._present[i]:
+                out[self.task.objects[kind].name].append(tuple(float(v) for v in self._positions[i].round(4)))
+        return out
+
+    def _touch(self, inside: np.ndarray, mask: int, reward: float) -> tuple[int, float]:
+        """Apply the rules to every object whose zone the agent is in; return (label, reward).
+        An item is touched while within reach, a place acts on entering its zone."""
+        inv = self.inventory_counts
+        gained, arrived, touched = 0, -1, False
+        for i in np.flatnonzero(inside).tolist():
+            kind = self._kinds[i]
+            entered = not self._inside[i]
+            outcome = self.rules.touch(inv, kind, entered)
+            if entered and not self._is_item[i]:
+                arrived = kind
+            if outcome is None:
+                continue
+            touched = True
+            reward += outcome.reward
+            gained |= outcome.gained
+            if outcome.consumed:
+                self._present[i] = False
+                self._remove(i)
+                inside[i] = False
+        if touched:
+            self._write_inventory()
+            self._level_mask = self.labeller.levels(inv)
+        if touched or arrived >= 0:
+            mask = self.labeller(inv, gained, arrived)
+        return mask, reward
+
+    def _remove(self, i: int) -> None:
+        """What else consuming slot ``i`` changes (``_present`` is cleared already)."""
+
+    def _write_inventory(self) -> None:
+        off, scale = self._inv_offset, self.rules.scale
+        for s, count in enumerate(self.inventory_counts):
+            self._obs[off + s] = count / scale[s]
+
+    @property
+    def frame_shape(self) -> tuple[int, int, int]:
+        """Shape of an ``rgb_array`` frame: ``(rows, columns, 3)``."""
+        return (self.height + (PANEL_HEIGHT if self.status_panel else 0), self.width, 3)

@@ -170,6 +170,7 @@ def test_markdown_csv_and_plot(runs, tmp_path):
 def test_runs_in_another_world_setting_get_their_own_row_and_plot(runs, tmp_path):
     fake_run(runs, "td3", 0, [(1000, 1.0)], [(995, 50.0)], world_kwargs={"frame_skip": 10, "max_episode_steps": 200})
     fake_run(runs, "dqn", 0, [(1000, 0.5)], [(995, 5.0)], world="Grid10", layout_seed=1)
+    fake_run(runs, "td3", 0, [(1000, 0.2)], [(995, 9.0)], world="Kinematic")
     entries = {(e.world, e.method): e for e in leaderboard.build(runs)}
     assert entries[("Cont", "td3")].seeds == [0, 1]  # the registered world's runs are not mixed with the others
     other = entries[("Cont: frame_skip=10, max_episode_steps=200", "td3")]
@@ -179,13 +180,15 @@ def test_runs_in_another_world_setting_get_their_own_row_and_plot(runs, tmp_path
     sections = {part.split(")")[0]: part for part in md.split("## BlindCraftsman (")[1:]}
     assert "reference" in sections["Cont: frame_skip=10, max_episode_steps=200"]  # theirs was a 2-D toy
     assert "reference" not in sections["Grid10: layout_seed=1"]  # their numbers are continuous ones
+    assert "reference" in sections["Kinematic"]  # the world their figures come from
     names = {p.name for p in leaderboard.plot_curves(runs, tmp_path)}
     assert names == {"curves-BlindCraftsman-Cont.png", "curves-BlindCraftsman-Grid10-layout_seed-1.png",
-                     "curves-BlindCraftsman-Cont-frame_skip-10-max_episode_steps-200.png"}
+                     "curves-BlindCraftsman-Cont-frame_skip-10-max_episode_steps-200.png",
+                     "curves-BlindCraftsman-Kinematic.png"}
     # settings that read alike in a file name do not overwrite each other's plot
     fake_run(runs, "td3", 0, [(1000, 0.0)], [(995, 0.0)], world_kwargs={"x": -1})
     fake_run(runs, "td3", 0, [(1000, 0.0)], [(995, 0.0)], world_kwargs={"x": 1})
-    assert len({p.name for p in leaderboard.plot_curves(runs, tmp_path)}) == 5
+    assert len({p.name for p in leaderboard.plot_curves(runs, tmp_path)}) == 6
 
 
 def test_runs_of_one_method_that_differ_beyond_the_seed_are_flagged_and_not_pooled(runs, tmp_path):

@@ -75,15 +75,21 @@ class ObjectivePlanner:
         return answer
 
 
-class GridScriptedPolicy:
-    """Acts in a ``GridWorldEnv`` (its ``unwrapped``): ``policy(obs) -> action``."""
+class ScriptedPolicy:
+    """A policy that heads for the next object its planner names: ``policy(obs) -> action``
+    (the observation is not read: it acts on the world, ``env.unwrapped``). Subclasses
+    define ``toward(kind)`` for their world's moves."""
 
     def __init__(self, env):
         self.env = env.unwrapped
         self.planner = ObjectivePlanner(self.env.task)
 
-    def __call__(self, observation=None) -> int:
+    def __call__(self, observation=None):
         return self.toward(self.planner.next_kind_in(self.env))
+
+
+class GridScriptedPolicy(ScriptedPolicy):
+    """Acts in a ``GridWorldEnv`` (its ``unwrapped``): ``policy(obs) -> action``."""
 
     def toward(self, target: int | None) -> int:
         """A step towards the nearest object of kind ``target``, through harmless cells."""
@@ -129,7 +135,7 @@ def _bfs_first_step(size, cells, start, goals, blocked) -> int | None:
     return None
 
 
-class ContinuousScriptedPolicy:
+class ContinuousScriptedPolicy(ScriptedPolicy):
     """Acts in a ``ContinuousWorldEnv``: ``policy(obs) -> thrust``.
 
     Paths come from a breadth-first search on a 0.25 m occupancy grid: walls and
@@ -144,8 +150,7 @@ class ContinuousScriptedPolicy:
     def __init__(self, env):
         from .envs.scene import AGENT_HALF
 
-        self.env = env.unwrapped
-        self.planner = ObjectivePlanner(self.env.task)
+        super().__init__(env)
         e = self.env
         self.n = int(np.ceil(e.arena / self.CELL))
         centres = (np.arange(self.n) + 0.5) * (e.arena / self.n) - e.half
@@ -161,9 +166,6 @@ class ContinuousScriptedPolicy:
         ix = int(np.clip((p[0] + e.half) / e.arena * self.n, 0, self.n - 1))
         iy = int(np.clip((p[1] + e.half) / e.arena * self.n, 0, self.n - 1))
         return iy, ix
-
-    def __call__(self, observation=None) -> np.ndarray:
-        return self.toward(self.planner.next_kind_in(self.env))
 
     def toward(self, target: int | None) -> np.ndarray:
         """Thrust towards the nearest object of kind ``target``, around unsafe zones."""
@@ -214,7 +216,7 @@ class ContinuousScriptedPolicy:
         return np.clip(thrust, -1, 1).astype(np.float32)
 
 
-class KinematicScriptedPolicy:
+class KinematicScriptedPolicy(ScriptedPolicy):
     """Acts in a ``KinematicWorldEnv``: ``policy(obs) -> displacement``.
 
     Moves are jumps (only where one ends counts), so no path search: jump onto the nearest
@@ -224,14 +226,10 @@ class KinematicScriptedPolicy:
     """
 
     def __init__(self, env):
-        self.env = env.unwrapped
-        self.planner = ObjectivePlanner(self.env.task)
+        super().__init__(env)
         axis = np.linspace(-1.0, 1.0, 25)
         # float32, the actions' type: ends are checked where the world will put them
         self._moves = np.array([(x, y) for x in axis for y in axis], dtype=np.float32)
-
-    def __call__(self, observation=None) -> np.ndarray:
-        return self.toward(self.planner.next_kind_in(self.env))
 
     def toward(self, target: int | None) -> np.ndarray:
         e = self.env

@@ -285,6 +285,7 @@ def _student(args) -> int:
 def _transfer(args) -> int:
     import dataclasses
 
+    from .ids import CONT, world_kind
     from .provenance import command_line
     from .suites import SUITES, transfer
 
@@ -297,9 +298,11 @@ def _transfer(args) -> int:
                                  ("student_steps", args.steps), ("methods", tuple(args.methods) if args.methods else None),
                                  ("teacher_max_steps", args.teacher_steps), ("eval_every", args.eval_every))
                if v is not None}
-    if (args.env or args.td3_hyper) and "Cont" not in changes.get("worlds", suite.worlds):
-        raise ValueError("--env and --td3-hyper set the MuJoCo students; these worlds have none: "
-                         f"{list(changes.get('worlds', suite.worlds))}")
+    worlds = list(changes.get("worlds", suite.worlds))
+    if args.env and CONT not in worlds:
+        raise ValueError(f"--env sets the MuJoCo students' world ({CONT}); these worlds have none: {worlds}")
+    if args.td3_hyper and not any(world_kind(w) == CONT for w in worlds):
+        raise ValueError(f"--td3-hyper sets the TD3 students (continuous worlds); these worlds have none: {worlds}")
     if args.env is not None:
         changes["cont_world_kwargs"] = _json_object(args.env, "--env")
     if args.td3_hyper is not None:

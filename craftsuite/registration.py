@@ -11,7 +11,6 @@ from pathlib import Path
 
 import gymnasium as gym
 
-from . import ids
 from .ids import NAMESPACE, WORLD_KINDS, cont_id, grid_id, kinematic_id, parse_id, world_kind  # noqa: F401  (re-exported)
 from .spec import KINEMATIC, TaskSpec
 from .task_registry import add_task, carried, ladder, resolve_task, tasks  # noqa: F401  (re-exported)

@@ -113,7 +113,8 @@ class Suite:
                             eval_every=self.eval_every or max(1, steps // 20), eval_episodes=self.eval_episodes,
                             hyperparameters=dict(self.td3_hyperparameters if cont else self.dqn_hyperparameters),
                             layout_seed=None if cont else self.grid_layout_seed,
-                            world_kwargs=dict(self.cont_world_kwargs) if cont else {},
+                            # the MuJoCo world's keywords (frame_skip, ...): not the kinematic board's
+                            world_kwargs=dict(self.cont_world_kwargs) if world == CONT else {},
                             n_envs=self.td3_n_envs if cont else self.dqn_n_envs))
         if not out:
             raise ValueError(f"no method of {list(self.methods)} runs in the worlds {list(self.worlds)} "

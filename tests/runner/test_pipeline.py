@@ -81,6 +81,19 @@ def test_cli_errors_name_the_problem(tmp_path, capsys):
     assert main(["transfer", "--worlds", "Grid10", "--methods", "dqn", "--env", '{"frame_skip": 10}',
                  "--out", str(tmp_path / "t")]) == 2
     assert "these worlds have none: ['Grid10']" in capsys.readouterr().err
+    # the kinematic board has TD3 students but not the MuJoCo world's keywords
+    assert main(["transfer", "--worlds", "Kinematic", "--env", '{"frame_skip": 10}', "--out", str(tmp_path / "t")]) == 2
+    assert "--env sets the MuJoCo students' world (Cont); these worlds have none: ['Kinematic']" in capsys.readouterr().err
+
+
+def test_mujoco_keywords_reach_only_the_mujoco_students(tmp_path):
+    suite = dataclasses.replace(SUITES["quick"], worlds=("Cont", "Kinematic"), cont_world_kwargs={"frame_skip": 2},
+                                td3_hyperparameters={"learning_rate": 5e-4})
+    configs = suite.student_configs(tmp_path)
+    assert {c.world for c in configs} == {"Cont", "Kinematic"}
+    for c in configs:
+        assert c.world_kwargs == ({"frame_skip": 2} if c.world == "Cont" else {})
+        assert c.hyperparameters["learning_rate"] == 5e-4  # TD3 settings reach both continuous worlds
 
 
 def test_transfer_flags_reach_the_suite(tmp_path, monkeypatch):

@@ -207,7 +207,7 @@ def _teacher(args) -> int:
     config = TeacherConfig(task=args.task, size=args.size, layout_seed=None if args.layout_seed < 0 else args.layout_seed,
                            seed=args.seed, max_steps=args.max_steps, target_success=args.target_success,
                            eval_every=args.eval_every, eval_episodes=args.eval_episodes,
-                           hyperparameters=_hyper(args.hyper, "dqn"))
+                           hyperparameters=_hyper(args.hyper, "dqn"), n_envs=args.n_envs)
     path = train_teacher(config, args.out)
     print((path / "result.json").read_text().strip())
     print(f"teacher run: {path}\n  teacher: {path / 'teacher.zip'}\n  dynamic table: {path / 'table.npz'}")
@@ -273,7 +273,7 @@ def _student(args) -> int:
                            table=str(Path(args.table).resolve()) if args.table else None, eval_every=args.eval_every,
                            eval_episodes=args.eval_episodes, hyperparameters=_hyper(args.hyper, METHODS[args.method].algorithm),
                            layout_seed=args.layout_seed, world_kwargs=_json_object(args.env, "--env"),
-                           n_envs=args.n_envs)
+                           n_envs=args.n_envs, automaton_state=args.automaton_state)
     if METHODS[args.method].needs_table and not args.table:
         raise ValueError(f"method {args.method!r} needs --table (a teacher's table.npz: craftsuite teacher)")
     path = train_student(config, args.out)
@@ -303,6 +303,10 @@ def _transfer(args) -> int:
         raise ValueError(f"--env sets the MuJoCo students' world ({CONT}); these worlds have none: {worlds}")
     if args.td3_hyper and not any(world_kind(w) == CONT for w in worlds):
         raise ValueError(f"--td3-hyper sets the TD3 students (continuous worlds); these worlds have none: {worlds}")
+    if args.dqn_hyper is not None:
+        dqn = _hyper(args.dqn_hyper, "dqn", "--dqn-hyper")
+        changes["dqn_hyperparameters"] = {**suite.dqn_hyperparameters, **dqn}
+        changes["teacher_hyperparameters"] = {**suite.teacher_hyperparameters, **dqn}
     if args.env is not None:
         changes["cont_world_kwargs"] = _json_object(args.env, "--env")
     if args.td3_hyper is not None:
@@ -352,6 +356,12 @@ def _positive(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
     return value
+
+
+def _on_off(text: str) -> bool:
+    if text not in ("on", "off"):
+        raise argparse.ArgumentTypeError(f"must be on or off, got {text!r}")
+    return text == "on"
 
 
 class _CommandParser(argparse.ArgumentParser):
@@ -419,6 +429,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--eval-every", type=_positive, default=5_000)
     p.add_argument("--eval-episodes", type=_positive, default=50)
     p.add_argument("--hyper", help="JSON overrides of the DQN settings, e.g. '{\"learning_rate\": 1e-3}'")
+    p.add_argument("--n-envs", type=_positive, default=1,
+                   help="envs stepped side by side; each agent step collects one transition from each (default: 1)")
     p.set_defaults(run=_teacher)
 
     p = sub.add_parser("distill", help="distil a teacher (dynamic) or a task's automaton (static) into a table")
@@ -451,6 +463,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--env", help="JSON gymnasium.make keywords beyond the registered world, e.g. the "
                    "fine-control MuJoCo world '{\"frame_skip\": 2, \"max_episode_steps\": 1000}'")
     p.add_argument("--layout-seed", type=int, help="grid worlds: one fixed instance (default: a new one per episode)")
+    p.add_argument("--automaton-state", type=_on_off, metavar="on|off",
+                   help="whether a distilled student sees the automaton state (default: as its method; the paper's "
+                   "authors' students did not)")
     p.set_defaults(run=_student)
 
     p = sub.add_parser("transfer", help="a suite end to end: teacher, distillation, students, leaderboard, video")
@@ -471,6 +486,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "e.g. '{\"frame_skip\": 2, \"max_episode_steps\": 1000}'; the leaderboard names them")
     p.add_argument("--td3-hyper", help="JSON overrides of the TD3 students' settings, merged over the suite's, e.g. "
                    "'{\"action_noise\": {\"type\": \"persistent\", \"sigma\": 0.6, \"resample\": 0.1}}'")
+    p.add_argument("--dqn-hyper", help="JSON overrides of the DQN settings of the grid students and the teachers, "
+                   "merged over the suite's, e.g. '{\"features_extractor\": \"flatten\"}'")
     p.add_argument("--workers", type=_positive, help="parallel local processes (default: one per core)")
     p.add_argument("--ray", metavar="ADDRESS", help="run the students on Ray ('local' starts one here)")
     p.add_argument("--no-video", action="store_true", help="skip the rollout video of the best student")

@@ -29,6 +29,12 @@ class TeacherConfig:
     eval_every: int = 5_000
     eval_episodes: int = 50
     hyperparameters: dict = field(default_factory=dict)  # overrides of DQN_DEFAULTS
+    # envs stepped side by side: each agent step collects n_envs transitions (the authors' 10)
+    n_envs: int = field(default=1, metadata={"omit_if_default": True})
+
+    def __post_init__(self):
+        _check_n_envs(self.n_envs)
+        layout_kwargs(self.layout_seed)  # a ValueError for a bad seed
 
     @property
     def env_id(self) -> str:
@@ -64,10 +70,14 @@ class StudentConfig:
     # envs stepped side by side: each agent step collects n_envs transitions, then takes
     # the algorithm's gradient_steps updates (the authors' students used 10)
     n_envs: int = field(default=1, metadata={"omit_if_default": True})
+    # whether the policy sees the automaton state (None: as its method's row says); only a
+    # distilled student may differ from its row (the paper's authors' students did not see it)
+    automaton_state: bool | None = field(default=None, metadata={"omit_if_default": True})
 
     def __post_init__(self):
-        if not isinstance(self.n_envs, int) or isinstance(self.n_envs, bool) or self.n_envs < 1:
-            raise ValueError(f"n_envs must be a positive integer, got {self.n_envs!r}")
+        _check_n_envs(self.n_envs)
+        if self.method in METHODS:  # an unknown method is named where it is used (check_methods)
+            METHODS[self.method].observes(self.automaton_state)  # a MethodError naming both
         ids.world_kind(self.world)  # a ValueError naming the worlds there are
         if layout_kwargs(self.layout_seed) and ids.world_kind(self.world) != "Grid":  # also checks the seed
             raise ValueError(f"layout_seed fixes a grid instance; the {self.world} world has none "
@@ -83,6 +93,11 @@ class StudentConfig:
         return ids.env_id(self.task, self.world)
 
     @property
+    def product(self) -> bool:
+        """Whether the student sees the automaton state (``Method.observes``)."""
+        return METHODS[self.method].observes(self.automaton_state)
+
+    @property
     def env_kwargs(self) -> dict:
         return {**layout_kwargs(self.layout_seed), **self.world_kwargs}
 
@@ -92,12 +107,18 @@ class StudentConfig:
         method's row and its world (recorded and hashed)."""
         out = _effective(self.method, {"buffer_size": min(self.steps, 1_000_000), **self.hyperparameters},
                          self.env_id, self.env_kwargs, self.task)
+        out["method"]["product"] = self.product
         if self.table is not None:  # the teacher, by its run's name (its settings' hash), not by where it lies
             out["teacher"] = f"{Path(self.table).parent.name}/{Path(self.table).name}"
         return out
 
     def run_name(self) -> str:
         return f"student-{self.task}-{self.world}-{self.method}-s{self.seed}-{config_key(self)}"
+
+
+def _check_n_envs(n_envs) -> None:
+    if not isinstance(n_envs, int) or isinstance(n_envs, bool) or n_envs < 1:
+        raise ValueError(f"n_envs must be a positive integer, got {n_envs!r}")
 
 
 def _effective(method: str, hyperparameters: dict, env_id: str, env_kwargs: dict, task: str) -> dict:

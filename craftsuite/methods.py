@@ -55,7 +55,10 @@ class OneOf(tuple):
 _OFF_POLICY = dict(tau=1.0, train_freq=OneOf((1, [1, "step"])), gradient_steps=1, n_steps=1,
                    optimize_memory_usage=False, replay_buffer_kwargs={}, stats_window_size=100, device="auto",
                    prioritized=True)
-DQN_MORE = MappingProxyType(dict(_OFF_POLICY, max_grad_norm=10.0, double=True, dueling=True))
+# loss "huber" or "mse"; target_update_unit "transitions" (SB3's) or "gradient_steps";
+# features_extractor "flatten" (SB3's) or "residual-cnn" (the grid planes as an image)
+DQN_MORE = MappingProxyType(dict(_OFF_POLICY, max_grad_norm=10.0, double=True, dueling=True, loss="huber",
+                                 target_update_unit="transitions", features_extractor="flatten"))
 TD3_MORE = MappingProxyType(dict(_OFF_POLICY, tau=0.005, policy_delay=OneOf((2, None)),  # None: the schedule
                                  delay_schedule=[[20_000, 4], [None, 2]]))
 
@@ -193,6 +196,32 @@ class Method:
         """Whether the method needs a teacher's table (``craftsuite teacher``)."""
         return self.distill == "dynamic"
 
+    def observes(self, automaton_state: bool | None = None) -> bool:
+        """Whether a run of this method sees the automaton state: the row's ``product``, or
+        ``automaton_state`` (None: the row's) for a distilled student, whose automaton enters
+        through its target whether or not the policy sees the state (the paper's authors'
+        students did not).
+
+        Raises:
+            MethodError: ``automaton_state`` differs from the row's and the method cannot
+                take it, naming both.
+        """
+        if automaton_state is None or automaton_state == self.product:
+            return self.product
+        if not isinstance(automaton_state, bool):
+            raise MethodError(f"automaton_state must be true, false or null, got {automaton_state!r}")
+        if self.distill is not None:
+            return automaton_state
+        if self.crm:
+            why = "its counterfactual experiences relabel the automaton state in the observation"
+        elif self.product:
+            why = f"the automaton state is what it adds to {_scratch_of(self.world)!r}: run that instead"
+        else:
+            why = f"a method from scratch sees the world alone: {_product_of(self.world)!r} sees the automaton state"
+        raise MethodError(f"method {self.name!r} cannot run with automaton_state={automaton_state}: {why}; only "
+                          f"the distilled students ({', '.join(n for n, m in METHODS.items() if m.distill)}) "
+                          "may go with or without it")
+
     def settings(self) -> dict:
         """What the row makes a run do, as plain data (recorded and hashed with each run)."""
         return {"algorithm": self.algorithm, "product": self.product, "distill": self.distill, "crm": self.crm,
@@ -235,8 +264,17 @@ def methods_for(world: str) -> list[str]:
 def scratch(world: str) -> str | None:
     """The baseline of a student world: its algorithm from scratch, without the automaton
     (``td3`` in ``Cont``, ``dqn`` on the grids)."""
-    return next((name for name in methods_for(world)
-                 if not (METHODS[name].product or METHODS[name].distill or METHODS[name].crm)), None)
+    from .ids import world_kind
+
+    return _scratch_of(world_kind(world))
+
+
+def _scratch_of(kind: str) -> str | None:
+    return next((n for n, m in METHODS.items() if m.world == kind and not (m.product or m.distill or m.crm)), None)
+
+
+def _product_of(kind: str) -> str | None:
+    return next((n for n, m in METHODS.items() if m.world == kind and m.product and not (m.distill or m.crm)), None)
 
 
 def check_methods(names) -> None:

@@ -298,7 +298,8 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
         if run.finished():
             return run.path
         start = time.perf_counter()
-        fresh = make_agent("product-dqn", config.env_id, seed=config.seed, env_kwargs=config.env_kwargs,
+        fresh = make_agent("product-dqn", config.env_id, seed=config.seed, n_envs=config.n_envs,
+                           env_kwargs=config.env_kwargs,
                            **config.effective()["hyperparameters"])
 
         def evaluate_fn(model, step):
@@ -346,10 +347,11 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
             return run.path
         start = time.perf_counter()
         fresh = make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=config.n_envs,
-                           env_kwargs=config.env_kwargs, **config.effective()["hyperparameters"])
+                           env_kwargs=config.env_kwargs, automaton_state=config.automaton_state,
+                           **config.effective()["hyperparameters"])
 
         def evaluate_fn(model, step):
-            return evaluate(model, config.env_id, config.eval_episodes, seed=10**7 + step, product=method.product,
+            return evaluate(model, config.env_id, config.eval_episodes, seed=10**7 + step, product=config.product,
                             env_kwargs=config.env_kwargs)
 
         agent = _learn(run, fresh, config.steps, config.eval_every, config.eval_episodes, evaluate_fn,
@@ -360,7 +362,7 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
         run.write_result({"kind": "student", "env_id": config.env_id, "method": config.method,
                           "algorithm": agent.algorithm,
                           "task": config.task, "seed": config.seed, "steps": int(agent.num_timesteps),
-                          "updates": int(agent._n_updates), "product": method.product,
+                          "updates": int(agent._n_updates), "product": config.product,
                           "env_kwargs": config.env_kwargs, "model": "model.zip",
                           "seconds_this_session": round(time.perf_counter() - start, 1)})
         # a finished run is reused, never resumed (a larger budget is another run): its replay

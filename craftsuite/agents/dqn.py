@@ -6,7 +6,11 @@ Where this differs from SB3's DQN, and nowhere else:
 * ``AutomatonDQN._td_target``: the one seam for the target (double DQN, then the distilled
   mix when a ``DistilledTarget`` is given).
 * ``AutomatonDQN.train``: SB3's loop, with the loss weighted by importance weights and
-  the priorities updated from the TD errors.
+  the priorities updated from the TD errors; the loss Huber (SB3's) or squared error
+  (the paper's authors'); the target network's hard update counted in transitions (SB3's
+  ``target_update_interval``) or in gradient steps (the authors').
+* ``features_extractor``: SB3's flattening, or a residual CNN over the grid's planes
+  (``agents/networks.py``).
 """
 
 from __future__ import annotations
@@ -16,11 +20,17 @@ import torch as th
 import torch.nn.functional as F
 from stable_baselines3 import DQN
 from stable_baselines3.common.torch_layers import create_mlp
+from stable_baselines3.common.utils import polyak_update
 from stable_baselines3.dqn.policies import DQNPolicy, QNetwork
 from torch import nn
 
 from .distillation import DistilledTarget
+from .networks import features_policy_kwargs
 from .replay import AutomatonReplayBuffer, AutomatonSamples, NStepOwner, automaton_buffer_kwargs
+
+
+LOSSES = ("huber", "mse")
+TARGET_UPDATE_UNITS = ("transitions", "gradient_steps")
 
 
 class _DuelingHead(nn.Module):
@@ -61,13 +71,26 @@ class AutomatonDQN(NStepOwner, DQN):
         distill: a ``DistilledTarget`` for students; None for teachers and baselines.
         n_steps: n-step returns from the replay buffer (1: the one-step target); SB3's own
             setting, so ``model.n_steps`` is what the buffer uses.
+        loss: ``"huber"`` (SB3's smooth L1) or ``"mse"`` (squared TD error).
+        target_update_unit: what ``target_update_interval`` counts: ``"transitions"`` (SB3's
+            meaning: env steps over all envs) or ``"gradient_steps"``.
+        features_extractor: ``"flatten"`` (SB3's) or ``"residual-cnn"`` (grid worlds).
 
     ``algorithm`` (``"dqn"``) is saved with the model, so that ``load_agent`` knows its class.
     """
 
     def __init__(self, policy, env, *, double: bool = True, dueling: bool = True, prioritized: bool = True,
-                 distill: DistilledTarget | None = None, n_steps: int = 1,
+                 distill: DistilledTarget | None = None, n_steps: int = 1, loss: str = "huber",
+                 target_update_unit: str = "transitions", features_extractor: str = "flatten",
                  replay_buffer_kwargs: dict | None = None, **kwargs):
+        if loss not in LOSSES:
+            raise ValueError(f"loss must be one of {list(LOSSES)}, got {loss!r}")
+        if target_update_unit not in TARGET_UPDATE_UNITS:
+            raise ValueError(f"target_update_unit must be one of {list(TARGET_UPDATE_UNITS)}, "
+                             f"got {target_update_unit!r}")
+        if env is not None:  # None when SB3 loads a saved agent: its policy_kwargs hold the extractor already
+            kwargs["policy_kwargs"] = features_policy_kwargs(features_extractor, env, kwargs.get("policy_kwargs"))
+        self.loss, self.target_update_unit, self.features_extractor = loss, target_update_unit, features_extractor
         if dueling and policy == "MlpPolicy":
             policy = DuelingDQNPolicy
         kwargs.setdefault("replay_buffer_class", AutomatonReplayBuffer)
@@ -93,18 +116,30 @@ class AutomatonDQN(NStepOwner, DQN):
                 target = self.distill(data.w, data.sigma, target)
         return target
 
+    def _on_step(self) -> None:
+        if self.target_update_unit == "transitions":
+            return super()._on_step()  # SB3's: the target's update by transitions, then epsilon
+        self._n_calls += 1
+        self.exploration_rate = self.exploration_schedule(self._current_progress_remaining)
+        self.logger.record("rollout/exploration_rate", self.exploration_rate)
+
+    def _update_target(self) -> None:
+        polyak_update(self.q_net.parameters(), self.q_net_target.parameters(), self.tau)
+        polyak_update(self.batch_norm_stats, self.batch_norm_stats_target, 1.0)  # a CNN's running stats, as SB3
+
     def train(self, gradient_steps: int, batch_size: int = 100) -> None:
         self.policy.set_training_mode(True)
         self._update_learning_rate(self.policy.optimizer)
         losses = []
-        for _ in range(gradient_steps):
+        for step in range(gradient_steps):
             data = self.replay_buffer.sample(batch_size, env=self._vec_normalize_env)
             target = self._td_target(data)
             current = th.gather(self.q_net(data.observations), dim=1, index=data.actions.long())
+            loss_fn = F.smooth_l1_loss if self.loss == "huber" else F.mse_loss
             if self.replay_buffer.prioritized:
-                loss = (data.weights * F.smooth_l1_loss(current, target, reduction="none")).mean()
+                loss = (data.weights * loss_fn(current, target, reduction="none")).mean()
             else:  # uniform replay: SB3's loss exactly
-                loss = F.smooth_l1_loss(current, target)
+                loss = loss_fn(current, target)
             losses.append(loss.item())
             self.policy.optimizer.zero_grad()
             loss.backward()
@@ -112,6 +147,9 @@ class AutomatonDQN(NStepOwner, DQN):
             self.policy.optimizer.step()
             if self.replay_buffer.prioritized:
                 self.replay_buffer.update_priorities(data.indices, (current - target).detach().cpu().numpy())
+            counted = self._n_updates + step + 1
+            if self.target_update_unit == "gradient_steps" and counted % self.target_update_interval == 0:
+                self._update_target()
         self._n_updates += gradient_steps
         self.logger.record("train/n_updates", self._n_updates, exclude="tensorboard")
         self.logger.record("train/loss", np.mean(losses))

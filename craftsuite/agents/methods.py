@@ -33,7 +33,7 @@ assert set(CLASSES) == set(ALGORITHMS), "every algorithm of the methods table ne
 
 def make_agent(method: str, env, *, table: AutomatonQTable | None = None, seed: int = 0,
                n_envs: int = 1, rho: float | None = None, self_loops: bool | None = None, verbose: int = 0,
-               env_kwargs: dict | None = None, **overrides):
+               env_kwargs: dict | None = None, automaton_state: bool | None = None, **overrides):
     """An untrained agent of ``method``: each step of the agent collects one transition per
     env, then takes ``gradient_steps`` updates.
 
@@ -49,15 +49,16 @@ def make_agent(method: str, env, *, table: AutomatonQTable | None = None, seed: 
     "resample": 0.1}``: ``agents/noise.py``)."""
     check_methods([method])
     m = METHODS[method]
+    product = m.observes(automaton_state)  # a MethodError naming both, for a method that cannot go without
     kwargs = algorithm_settings(m.algorithm, overrides)  # bad settings are named before an env is made
     if isinstance(env, str):
         if world_kind(parse_id(env)[1]) != m.world:
             raise ValueError(f"method {method!r} is for {m.world} worlds, not {env}")
-        env = make_vec_env(env, n_envs=n_envs, seed=seed, env_kwargs={**(env_kwargs or {}), "product": m.product})
+        env = make_vec_env(env, n_envs=n_envs, seed=seed, env_kwargs={**(env_kwargs or {}), "product": product})
     else:
         if env_kwargs:
             raise ValueError("env_kwargs make an env from an id; this env is made already")
-        _check_suited(method, m, env)  # a gymnasium env stays one: SB3 wraps it (Monitor, DummyVecEnv)
+        _check_suited(method, m, env, product)  # a gymnasium env stays one: SB3 wraps it (Monitor, DummyVecEnv)
     n_envs = env.num_envs if isinstance(env, VecEnv) else 1
     base = _unwrapped(env)
     automaton = base.automaton
@@ -83,10 +84,9 @@ def _unwrapped(env):
     return env.get_attr("unwrapped", [0])[0] if isinstance(env, VecEnv) else env.unwrapped
 
 
-def _check_suited(name: str, method: Method, env) -> None:
+def _check_suited(name: str, method: Method, env, product: bool) -> None:
     """Raise unless ``env`` (a gymnasium env or a VecEnv) is a CraftSuite world of the
-    method's kind, with the automaton state in its observation exactly when the method is a
-    product method."""
+    method's kind, with the automaton state in its observation exactly when ``product``."""
     if not isinstance(env, (VecEnv, gym.Env)):
         raise TypeError(f"make_agent takes a CraftSuite id, a gymnasium env or a VecEnv, not {env!r}")
     base = _unwrapped(env)
@@ -97,10 +97,10 @@ def _check_suited(name: str, method: Method, env) -> None:
     where = spec.id if spec is not None else f"this {type(base).__name__}"
     if kind != method.world:
         raise ValueError(f"method {name!r} is for {method.world} worlds, not {where}")
-    product = env.observation_space.shape[0] == base.observation_space.shape[0] + base.automaton.n_states
-    if product != method.product:
-        raise ValueError(f"method {name!r} {'needs' if method.product else 'must not see'} the automaton state in "
-                         f"its observation: make {where} with product={method.product}")
+    seen = env.observation_space.shape[0] == base.observation_space.shape[0] + base.automaton.n_states
+    if seen != product:
+        raise ValueError(f"method {name!r} {'needs' if product else 'must not see'} the automaton state in "
+                         f"its observation: make {where} with product={product}")
 
 
 def distill_from_replay(teacher: AutomatonDQN, chunk: int = 4096) -> AutomatonQTable:

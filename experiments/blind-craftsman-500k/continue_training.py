@@ -27,7 +27,7 @@ def job(run: Path, sigma: float) -> str:
     from stable_baselines3.common.callbacks import BaseCallback
 
     from craftsuite.agents import AutomatonQTable
-    from craftsuite.agents.methods import METHODS, make_agent
+    from craftsuite.agents.methods import make_agent
     from craftsuite.agents.noise import make_action_noise
     from craftsuite.runs import load_config
     from craftsuite.training import StudentConfig, evaluate
@@ -42,7 +42,7 @@ def job(run: Path, sigma: float) -> str:
     start, rows = agent.num_timesteps, []
 
     def greedy() -> float:
-        return evaluate(agent, env_id, EPISODES, seed=10**8, product=METHODS[cfg.method].product, env_kwargs=world)[0]
+        return evaluate(agent, env_id, EPISODES, seed=10**8, product=cfg.product, env_kwargs=world)[0]
 
     class Report(BaseCallback):
         wins = episodes = 0

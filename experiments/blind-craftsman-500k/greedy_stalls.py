@@ -24,7 +24,7 @@ import numpy as np
 
 def _load(run: Path):
     """A run's config, its last checkpoint's model, and whether it sees the automaton state."""
-    from craftsuite.agents.methods import METHODS, load_agent
+    from craftsuite.agents.methods import load_agent
     from craftsuite.runs import RunDir, load_config
     from craftsuite.training import StudentConfig, checkpoint_dir
 
@@ -32,7 +32,7 @@ def _load(run: Path):
     saved = checkpoint_dir(RunDir(run, config))
     if saved is None:
         raise FileNotFoundError(f"{run} has no checkpoint yet")
-    return config, load_agent(saved / "model.zip"), METHODS[config.method].product
+    return config, load_agent(saved / "model.zip"), config.product
 
 
 def _thrust_grid():

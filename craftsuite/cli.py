@@ -326,6 +326,14 @@ def _transfer(args) -> int:
 def _leaderboard(args) -> int:
     from . import leaderboard
 
+    if args.reproduction:
+        if args.page or args.out or len(args.runs) > 1:
+            raise ValueError("--reproduction writes one page from one transfer directory: give one RUNS, "
+                             "without --page or --out")
+        from .reproduction import write_report
+
+        print(f"wrote {write_report(args.runs[0], args.reproduction)}")
+        return 0
     if args.page:
         if args.out:
             raise ValueError("--page writes the page and its images beside PATH; --out is for one directory's "
@@ -499,6 +507,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="where to write (default: RUNS)")
     p.add_argument("--page", metavar="PATH", help="write a results page (Markdown with provenance, tables, plots) "
                    "from the RUNS directories to PATH, e.g. docs/results.md")
+    p.add_argument("--reproduction", metavar="PATH", help="write the paper's Figure 5 panels, each beside the "
+                   "paper's claim, from one transfer directory (craftsuite transfer --suite paper)")
     p.set_defaults(run=_leaderboard)
 
     p = sub.add_parser("video", help="record rollouts of a policy as an MP4 (grid and MuJoCo ids)")

@@ -1,0 +1,84 @@
+"""The reproduction report on synthetic runs with known answers: each Figure 5 panel says
+what ran and what did not, and its verdict follows the runs' intervals."""
+
+import json
+
+import pytest
+
+from craftsuite import leaderboard
+from craftsuite.cli import main
+from craftsuite.reproduction import FIGURE_5, verdict, write_report
+
+from .test_leaderboard import fake_run
+
+
+def _seeds(root, method, success, world="Kinematic", task="BlindCraftsman", seeds=5, ret=0.0):
+    for seed in range(seeds):
+        value = success + 0.01 * seed if success else 0.0
+        fake_run(root, method, seed, [(500, value), (1000, value)], [(950, ret + seed)], task=task, world=world)
+
+
+@pytest.fixture
+def transfer_dir(tmp_path):
+    out = tmp_path / "paper"
+    students = out / "students"
+    _seeds(students, "td3-dynamic", 0.8, ret=50.0)  # (e), kinematic: ahead of scratch
+    _seeds(students, "td3", 0.1)
+    _seeds(students, "td3-dynamic", 0.0, world="Cont", seeds=2)  # (e), MuJoCo: two seeds, nothing learned
+    _seeds(students, "td3", 0.0, world="Cont", seeds=2)
+    _seeds(students, "dynamic", 0.1, world="Grid10", task="DungeonQuest")  # (a): behind product DQN; static missing
+    for baseline in ("crm", "product-dqn", "dqn"):
+        _seeds(students, baseline, 0.6 if baseline == "product-dqn" else 0.1, world="Grid10", task="DungeonQuest")
+    (out / "suite.json").write_text(json.dumps({"name": "paper", "teacher_layout_seed": None, "grid_layout_seed": None,
+                                                "teacher_n_envs": 10, "dqn_n_envs": 10, "td3_n_envs": 10,
+                                                "students_see_automaton": False}))
+    teacher = out / "teachers" / "teacher-DungeonQuest-Grid7-s0-abc"
+    teacher.mkdir(parents=True)
+    (teacher / "result.json").write_text(json.dumps({"steps": 100_000, "updates": 9_900, "success": 0.3,
+                                                     "reached_target": False}))
+    return out
+
+
+def test_verdicts_follow_the_intervals(transfer_dir):
+    board = {(e.task, e.world, e.method): e for e in leaderboard.build(transfer_dir / "students")}
+    ahead = board["BlindCraftsman", "Kinematic", "td3-dynamic"]
+    assert verdict(ahead, board["BlindCraftsman", "Kinematic", "td3"]) == "ahead"
+    assert verdict(board["BlindCraftsman", "Kinematic", "td3"], ahead) == "behind"
+    assert verdict(ahead, board["BlindCraftsman", "Kinematic", "td3"], "return") == "ahead"
+    dq = {m: board["DungeonQuest", "Grid10", m] for m in ("dynamic", "crm", "product-dqn")}
+    assert verdict(dq["dynamic"], dq["product-dqn"]) == "behind"
+    assert verdict(dq["dynamic"], dq["crm"]) == "no difference measured"
+    nothing = board["BlindCraftsman", "Cont", "td3-dynamic"], board["BlindCraftsman", "Cont", "td3"]
+    assert verdict(*nothing) == "neither learned"
+
+
+def test_the_report_names_every_panel_what_ran_and_what_did_not(transfer_dir, tmp_path):
+    page = write_report(transfer_dir, tmp_path / "docs" / "reproduction.md")
+    text = page.read_text()
+    rows = [line for line in text.splitlines() if line.startswith("| ") and line[2] in "abcdefg" and line[3] == " "]
+    # one row per panel and world: four grid panels, three continuous ones in two worlds
+    assert len(rows) == 4 + 3 * 2 == sum(len(p.worlds) for p in FIGURE_5)
+    by_panel = {(r.split("|")[1].strip(), r.split("|")[3].strip()): r for r in rows}
+    assert "td3: AUC ahead, return ahead" in by_panel["e", "Kinematic"] and "| 5 |" in by_panel["e", "Kinematic"]
+    assert "fewer than 5 seeds: not a claim" in by_panel["e", "Cont"]
+    assert "product-dqn: AUC behind" in by_panel["a", "Grid10"]
+    assert "did not run" in by_panel["b", "Grid10"] and "did not run" in by_panel["f", "Kinematic"]
+    assert "Did not run: static." in text  # a panel with a method missing says which
+    # the authors' published returns stay as reference rows in the continuous panels
+    assert "*reference: authors' td3-dynamic, 1 run, 2M steps" in text
+    # the protocol and the teachers as run, and the paper's budget beside ours
+    assert "teachers' layout new every episode" in text and "see the automaton state: no" in text
+    assert "did not reach its target" in text and "20M transitions" in text
+    assert "1,000 transitions" in text
+    assert (tmp_path / "docs" / "images" / "reproduction" / "curves-BlindCraftsman-Kinematic.png").exists()
+
+
+def test_bad_input_is_named(tmp_path, capsys):
+    with pytest.raises(FileNotFoundError, match="no students/"):
+        write_report(tmp_path, tmp_path / "r.md")
+    (tmp_path / "students").mkdir()
+    with pytest.raises(ValueError, match="no finished student runs"):
+        write_report(tmp_path, tmp_path / "r.md")
+    assert not (tmp_path / "r.md").exists()
+    assert main(["leaderboard", str(tmp_path), str(tmp_path), "--reproduction", str(tmp_path / "r.md")]) == 2
+    assert "one transfer directory" in capsys.readouterr().err

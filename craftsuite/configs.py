@@ -78,6 +78,8 @@ class StudentConfig:
         _check_n_envs(self.n_envs)
         if self.method in METHODS:  # an unknown method is named where it is used (check_methods)
             METHODS[self.method].observes(self.automaton_state)  # a MethodError naming both
+            if self.automaton_state == METHODS[self.method].product:  # what the method does anyway: one run key
+                object.__setattr__(self, "automaton_state", None)
         ids.world_kind(self.world)  # a ValueError naming the worlds there are
         if layout_kwargs(self.layout_seed) and ids.world_kind(self.world) != "Grid":  # also checks the seed
             raise ValueError(f"layout_seed fixes a grid instance; the {self.world} world has none "

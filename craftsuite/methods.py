@@ -55,8 +55,11 @@ class OneOf(tuple):
 _OFF_POLICY = dict(tau=1.0, train_freq=OneOf((1, [1, "step"])), gradient_steps=1, n_steps=1,
                    optimize_memory_usage=False, replay_buffer_kwargs={}, stats_window_size=100, device="auto",
                    prioritized=True)
-# loss "huber" or "mse"; target_update_unit "transitions" (SB3's) or "gradient_steps";
-# features_extractor "flatten" (SB3's) or "residual-cnn" (the grid planes as an image)
+# CraftSuite's DQN settings that take one of a few names, the first SB3's behaviour:
+# the loss, what target_update_interval counts, and how the observation reaches the MLP
+# (the grid planes as an image: agents/networks.py)
+DQN_CHOICES = MappingProxyType({"loss": ("huber", "mse"), "target_update_unit": ("transitions", "gradient_steps"),
+                                "features_extractor": ("flatten", "residual-cnn")})
 DQN_MORE = MappingProxyType(dict(_OFF_POLICY, max_grad_norm=10.0, double=True, dueling=True, loss="huber",
                                  target_update_unit="transitions", features_extractor="flatten"))
 TD3_MORE = MappingProxyType(dict(_OFF_POLICY, tau=0.005, policy_delay=OneOf((2, None)),  # None: the schedule
@@ -133,6 +136,9 @@ def check_hyperparameters(algorithm: str, overrides: Mapping | None, source: str
             # library's defaults, which CraftSuite may replace (TD3's policy_delay: its schedule)
             shown = f"default {example!r}" if name in defaults else f"e.g. {example!r}"
             raise HyperparameterError(f"{source}: {name} must be {text} ({shown}), got {value!r}")
+        choices = DQN_CHOICES.get(name) if algorithm == "dqn" else None
+        if choices and value not in choices:
+            raise HyperparameterError(f"{source}: {name} must be one of {list(choices)}, got {value!r}")
     return overrides
 
 

@@ -154,18 +154,20 @@ def _what_ran(run_dir: Path, board, suite: dict, sessions: list[dict]) -> list[s
         lines.append(f"- `{s['command']}`: {s['started'][:10]}, commit {s.get('commit') or 'unknown'}, {took} "
                      f"on {s['machine']}")
     if suite:
-        lines += [f"- Suite `{suite.get('name')}`: teachers' layout "
-                  f"{'new every episode' if suite.get('teacher_layout_seed') is None else 'fixed'}, "
-                  f"grid students' layout {'new every episode' if suite.get('grid_layout_seed') is None else 'fixed'}; "
-                  f"envs per gradient step: teachers {suite.get('teacher_n_envs')}, DQN {suite.get('dqn_n_envs')}, "
-                  f"TD3 {suite.get('td3_n_envs')}; distilled students see the automaton state: "
+        def layout(key, fixed):  # a suite.json from before a field existed holds the default's meaning
+            return "new every episode" if suite.get(key, fixed) is None else "fixed"
+
+        lines += [f"- Suite `{suite.get('name')}`: teachers' layout {layout('teacher_layout_seed', 0)}, "
+                  f"grid students' layout {layout('grid_layout_seed', 1)}; envs per gradient step: teachers "
+                  f"{suite.get('teacher_n_envs', 1)}, DQN {suite.get('dqn_n_envs', 1)}, TD3 "
+                  f"{suite.get('td3_n_envs', 1)}; distilled students see the automaton state: "
                   f"{'yes' if suite.get('students_see_automaton', True) else 'no'}.",
                   f"- DQN settings (teachers): `{json.dumps(suite.get('teacher_hyperparameters', {}))}`",
                   f"- DQN settings (students): `{json.dumps(suite.get('dqn_hyperparameters', {}))}`",
                   f"- TD3 settings: `{json.dumps(suite.get('td3_hyperparameters', {}))}`"]
     budgets = sorted({(e.budget, e.updates) for e in board})
-    lines.append("- Budget per run: " + ", ".join(f"{b:,} transitions / {u if u is None else f'{u:,}'} gradient "
-                                                  "updates" for b, u in budgets)
+    lines.append("- Budget per run: " + ", ".join(f"{b:,} transitions / " + ("unrecorded" if u is None else f"{u:,}")
+                                                  + " gradient updates" for b, u in budgets)
                  + "; the paper's: 2M steps of 10 envs, i.e. 20M transitions and 2M updates, 20 seeds.")
     for teacher in sorted((run_dir / "teachers").glob("teacher-*/result.json")):
         r = json.loads(teacher.read_text())

@@ -181,7 +181,7 @@ SUITES = {s.name: s for s in (
     Suite("paper", "the paper's protocol as the authors' code ran it: every method on the paper's tasks in the grid, "
           "MuJoCo and kinematic worlds, 20 seeds, 2M steps of 10 envs (20M transitions) per run",
           tags=("paper",), worlds=("Grid10", "Cont", "Kinematic"), methods=tuple(METHODS), seeds=20,
-          student_steps=20_000_000, eval_every=500_000, teacher_max_steps=2_000_000, **PAPER_PROTOCOL),
+          student_steps=20_000_000, eval_every=500_000, teacher_max_steps=20_000_000, **PAPER_PROTOCOL),
 )}
 
 

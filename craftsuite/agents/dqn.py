@@ -24,13 +24,13 @@ from stable_baselines3.common.utils import polyak_update
 from stable_baselines3.dqn.policies import DQNPolicy, QNetwork
 from torch import nn
 
+from ..methods import DQN_CHOICES
 from .distillation import DistilledTarget
 from .networks import features_policy_kwargs
 from .replay import AutomatonReplayBuffer, AutomatonSamples, NStepOwner, automaton_buffer_kwargs
 
 
-LOSSES = ("huber", "mse")
-TARGET_UPDATE_UNITS = ("transitions", "gradient_steps")
+LOSSES, TARGET_UPDATE_UNITS = DQN_CHOICES["loss"], DQN_CHOICES["target_update_unit"]
 
 
 class _DuelingHead(nn.Module):
@@ -106,7 +106,10 @@ class AutomatonDQN(NStepOwner, DQN):
         with th.no_grad():
             next_q = self.q_net_target(data.next_observations)
             if self.double:
+                training = self.q_net.training
+                self.q_net.set_training_mode(False)  # a CNN's batch-norm statistics move once per step, not twice
                 best = self.q_net(data.next_observations).argmax(dim=1, keepdim=True)
+                self.q_net.set_training_mode(training)
                 next_q = th.gather(next_q, dim=1, index=best)
             else:
                 next_q = next_q.max(dim=1, keepdim=True)[0]
@@ -157,7 +160,14 @@ class AutomatonDQN(NStepOwner, DQN):
             self.logger.record("train/teacher_weight", self.distill.last_weight)
 
     def q_values(self, observations: np.ndarray) -> np.ndarray:
-        """Q(s, .) of the online network for a batch of observations."""
-        with th.no_grad():
-            obs = th.as_tensor(np.asarray(observations), device=self.device, dtype=th.float32)
-            return self.q_net(obs).cpu().numpy()
+        """Q(s, .) of the online network for a batch of observations, in evaluation mode (a
+        CNN's batch norm reads its running statistics and leaves them as they are), as the
+        greedy policy acts; the network's mode is restored after."""
+        training = self.q_net.training
+        self.q_net.set_training_mode(False)
+        try:
+            with th.no_grad():
+                obs = th.as_tensor(np.asarray(observations), device=self.device, dtype=th.float32)
+                return self.q_net(obs).cpu().numpy()
+        finally:
+            self.q_net.set_training_mode(training)

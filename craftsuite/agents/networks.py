@@ -14,7 +14,9 @@ import torch as th
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 
-FEATURES_EXTRACTORS = ("flatten", "residual-cnn")
+from ..methods import DQN_CHOICES
+
+FEATURES_EXTRACTORS = DQN_CHOICES["features_extractor"]
 
 
 class _Residual(nn.Module):

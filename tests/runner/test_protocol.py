@@ -57,26 +57,28 @@ def test_envs_per_gradient_step(tmp_path):
     assert result["updates"] == (400 - 100) // 5
 
 
-def _count_target_updates(agent) -> list[int]:
-    """The gradient-step counts at which the target network is copied."""
-    seen = []
-    copy = agent._update_target
-
-    def spy():
-        seen.append(agent._n_updates)
-        copy()
-
-    agent._update_target = spy
-    return seen
-
-
 def test_target_update_period_counted_in_gradient_steps(monkeypatch):
     agent = make_agent("dqn", GRID, n_envs=2, target_update_unit="gradient_steps", target_update_interval=3,
                        gradient_steps=2, **TINY)
-    seen = _count_target_updates(agent)
+    steps, copies = [0], []
+    optimizer_step = agent.policy.optimizer.step
+    def counted(*args):
+        steps[0] += 1
+        return optimizer_step(*args)
+
+    monkeypatch.setattr(agent.policy.optimizer, "step", counted)
+    copy = agent._update_target
+
+    def spy():
+        copy()
+        same = all((p == q).all() for p, q in zip(agent.q_net.parameters(), agent.q_net_target.parameters()))
+        copies.append((steps[0], same))
+
+    agent._update_target = spy
     agent.learn(60)  # 30 agent steps of 2 envs; 20 transitions before learning, then 2 updates per step
-    assert agent._n_updates == 40
-    assert len(seen) == 40 // 3  # every third gradient step, whatever the envs and transitions
+    assert agent._n_updates == steps[0] == 40
+    # every third gradient step, whatever the envs and transitions, the target made the online network
+    assert copies == [(k, True) for k in range(3, 41, 3)]
     # counted in transitions (SB3's meaning), the period is in env steps over all envs: with 2 envs
     # and a period of 3, max(3 // 2, 1) = 1 agent step, i.e. every one of the 30
     import stable_baselines3.dqn.dqn as sb3_dqn
@@ -100,8 +102,10 @@ def test_loss_switch(monkeypatch):
         agent = make_agent("dqn", GRID, loss=loss, **TINY)
         agent.learn(40)
         assert used and set(used) == {expected}
-    with pytest.raises(ValueError, match="loss must be one of"):
+    with pytest.raises(ValueError, match=r"loss must be one of \['huber', 'mse'\], got 'l1'"):
         make_agent("dqn", GRID, **{**TINY, "loss": "l1"})
+    with pytest.raises(ValueError, match="target_update_unit must be one of"):  # named before any run starts
+        TeacherConfig(hyperparameters={"target_update_unit": "updates"}).run_name()
 
 
 def test_residual_cnn_reads_the_planes():
@@ -113,6 +117,15 @@ def test_residual_cnn_reads_the_planes():
     obs = agent.get_env().reset()
     assert agent.q_values(obs).shape == (1, 4)
     agent.learn(30)  # trains through the batch-norm layers
+    # Q-values (the greedy policy's, and the teacher's table's) read the running statistics and
+    # leave them and the network's mode as they were
+    agent.q_net.set_training_mode(True)
+    before = [b.clone() for b in agent.q_net.features_extractor.buffers()]
+    batch = np.stack([agent.get_env().observation_space.sample() for _ in range(7)])
+    first, second = agent.q_values(batch), agent.q_values(batch[:3])
+    np.testing.assert_allclose(first[:3], second, rtol=1e-5)  # a row's value does not depend on its batch
+    assert agent.q_net.training
+    assert all((a == b).all() for a, b in zip(before, agent.q_net.features_extractor.buffers()))
     from craftsuite.agents.networks import features_policy_kwargs
 
     with pytest.raises(ValueError, match="reads grid planes"):
@@ -133,9 +146,11 @@ def test_students_without_the_automaton_state(tmp_path, method):
     agent = load_agent(run / "model.zip")
     assert agent.observation_space.shape == base  # no automaton one-hot
     assert agent.distill is not None  # the automaton still reaches the target
-    # the same student with the state is another run, told apart by its settings
+    # the same student with the state is another run, told apart by its settings; asking a
+    # method for what it does anyway is the same run
     seeing = dataclasses.replace(config, automaton_state=None)
     assert seeing.run_name() != config.run_name() and seeing.product
+    assert dataclasses.replace(config, automaton_state=True).run_name() == seeing.run_name()
 
 
 def test_a_method_that_cannot_go_without_the_automaton_state_is_refused(tmp_path, capsys):

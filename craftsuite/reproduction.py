@@ -123,7 +123,8 @@ def write_report(run_dir, path) -> Path:
                 verdicts += f" (fewer than {MIN_SEEDS} seeds: not a claim)"
             summary.append(f"| {panel.letter} | {panel.task} | {world} | {seeds} | {budget} | {verdicts} |")
             body += [f"## {title}", "", f"The paper: *{panel.claim}*.", "",
-                     f"Measured: {verdicts}." + (f" Did not run: {', '.join(missing)}." if missing else ""), ""]
+                     f"Measured: {verdicts}." + (f" Did not run: {', '.join(missing)}."
+                                                 if [m for m in missing if m != panel.distilled] else ""), ""]
             body += [_table(to_markdown([entries[m] for m in ran], title=None)), ""]
             plot = curves.get(f"curves-{panel.task}-{world}")
             if plot is not None:

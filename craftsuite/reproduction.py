@@ -134,6 +134,9 @@ def write_report(run_dir, path) -> Path:
               "over the last 10% of a run (the paper's figure plots reward per episode). *Ahead* / *behind*: the "
               "distilled student's 95% t-interval lies wholly above / below the baseline's; *no difference "
               "measured*: they overlap; *neither learned*: both succeed at no evaluation.", "", *body]
+    for plot in curves.values():  # a task or world of no panel (e.g. obstacles in a continuous world)
+        if plot.stem not in {f"curves-{p.task}-{w}" for p in FIGURE_5 for w in p.worlds}:
+            plot.unlink()
     atomic_write(path, "\n".join(lines))
     return path
 

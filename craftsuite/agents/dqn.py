@@ -106,10 +106,14 @@ class AutomatonDQN(NStepOwner, DQN):
         with th.no_grad():
             next_q = self.q_net_target(data.next_observations)
             if self.double:
+                # a CNN's batch-norm statistics move once per gradient step, not twice (an MLP has none:
+                # no mode switch on the hot path)
                 training = self.q_net.training
-                self.q_net.set_training_mode(False)  # a CNN's batch-norm statistics move once per step, not twice
+                if self.batch_norm_stats:
+                    self.q_net.set_training_mode(False)
                 best = self.q_net(data.next_observations).argmax(dim=1, keepdim=True)
-                self.q_net.set_training_mode(training)
+                if self.batch_norm_stats:
+                    self.q_net.set_training_mode(training)
                 next_q = th.gather(next_q, dim=1, index=best)
             else:
                 next_q = next_q.max(dim=1, keepdim=True)[0]

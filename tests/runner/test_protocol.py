@@ -10,6 +10,7 @@ import json
 import gymnasium as gym
 import numpy as np
 import pytest
+import torch as th
 
 import craftsuite  # noqa: F401  (registers the ids)
 from craftsuite.agents.methods import make_agent
@@ -117,6 +118,8 @@ def test_residual_cnn_reads_the_planes():
     obs = agent.get_env().reset()
     assert agent.q_values(obs).shape == (1, 4)
     agent.learn(30)  # trains through the batch-norm layers
+    norms = [m for m in agent.q_net.modules() if isinstance(m, th.nn.BatchNorm2d)]
+    assert norms and all(int(m.num_batches_tracked) == agent._n_updates > 0 for m in norms)  # once per update
     # Q-values (the greedy policy's, and the teacher's table's) read the running statistics and
     # leave them and the network's mode as they were
     agent.q_net.set_training_mode(True)

@@ -9,7 +9,7 @@ from ..rendering.frames import MAX_FRAME_SIDE, frame_side  # noqa: F401  (MAX_FR
 from ..rendering.gl import gl_error_hint
 from ..rendering.panel import add_status_panel
 from ..spec import TaskSpec
-from .planar import PlanarWorld
+from .planar import PlanarWorld, within_boxes
 from .scene import AGENT_HALF, build_scene
 
 TOP_SPEED = 2.0  # m/s at full thrust (gear 10 / damping 5 in assets/arena.xml)
@@ -88,6 +88,7 @@ class ContinuousWorldEnv(PlanarWorld):
         self.half = cfg.arena / 2
         self.radius = cfg.pickup_radius
         self.scene = scene = build_scene(spec)
+        self._boxes = np.array(scene.obstacles, dtype=float).reshape(-1, 3)  # x, y, half side
         self.model = mujoco.MjModel.from_xml_string(scene.xml)
         self.data = mujoco.MjData(self.model)
         self.frame_skip = frame_skip = frame_skip or self._spec_frame_skip()
@@ -136,11 +137,7 @@ class ContinuousWorldEnv(PlanarWorld):
     def _clear(self, points: np.ndarray, margin: float) -> np.ndarray:
         """Which of the (n, 2) points keep ``margin`` from the walls and every obstacle."""
         ok = (np.abs(points) <= self.half - margin).all(axis=1)
-        if self.scene.obstacles:
-            box = np.array(self.scene.obstacles)  # (k, 3): x, y, half side
-            gap = np.maximum(np.abs(points[:, None, 0] - box[:, 0]), np.abs(points[:, None, 1] - box[:, 1]))
-            ok &= (gap >= box[:, 2] + margin).all(axis=1)
-        return ok
+        return ok & ~within_boxes(points, self._boxes, margin)
 
     def _sample_positions(self, n: int) -> np.ndarray:
         """n points, pairwise >= 2 pickup radii apart, clear of walls and obstacles.

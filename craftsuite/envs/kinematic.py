@@ -18,7 +18,7 @@ import numpy as np
 from ..rendering.frames import frame_side
 from ..rendering.panel import add_status_panel, hex_to_rgb
 from ..spec import KINEMATIC, TaskSpec
-from .planar import PlanarWorld
+from .planar import PlanarWorld, obstacle_boxes, within_boxes
 
 # The authors' values (``spec.KinematicConfig``); the board side, pickup radius and
 # off-board penalty are the spec's ``[continuous]`` values, which equal theirs (7, 0.4, -0.1).
@@ -84,7 +84,8 @@ class KinematicWorldEnv(PlanarWorld):
         self.step_size = STEP
         self._lay_out([kind for kind, obj in enumerate(spec.objects) for _ in range(obj.count)])
         n_obj = len(self._kinds)
-        self._obstacles = self._obstacle_squares()
+        # the MuJoCo scene's boxes, moved from its centre origin to the board's corner
+        self._obstacles = np.array(obstacle_boxes(spec), dtype=float).reshape(-1, 3) + [self.half, self.half, 0.0]
         # the authors' object sites: the board's integer points but (0, 0), here also clear
         # of obstacles by a pickup radius (so no object hides in a wall)
         axis = np.arange(int(np.ceil(self.arena)), dtype=float)
@@ -96,23 +97,8 @@ class KinematicWorldEnv(PlanarWorld):
         self._position = np.zeros(2)
         self._level_mask = 0
 
-    def _obstacle_squares(self) -> np.ndarray:
-        """Obstacle cells of the largest grid, scaled to the board: (k, 3) x, y, half side,
-        y up (grid rows count down from the top, as the MuJoCo scene reads them)."""
-        spec = self.task
-        if not spec.grid.obstacles:
-            return np.zeros((0, 3))
-        cell = self.arena / max(spec.grid.sizes)
-        return np.array([((x + 0.5) * cell, self.arena - (y + 0.5) * cell, cell / 2)
-                         for x, y in spec.grid.obstacles])
-
     def _in_obstacle(self, points: np.ndarray, margin: float = 0.0) -> np.ndarray:
-        points = np.atleast_2d(points)
-        if not len(self._obstacles):
-            return np.zeros(len(points), dtype=bool)
-        box = self._obstacles
-        gap = np.maximum(np.abs(points[:, None, 0] - box[:, 0]), np.abs(points[:, None, 1] - box[:, 1]))
-        return (gap < box[:, 2] + margin).any(axis=1)
+        return within_boxes(points, self._obstacles, margin)
 
     def on_board(self, point) -> bool:
         """Whether the agent may stand at ``point``: on the half-open board (the authors'

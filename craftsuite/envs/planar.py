@@ -11,7 +11,29 @@ import gymnasium as gym
 import numpy as np
 
 from ..rendering.panel import PANEL_HEIGHT
+from ..spec import TaskSpec
 from .base import CraftWorld
+
+
+def obstacle_boxes(spec: TaskSpec) -> tuple[tuple[float, float, float], ...]:
+    """Obstacle cells of the largest grid as (x, y, half side) in arena coordinates (y up,
+    origin at the centre); the kinematic board shifts them to its corner origin."""
+    if not spec.grid.obstacles:
+        return ()
+    n = max(spec.grid.sizes)
+    cell = spec.continuous.arena / n
+    half = spec.continuous.arena / 2
+    return tuple(((x + 0.5) * cell - half, half - (y + 0.5) * cell, cell / 2)
+                 for x, y in spec.grid.obstacles)
+
+
+def within_boxes(points: np.ndarray, boxes: np.ndarray, margin: float = 0.0) -> np.ndarray:
+    """Which of the (n, 2) points lie inside any (k, 3) box (x, y, half side) grown by ``margin``."""
+    points = np.atleast_2d(points)
+    if not len(boxes):
+        return np.zeros(len(points), dtype=bool)
+    gap = np.maximum(np.abs(points[:, None, 0] - boxes[:, 0]), np.abs(points[:, None, 1] - boxes[:, 1]))
+    return (gap < boxes[:, 2] + margin).any(axis=1)
 
 
 class PlanarWorld(CraftWorld):

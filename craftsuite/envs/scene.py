@@ -16,6 +16,7 @@ from dm_control import mjcf
 from ..paths import assets_dir
 from ..rendering.panel import hex_to_rgb
 from ..spec import TaskSpec
+from .planar import obstacle_boxes
 
 WALL_THICKNESS = 0.1
 AGENT_HALF = 0.15
@@ -33,17 +34,6 @@ class Scene:
 
 def _rgba(color: str) -> list[float]:
     return [c / 255 for c in hex_to_rgb(color)] + [1.0]
-
-
-def obstacle_boxes(spec: TaskSpec) -> tuple[tuple[float, float, float], ...]:
-    """Obstacle cells as (x, y, half side) in arena coordinates (y up, origin at the centre)."""
-    if not spec.grid.obstacles:
-        return ()
-    n = max(spec.grid.sizes)
-    cell = spec.continuous.arena / n
-    half = spec.continuous.arena / 2
-    return tuple(((x + 0.5) * cell - half, half - (y + 0.5) * cell, cell / 2)
-                 for x, y in spec.grid.obstacles)
 
 
 _SCENES: dict[int, tuple[TaskSpec, Scene]] = {}  # by id(spec); the spec is kept alive with it

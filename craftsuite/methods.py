@@ -246,6 +246,13 @@ METHODS = MappingProxyType({m.name: m for m in (
     Method("static", "Grid", "dqn", True, "static", description="DQN student, statically distilled automaton"),
     Method("dynamic", "Grid", "dqn", True, "dynamic",
            description="DQN student, teacher distilled into the automaton (the paper's method)"),
+    # The transfer method: the teacher's values only where the automaton moves, never faded
+    # (its self-loop values, ~77 everywhere, are fitted everywhere otherwise and slow the
+    # student: experiments/self-loops), and every real step replayed from every automaton
+    # state (CRM), so that one touch of an object teaches each edge it would take
+    Method("crm-edges", "Grid", "dqn", True, "dynamic", crm=True, target={"rho": 1.0, "self_loops": False},
+           description="product DQN with counterfactual experiences and the teacher's values on the "
+                       "automaton's edges only, never faded"),
     Method("td3", "Cont", "td3", False, description="TD3 from scratch"),
     Method("product-td3", "Cont", "td3", True, description="TD3 over the product MDP"),
     Method("td3-static", "Cont", "td3", True, "static", description="TD3 student, statically distilled automaton"),
@@ -256,6 +263,8 @@ METHODS = MappingProxyType({m.name: m for m in (
     # (its flat self-loop values are fitted everywhere otherwise), never faded
     Method("td3-dynamic-edges", "Cont", "td3", True, "dynamic", target={"rho": 1.0, "self_loops": False},
            description="td3-dynamic with the teacher's values on the automaton's edges only, never faded (rho 1)"),
+    Method("td3-crm-edges", "Cont", "td3", True, "dynamic", crm=True, target={"rho": 1.0, "self_loops": False},
+           description="td3-dynamic-edges with counterfactual experiences over automaton states (CRM)"),
 )})
 
 

@@ -148,3 +148,21 @@ def test_each_env_of_a_vector_explores_with_its_own_persistent_noise():
                        **SMALL_TD3)
     draws = agent.action_noise()
     assert draws.shape == (3, 2) and len({tuple(d) for d in draws}) == 3
+
+
+@pytest.mark.parametrize("method, world", [("crm-edges", "CraftSuite/DungeonQuest-Grid10-v0"), ("td3-crm-edges", CONT)])
+def test_the_transfer_method_distills_edges_into_counterfactual_experiences(method, world, table):
+    # the row composes two components: CRM's replay and the edges-only, never-faded target
+    small = SMALL_DQN if METHODS[method].algorithm == "dqn" else SMALL_TD3
+    agent = make_agent(method, world, table=table, seed=2, **small)
+    assert type(agent.replay_buffer).__name__ == "CRMReplayBuffer"
+    assert (agent.distill.rho, agent.distill.self_loops) == (1.0, False)
+    agent.learn(300)
+    automaton = agent.get_env().envs[0].unwrapped.automaton
+    buffer = agent.replay_buffer
+    # every live automaton state has experiences, though the agent was in few of them
+    assert set(np.unique(buffer.w[:buffer.pos])) == set(np.flatnonzero(~(automaton.accepting | automaton.rejecting)))
+    # and the target read the teacher only on edges: the self-loops' counts carry no teacher weight
+    counted = agent.distill.student_counts > 0
+    loops = automaton.delta == np.arange(automaton.n_states)[:, None]
+    assert counted[loops].any() and agent.distill.beta(*np.nonzero(counted & loops)).max() == 0.0

@@ -145,9 +145,17 @@ def test_suites_are_well_formed(tmp_path):
     assert both.teachers() == {}  # no method needs a teacher
     grid_distiller = dataclasses.replace(SUITES["quick"], methods=("td3", "dynamic"))
     assert grid_distiller.teachers() == {}  # `dynamic` needs one, but runs on the grids, not in this suite's world
-    # standard: every rung x every method (each in its world) x 5 seeds, budgets by level
+    # standard: every rung x the paper's methods and baselines (each in its world) x 5 seeds, budgets by level
+    from craftsuite.suites import PAPER_METHODS
+
     standard = SUITES["standard"].student_configs(tmp_path)
-    assert {(c.task, c.method) for c in standard} == set(product([s.name for s in ladder()], METHODS))
+    assert {(c.task, c.method) for c in standard} == set(product([s.name for s in ladder()], PAPER_METHODS))
+    assert set(METHODS) - set(PAPER_METHODS) == {"crm-edges", "td3-crm-edges"}  # the transfer suite's
+    transfer = SUITES["transfer"].student_configs(tmp_path)
+    assert {c.method for c in transfer} == {"dqn", "dynamic", "crm-edges", "td3", "td3-dynamic", "td3-crm-edges"}
+    # every TD3 method of the transfer suite gets the same replay, small enough for CRM's copies
+    assert {c.hyperparameters["buffer_size"] for c in transfer if c.world == "Cont"} == {200_000}
+    assert {c.table is not None for c in transfer if c.method.endswith("crm-edges")} == {True}
     assert {c.seed for c in standard} == set(range(5))
     budgets, specs = SUITES["standard"].budgets, {s.name: s for s in ladder()}
     assert all(c.steps == budgets["Cont" if c.world == "Cont" else "Grid"][specs[c.task].level] for c in standard)

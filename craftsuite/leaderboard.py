@@ -242,6 +242,37 @@ AGGREGATE_LEGEND = (
     "5 seeds covered 89% of simulated cases, not 95%): read an overlap as no difference.")
 
 
+def transfer_verdict(entry: Entry, baseline: Entry) -> tuple[bool, str]:
+    """Whether ``entry`` reaches 80% greedy success in at most half the transitions of
+    ``baseline`` (its algorithm from scratch, same task and world), read on the medians over
+    all seeds (``stats.Reached.overall``), and the figures that say so. Where scratch's
+    median is never, reaching 80% at all within the budget meets it."""
+    mine, theirs = entry.reached.overall, baseline.reached.overall
+
+    def text(steps: float, e: Entry) -> str:
+        return f"{steps:,.0f}" if math.isfinite(steps) else f"never in {e.budget:,}"
+
+    figures = f"{text(mine, entry)} against {text(theirs, baseline)}"
+    if not math.isfinite(mine):
+        return False, f"not met ({figures})"
+    if not math.isfinite(theirs) and baseline.budget >= entry.budget:
+        return True, f"met ({figures})"
+    if math.isfinite(theirs) and mine <= theirs / 2:
+        return True, f"met ({figures})"
+    return False, f"not met ({figures})"
+
+
+def transfer_verdicts(rows: list[Entry]) -> list[tuple[Entry, Entry, str]]:
+    """For one task and world: each method beside its algorithm from scratch, (entry,
+    scratch's entry, verdict text); none where scratch did not run or ran in variants."""
+    from .methods import scratch
+
+    base = [e for e in rows if e.method == scratch(e.world.split(":")[0])]
+    if len(base) != 1:
+        return []
+    return [(e, base[0], transfer_verdict(e, base[0])[1]) for e in rows if e is not base[0]]
+
+
 def to_markdown(board, title: str | None = "# Leaderboard", profiles: dict[str, Path] | None = None,
                 aggs: list[Aggregate] | None = None) -> str:
     """The board as Markdown; ``profiles``: per world, a performance-profile image to link;
@@ -270,6 +301,11 @@ def to_markdown(board, title: str | None = "# Leaderboard", profiles: dict[str, 
             for method, value in ref.items():
                 lines.append(f"| *reference: authors' {method}, 1 run, 2M steps (return over the last 5%)* "
                              f"| 1 | | | | {value:.2f} | | | |")
+        verdicts = transfer_verdicts(rows)
+        if verdicts:
+            lines += ["", f"Transfer target (80% greedy success in at most half the transitions "
+                      f"`{verdicts[0][1].method}` needs; median over seeds, a seed that never reached 80% counting "
+                      "as never): " + "; ".join(f"`{e.label}` {text}" for e, _, text in verdicts) + "."]
         notes = [f"*{e.label}: " + "; ".join(f"{k} = {json.dumps(v)}" for k, v in e.differs.items()) + "*"
                  for e in rows if e.variant]
         if notes:

@@ -141,6 +141,9 @@ class Reached:
     k: int
     n: int
     median: float | None
+    # the median over every seed, one that never reached counting as later than any that did
+    # (inf: half or more never did): what a comparison of methods' time to a threshold reads
+    overall: float = math.inf
 
     def __str__(self) -> str:
         if self.k == 0:
@@ -151,4 +154,7 @@ class Reached:
 def reached(steps) -> Reached:
     """``steps``: per seed, the transitions at which it reached the threshold, or None."""
     done = [s for s in steps if s is not None]
-    return Reached(len(done), len(steps), float(median(done)) if done else None)
+    every = sorted(math.inf if s is None else float(s) for s in steps)
+    middle = every[(len(every) - 1) // 2: len(every) // 2 + 1]  # one value, or the two of an even count
+    overall = math.inf if not every or math.inf in middle else float(np.mean(middle))
+    return Reached(len(done), len(steps), float(median(done)) if done else None, overall)

@@ -264,3 +264,29 @@ def test_a_world_with_nothing_to_aggregate_says_why(tmp_path):
     md = leaderboard.to_markdown(leaderboard.build(root))
     assert "### Cont\n\nNothing to aggregate: td3, td3-dynamic: fewer than 2 runs on some task" in md
     assert leaderboard.plot_profiles(leaderboard.build(root), tmp_path) == []
+
+
+def test_each_task_says_whether_a_method_reaches_80_percent_in_half_of_scratchs_transitions(tmp_path):
+    root = tmp_path / "students"
+    evals = {"late": [(500, 0.0), (1000, 0.8)], "early": [(500, 0.8), (1000, 1.0)], "never": [(500, 0.0), (1000, 0.0)]}
+    for seed, speed in enumerate(["late", "late", "never"]):  # scratch: median 1,000
+        fake_run(root, "td3", seed, evals[speed], [])
+    for seed, speed in enumerate(["early", "early", "never"]):  # median 500: half of scratch's, met
+        fake_run(root, "td3-crm-edges", seed, evals[speed], [])
+    for seed, speed in enumerate(["early", "late", "late"]):  # median 1,000: not met, though one seed was early
+        fake_run(root, "td3-dynamic", seed, evals[speed], [])
+    board = leaderboard.build(root)
+    line = next(l for l in leaderboard.to_markdown(board).splitlines() if l.startswith("Transfer target"))
+    assert "`td3` needs" in line
+    assert "`td3-crm-edges` met (500 against 1,000)" in line
+    assert "`td3-dynamic` not met (1,000 against 1,000)" in line
+    # where scratch never gets there, reaching 80% at all meets it; never reaching never does
+    never = tmp_path / "never"
+    for seed in range(3):
+        fake_run(never, "td3", seed, evals["never"], [])
+        fake_run(never, "td3-crm-edges", seed, evals["early"] if seed else evals["never"], [])
+        fake_run(never, "td3-dynamic", seed, evals["never"], [])
+    line = next(l for l in leaderboard.to_markdown(leaderboard.build(never)).splitlines()
+                if l.startswith("Transfer target"))
+    assert "`td3-crm-edges` met (500 against never in 1,000)" in line  # seeds: never, 500, 500
+    assert "`td3-dynamic` not met (never in 1,000 against never in 1,000)" in line

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -41,6 +43,11 @@ def test_steps_to_a_threshold_never_average_the_runs_that_did_not_get_there():
     assert str(stats.reached([300, None, 100, 200])) == "3 of 4; median 200"
     assert str(stats.reached([None, None])) == "0 of 2"
     assert stats.reached([10, 30]).median == 20.0
+    # over every seed, a seed that never reached counting as later than all that did
+    assert stats.reached([300, None, 100, 200]).overall == 250.0  # 200 and 300 in the middle
+    assert stats.reached([300, None, 100]).overall == 300.0
+    assert stats.reached([300, None, None, 100]).overall == math.inf  # the middle holds a never
+    assert stats.reached([None, None, None]).overall == stats.reached([]).overall == math.inf
 
 
 def test_aggregate_estimates_need_two_runs_per_task():

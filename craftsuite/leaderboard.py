@@ -246,7 +246,8 @@ def transfer_verdict(entry: Entry, baseline: Entry) -> tuple[bool, str]:
     """Whether ``entry`` reaches 80% greedy success in at most half the transitions of
     ``baseline`` (its algorithm from scratch, same task and world), read on the medians over
     all seeds (``stats.Reached.overall``), and the figures that say so. Where scratch's
-    median is never, reaching 80% at all within the budget meets it."""
+    median is never, all that is known is that it exceeds scratch's budget: the target is
+    met within half that budget."""
     mine, theirs = entry.reached.overall, baseline.reached.overall
 
     def text(steps: float, e: Entry) -> str:
@@ -255,22 +256,22 @@ def transfer_verdict(entry: Entry, baseline: Entry) -> tuple[bool, str]:
     figures = f"{text(mine, entry)} against {text(theirs, baseline)}"
     if not math.isfinite(mine):
         return False, f"not met ({figures})"
-    if not math.isfinite(theirs) and baseline.budget >= entry.budget:
-        return True, f"met ({figures})"
-    if math.isfinite(theirs) and mine <= theirs / 2:
+    if mine <= (theirs if math.isfinite(theirs) else baseline.budget) / 2:
         return True, f"met ({figures})"
     return False, f"not met ({figures})"
 
 
 def transfer_verdicts(rows: list[Entry]) -> list[tuple[Entry, Entry, str]]:
-    """For one task and world: each method beside its algorithm from scratch, (entry,
-    scratch's entry, verdict text); none where scratch did not run or ran in variants."""
-    from .methods import scratch
+    """For one task and world: each distilled student (a method with a distilled target)
+    beside its algorithm from scratch, (entry, scratch's entry, verdict text); none where
+    scratch did not run or ran in variants."""
+    from .methods import METHODS, scratch
 
     base = [e for e in rows if e.method == scratch(e.world.split(":")[0])]
     if len(base) != 1:
         return []
-    return [(e, base[0], transfer_verdict(e, base[0])[1]) for e in rows if e is not base[0]]
+    return [(e, base[0], transfer_verdict(e, base[0])[1]) for e in rows
+            if e.method in METHODS and METHODS[e.method].distill]
 
 
 def to_markdown(board, title: str | None = "# Leaderboard", profiles: dict[str, Path] | None = None,

@@ -216,16 +216,16 @@ class Method:
             return self.product
         if not isinstance(automaton_state, bool):
             raise MethodError(f"automaton_state must be true, false or null, got {automaton_state!r}")
-        if self.distill is not None:
+        if self.distill is not None and not self.crm:
             return automaton_state
-        if self.crm:
+        if self.crm:  # distilled or not: its replay writes the one-hot the observation must carry
             why = "its counterfactual experiences relabel the automaton state in the observation"
         elif self.product:
             why = f"the automaton state is what it adds to {_scratch_of(self.world)!r}: run that instead"
         else:
             why = f"a method from scratch sees the world alone: {_product_of(self.world)!r} sees the automaton state"
         raise MethodError(f"method {self.name!r} cannot run with automaton_state={automaton_state}: {why}; only "
-                          f"the distilled students ({', '.join(n for n, m in METHODS.items() if m.distill)}) "
+                          f"the distilled students ({', '.join(n for n, m in METHODS.items() if m.distill and not m.crm)}) "
                           "may go with or without it")
 
     def settings(self) -> dict:

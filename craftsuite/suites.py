@@ -171,7 +171,7 @@ PAPER_PROTOCOL = dict(teacher_layout_seed=None, teacher_n_envs=10, teacher_hyper
 # The methods of the paper and its baselines (every row before the transfer method): what
 # the standard and paper suites compare. The transfer method's counterfactual replay holds
 # one copy of each step per automaton state, which the 1M-transition TD3 buffer cannot
-# afford on Diamond Mine (12 copies of 154 numbers); the transfer suite runs it.
+# afford on Diamond Mine (13 copies of 154 numbers); the transfer suite runs it.
 PAPER_METHODS = tuple(name for name, m in METHODS.items() if not (m.crm and m.distill))
 TRANSFER_METHODS = ("dqn", "dynamic", "crm-edges", "td3", "td3-dynamic", "td3-crm-edges")
 
@@ -180,23 +180,25 @@ SUITES = {s.name: s for s in (
           "(about 10 minutes on 2 cores)",
           tags=("calibration", "medium"), worlds=("Cont",), methods=("td3", "td3-dynamic-edges"), seeds=2,
           budgets={"Cont": {"easy": 200_000, "medium": 800_000}}, **TD3_REGIME),
-    Suite("standard", "every rung x every method, 5 seeds (about 3 hours on 2 cores)",
+    Suite("standard", "every rung x the paper's methods and baselines, 5 seeds (about 3 hours on 2 cores)",
           tags=("easy", "medium", "hard"), worlds=("Grid10", "Cont"), methods=PAPER_METHODS, seeds=5,
           budgets={"Cont": {"easy": 250_000, "medium": 800_000, "hard": 60_000},
                    "Grid": {"easy": 30_000, "medium": 60_000, "hard": 60_000}},
           **TD3_REGIME, **DQN_REGIME),
-    Suite("paper", "the paper's protocol as the authors' code ran it: every method on the paper's tasks in the grid, "
-          "MuJoCo and kinematic worlds, 20 seeds, 2M steps of 10 envs (20M transitions) per run",
+    Suite("paper", "the paper's protocol as the authors' code ran it: the paper's methods and baselines on its tasks "
+          "in the grid, MuJoCo and kinematic worlds, 20 seeds, 2M steps of 10 envs (20M transitions) per run",
           tags=("paper",), worlds=("Grid10", "Cont", "Kinematic"), methods=PAPER_METHODS, seeds=20,
           student_steps=20_000_000, eval_every=500_000, teacher_max_steps=20_000_000, **PAPER_PROTOCOL),
     # the transfer target (a distilled student at 80% greedy success in at most half the
     # transitions its algorithm needs from scratch) on the paper's three tasks: scratch, the
     # paper's method and the transfer method, in the standard suite's collection regimes, with
-    # a 200k-transition replay (see PAPER_METHODS) for every TD3 method alike
+    # a 200k-transition replay (see PAPER_METHODS) for every TD3 method alike. A DQN's replay
+    # holds its whole budget: crm-edges on Diamond Mine's grid fills about 7.5 GB (13 copies
+    # of 721 numbers), so on 24 GiB run the grids with --workers 1
     Suite("transfer", "the paper's three tasks: scratch, the paper's method and the transfer method (crm-edges), "
-          "Grid10 and MuJoCo, 5 seeds (about 2 hours on 2 cores)",
+          "Grid10 and MuJoCo, 5 seeds (about 4 hours on 2 cores)",
           tasks=("BlindCraftsman", "DungeonQuest", "DiamondMine"), worlds=("Grid10", "Cont"),
-          methods=TRANSFER_METHODS, seeds=5, budgets={"Cont": {"hard": 600_000}, "Grid": {"hard": 150_000}},
+          methods=TRANSFER_METHODS, seeds=5, budgets={"Cont": {"hard": 600_000}, "Grid": {"hard": 100_000}},
           td3_n_envs=TD3_REGIME["td3_n_envs"], td3_hyperparameters={**TD3_REGIME["td3_hyperparameters"],
                                                                     "buffer_size": 200_000},
           **DQN_REGIME),

@@ -166,3 +166,12 @@ def test_the_transfer_method_distills_edges_into_counterfactual_experiences(meth
     counted = agent.distill.student_counts > 0
     loops = automaton.delta == np.arange(automaton.n_states)[:, None]
     assert counted[loops].any() and agent.distill.beta(*np.nonzero(counted & loops)).max() == 0.0
+
+
+def test_the_transfer_method_cannot_go_without_the_automaton_state_its_replay_rewrites(table):
+    # distilled, yet CRM: its counterfactuals write the one-hot into the observation's last entries
+    for method, world in (("crm-edges", "CraftSuite/DungeonQuest-Grid10-v0"), ("td3-crm-edges", CONT)):
+        with pytest.raises(MethodError, match=f"method '{method}' cannot run with automaton_state=False: its "
+                                              "counterfactual experiences relabel"):
+            make_agent(method, world, table=table, automaton_state=False, **SMALL_TD3)
+    assert METHODS["td3-dynamic-edges"].observes(False) is False  # a distilled student without CRM still may

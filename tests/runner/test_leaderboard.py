@@ -288,14 +288,14 @@ def test_each_task_says_whether_a_method_reaches_80_percent_in_half_of_scratchs_
         fake_run(never, "td3-dynamic", seed, evals["never"], [])
     line = next(l for l in leaderboard.to_markdown(leaderboard.build(never)).splitlines()
                 if l.startswith("Transfer target"))
-    assert "`td3-crm-edges` met (500 against never in 1,000)" in line  # seeds: never, 500, 500
+    assert "`td3-crm-edges` met: scratch never got there (500 against never in 1,000)" in line  # never, 500, 500
     assert "`td3-dynamic` not met (never in 1,000 against never in 1,000)" in line
-    # scratch's never says only that it needs more than its budget: 80% at 750 of 1,000 is not half of it
-    late = tmp_path / "late"
+    # scratch with a smaller budget than the student's never says enough
+    small = tmp_path / "small"
     for seed in range(3):
-        fake_run(late, "td3", seed, evals["never"], [])
-        fake_run(late, "td3-crm-edges", seed, [(750, 0.8), (1000, 0.9)], [])
-        fake_run(late, "product-td3", seed, evals["early"], [])  # no distilled target: no verdict
-    line = next(l for l in leaderboard.to_markdown(leaderboard.build(late)).splitlines()
+        fake_run(small, "td3", seed, [(250, 0.0), (500, 0.0)], [], budget=500)
+        fake_run(small, "td3-crm-edges", seed, [(750, 0.8), (1000, 0.9)], [])
+        fake_run(small, "product-td3", seed, evals["early"], [])  # no distilled target: no verdict
+    line = next(l for l in leaderboard.to_markdown(leaderboard.build(small)).splitlines()
                 if l.startswith("Transfer target"))
-    assert line.endswith("`td3-crm-edges` not met (750 against never in 1,000).")
+    assert line.endswith("`td3-crm-edges` not met (750 against never in 500).")

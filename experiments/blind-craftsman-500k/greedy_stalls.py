@@ -30,9 +30,10 @@ def _load(run: Path):
 
     config = load_config(StudentConfig, run)
     saved = checkpoint_dir(RunDir(run, config))
-    if saved is None:
-        raise FileNotFoundError(f"{run} has no checkpoint yet")
-    return config, load_agent(saved / "model.zip"), config.product
+    model = saved / "model.zip" if saved is not None else run / "model.zip"  # a finished run keeps its model only
+    if not model.is_file():
+        raise FileNotFoundError(f"{run} has no checkpoint nor final model yet")
+    return config, load_agent(model), config.product
 
 
 def _thrust_grid():

@@ -224,9 +224,9 @@ class Method:
             why = f"the automaton state is what it adds to {_scratch_of(self.world)!r}: run that instead"
         else:
             why = f"a method from scratch sees the world alone: {_product_of(self.world)!r} sees the automaton state"
+        free = ", ".join(n for n, m in METHODS.items() if m.distill and not m.crm)
         raise MethodError(f"method {self.name!r} cannot run with automaton_state={automaton_state}: {why}; only "
-                          f"the distilled students ({', '.join(n for n, m in METHODS.items() if m.distill and not m.crm)}) "
-                          "may go with or without it")
+                          f"the distilled students ({free}) may go with or without it")
 
     def settings(self) -> dict:
         """What the row makes a run do, as plain data (recorded and hashed with each run)."""

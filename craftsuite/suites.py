@@ -163,11 +163,6 @@ PAPER_PROTOCOL = dict(teacher_layout_seed=None, teacher_n_envs=10, teacher_hyper
                       grid_layout_seed=None, dqn_n_envs=10, dqn_hyperparameters=AUTHORS_DQN,
                       td3_n_envs=10, td3_hyperparameters=AUTHORS_TD3, students_see_automaton=False)
 
-# Budgets, in transitions: TD3 students on the easy and medium rungs get enough to pass the
-# collapse that follows their first success (greedy success falls for 30-80k transitions
-# before it settles: experiments/collection-regime, "Stability"), so that the last
-# evaluation reads what was learned; the hard rungs get what is left of about 3 hours
-# on 2 cores for the standard suite (no TD3 student learns them in so few).
 # The methods of the paper and its baselines (every row before the transfer method): what
 # the standard and paper suites compare. The transfer method's counterfactual replay holds
 # one copy of each step per automaton state, which the 1M-transition TD3 buffer cannot
@@ -175,6 +170,11 @@ PAPER_PROTOCOL = dict(teacher_layout_seed=None, teacher_n_envs=10, teacher_hyper
 PAPER_METHODS = tuple(name for name, m in METHODS.items() if not (m.crm and m.distill))
 TRANSFER_METHODS = ("dqn", "dynamic", "crm-edges", "td3", "td3-dynamic", "td3-crm-edges")
 
+# Budgets, in transitions: TD3 students on the easy and medium rungs get enough to pass the
+# collapse that follows their first success (greedy success falls for 30-80k transitions
+# before it settles: experiments/collection-regime, "Stability"), so that the last
+# evaluation reads what was learned; the hard rungs get what is left of about 3 hours
+# on 2 cores for the standard suite (no TD3 student learns them in so few).
 SUITES = {s.name: s for s in (
     Suite("quick", "the calibration rung and the two-stage rung in MuJoCo: TD3 from scratch and distilled "
           "(about 10 minutes on 2 cores)",

@@ -242,7 +242,7 @@ AGGREGATE_LEGEND = (
     "5 seeds covered 89% of simulated cases, not 95%): read an overlap as no difference.")
 
 
-def transfer_verdict(entry: Entry, baseline: Entry) -> tuple[bool, str]:
+def transfer_verdict(entry: Entry, baseline: Entry) -> str:
     """Whether ``entry`` reaches 80% greedy success in at most half the transitions of
     ``baseline`` (its algorithm from scratch, same task and world), read on the medians over
     all seeds (``stats.Reached.overall``), and the figures that say so. Where scratch's
@@ -256,12 +256,12 @@ def transfer_verdict(entry: Entry, baseline: Entry) -> tuple[bool, str]:
 
     figures = f"{text(mine, entry)} against {text(theirs, baseline)}"
     if not math.isfinite(mine):
-        return False, f"not met ({figures})"
+        return f"not met ({figures})"
     if math.isfinite(theirs) and mine <= theirs / 2:
-        return True, f"met ({figures})"
+        return f"met ({figures})"
     if not math.isfinite(theirs) and baseline.budget >= entry.budget:
-        return True, f"met: scratch never got there ({figures})"
-    return False, f"not met ({figures})"
+        return f"met: scratch never got there ({figures})"
+    return f"not met ({figures})"
 
 
 def transfer_verdicts(rows: list[Entry]) -> list[tuple[Entry, Entry, str]]:
@@ -273,7 +273,7 @@ def transfer_verdicts(rows: list[Entry]) -> list[tuple[Entry, Entry, str]]:
     base = [e for e in rows if e.method == scratch(e.world.split(":")[0])]
     if len(base) != 1:
         return []
-    return [(e, base[0], transfer_verdict(e, base[0])[1]) for e in rows
+    return [(e, base[0], transfer_verdict(e, base[0])) for e in rows
             if e.method in METHODS and METHODS[e.method].distill]
 
 

@@ -14,21 +14,25 @@ import gymnasium as gym
 import numpy as np
 
 import craftsuite  # noqa: F401  (registers the ids)
+from craftsuite.agents.noise import make_action_noise
+from craftsuite.suites import TD3_REGIME
+
+SUITE_NOISE = TD3_REGIME["td3_hyperparameters"]["action_noise"]
 
 
 def explore(episodes: int, persistent: bool, seed: int = 0) -> tuple[Counter, Counter]:
     """(golds held at the end, how episodes ended) over ``episodes`` episodes."""
     env = gym.make("CraftSuite/DiamondMine-Cont-v0")
     rng = np.random.default_rng(seed)
+    noise = make_action_noise(SUITE_NOISE, dim=2, seed=seed)  # the students' own noise process
     golds, endings = Counter(), Counter()
     gold = env.unwrapped.task.inventory.index("gold")
     for episode in range(episodes):
         env.reset(seed=seed + episode)
-        held = np.zeros(2)
+        noise.reset()
         while True:
-            if not persistent or rng.random() < 0.1:
-                held = rng.normal(0.0, 0.6, 2) if persistent else rng.uniform(-1, 1, 2)
-            _, _, terminated, truncated, info = env.step(np.clip(held, -1, 1).astype(np.float32))
+            action = noise() if persistent else rng.uniform(-1, 1, 2)
+            _, _, terminated, truncated, info = env.step(np.clip(action, -1, 1).astype(np.float32))
             if terminated or truncated:
                 break
         golds[int(env.unwrapped.inventory_counts[gold])] += 1
@@ -40,7 +44,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--episodes", type=int, default=200)
     args = parser.parse_args()
-    for name, persistent in (("uniform random thrust", False), ("persistent noise N(0, 0.6), p 0.1", True)):
+    for name, persistent in (("uniform random thrust", False), (f"the suites' noise {SUITE_NOISE}", True)):
         golds, endings = explore(args.episodes, persistent)
         print(f"{name}: golds held at the end {dict(sorted(golds.items()))}; endings {dict(endings)}")
 

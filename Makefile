@@ -29,6 +29,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/automata.py --flloat-timeout 30
 	$(PY) benchmarks/grid_steps.py --steps 100000
 	$(PY) benchmarks/cont_steps.py --steps 20000
+	$(PY) benchmarks/vector_envs.py
 	$(PY) benchmarks/training_steps.py --repeats 2
 	$(PY) benchmarks/student_throughput.py
 	$(PY) benchmarks/teachers.py --quick

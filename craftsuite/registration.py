@@ -67,18 +67,24 @@ def make_kinematic(task: str | TaskSpec, product: bool = False, render_mode: str
 make_kinematic.metadata = {"render_modes": ["rgb_array"], "render_fps": 8}
 
 
+_VECTOR = {"grid": "craftsuite.envs.vector:make_grid_vector",
+           "kinematic": "craftsuite.envs.vector:make_kinematic_vector"}
+
+
 def _register(spec: TaskSpec) -> list[str]:
     # the ids carry the task as plain data (a built-in by name, a user task as its TOML data):
     # worker processes of vector envs need not re-register it, and EnvSpec.to_json works
     task = carried(spec)
-    worlds = [(grid_id(spec.name, size), "make_grid", {"size": size}, spec.grid.max_steps)
+    # (id, entry point, vector entry point, kwargs, max steps); the vector entry points are
+    # the natively vectorized worlds of craftsuite.envs.vector (make_vec's "vector_entry_point")
+    worlds = [(grid_id(spec.name, size), "make_grid", _VECTOR["grid"], {"size": size}, spec.grid.max_steps)
               for size in spec.grid.sizes]
-    worlds.append((cont_id(spec.name), "make_continuous", {}, spec.continuous.max_steps))
-    worlds.append((kinematic_id(spec.name), "make_kinematic", {}, KINEMATIC.max_steps))
-    for env_id, entry, kwargs, max_steps in worlds:
+    worlds.append((cont_id(spec.name), "make_continuous", None, {}, spec.continuous.max_steps))
+    worlds.append((kinematic_id(spec.name), "make_kinematic", _VECTOR["kinematic"], {}, KINEMATIC.max_steps))
+    for env_id, entry, vector_entry, kwargs, max_steps in worlds:
         if env_id in gym.registry:
             del gym.registry[env_id]  # re-registering a task replaces its ids
-        gym.register(id=env_id, entry_point=f"craftsuite.registration:{entry}",
+        gym.register(id=env_id, entry_point=f"craftsuite.registration:{entry}", vector_entry_point=vector_entry,
                      kwargs={"task": task, **kwargs}, max_episode_steps=max_steps)
     return [w[0] for w in worlds]
 

@@ -18,6 +18,9 @@ from .runs import config_key
 from .task_registry import resolve_task
 
 
+ENGINES = ("sb3", "population")
+
+
 @dataclass(frozen=True)
 class TeacherConfig:
     task: str = "BlindCraftsman"
@@ -73,9 +76,15 @@ class StudentConfig:
     # whether the policy sees the automaton state (None: as its method's row says); only a
     # distilled student may differ from its row (the paper's authors' students did not see it)
     automaton_state: bool | None = field(default=None, metadata={"omit_if_default": True})
+    # what trains it: "sb3" (one SB3 agent per run) or "population" (the seeds of a cell in
+    # one process: craftsuite.population); a part of the run key, since the two are equal in
+    # their update but not in their random streams
+    engine: str = field(default="sb3", metadata={"omit_if_default": True})
 
     def __post_init__(self):
         _check_n_envs(self.n_envs)
+        if self.engine not in ENGINES:
+            raise ValueError(f"engine must be one of {list(ENGINES)}, got {self.engine!r}")
         if self.method in METHODS:  # an unknown method is named where it is used (check_methods)
             METHODS[self.method].observes(self.automaton_state)  # a MethodError naming both
             if self.automaton_state == METHODS[self.method].product:  # what the method does anyway: one run key

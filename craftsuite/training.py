@@ -331,6 +331,10 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
 
     if config.method not in METHODS:
         raise KeyError(f"unknown method {config.method!r}; methods: {sorted(METHODS)}")
+    if config.engine == "population":  # a population of one
+        from .population import train_population
+
+        return train_population([config], root, progress=progress)[0]
     method = METHODS[config.method]
     # bad input is named before a run directory exists: the settings (run_name checks the
     # hyperparameters), and the teacher's table, which must be made for this task's automaton

@@ -1,0 +1,121 @@
+"""DQN for K members in one set of stacked networks: ``agents.dqn.AutomatonDQN``'s update
+(the dueling head, the double-DQN target, Huber or squared loss weighted by importance
+weights, each member's gradient clipped to its own norm, the hard target update counted in
+transitions or gradient steps, the distilled target), computed for every member at once."""
+
+from __future__ import annotations
+
+import numpy as np
+import torch as th
+import torch.nn.functional as F
+
+from .nets import StackedMLP, activation_of, clip_grad_norm_per_member, polyak
+from .replay import Batch
+from .targets import MemberTargets
+
+
+class PopulationDQN:
+    """K DQN learners. ``settings`` are a run's effective DQN settings
+    (``methods.algorithm_settings("dqn", ...)``); ``targets`` the members' distilled targets."""
+
+    algorithm = "dqn"
+
+    def __init__(self, members: int, obs_dim: int, n_actions: int, settings: dict,
+                 targets: MemberTargets | None = None, device: str | th.device = "cpu"):
+        import torch.nn as nn
+
+        self.members, self.device, self.n_actions = members, th.device(device), n_actions
+        policy_kwargs = settings.get("policy_kwargs") or {}
+        hidden = list(policy_kwargs.get("net_arch", [64, 64]))
+        act = activation_of(policy_kwargs.get("activation_fn", nn.ReLU))
+        self.dueling = bool(settings.get("dueling", True))
+        outputs = n_actions + 1 if self.dueling else n_actions  # column 0 is V, as agents.dqn's head
+        self.q_net = StackedMLP(members, [obs_dim, *hidden, outputs], act, device=self.device)
+        self.q_net_target = StackedMLP(members, [obs_dim, *hidden, outputs], act, device=self.device)
+        self.q_net_target.load_state_dict(self.q_net.state_dict())
+        optimizer_kwargs = {**(policy_kwargs.get("optimizer_kwargs") or {})}
+        self.optimizer = th.optim.Adam(self.q_net.parameters(), lr=float(settings["learning_rate"]),
+                                       **optimizer_kwargs)
+        self.gamma, self.tau = float(settings["gamma"]), float(settings.get("tau", 1.0))  # SB3's hard update
+        self.double = bool(settings.get("double", True))
+        self.loss = settings.get("loss", "huber")
+        self.max_grad_norm = float(settings.get("max_grad_norm", 10.0))
+        self.prioritized = bool(settings.get("prioritized", True))
+        self.target_update_unit = settings.get("target_update_unit", "transitions")
+        self.target_update_interval = int(settings["target_update_interval"])
+        self.targets = targets
+        self.n_updates = 0
+        self.last_losses = np.zeros(members)
+
+    def q_values(self, net: StackedMLP, observations: th.Tensor) -> th.Tensor:
+        out = net(observations)
+        if not self.dueling:
+            return out
+        advantage = out[..., 1:]
+        return out[..., :1] + advantage - advantage.mean(dim=-1, keepdim=True)
+
+    def act(self, observations: np.ndarray) -> np.ndarray:
+        """Greedy actions ``(K, n)`` for observations ``(K, n, obs_dim)``."""
+        with th.no_grad():
+            return self.q_values(self.q_net, th.as_tensor(observations, device=self.device)).argmax(dim=-1).cpu().numpy()
+
+    def td_target(self, batch: Batch, next_obs: th.Tensor) -> th.Tensor:
+        """The one target rule (``AutomatonDQN._td_target`` for K members), ``(K, B, 1)``."""
+        K, B = batch.rewards.shape
+        with th.no_grad():
+            next_q = self.q_values(self.q_net_target, next_obs)
+            if self.double:
+                best = self.q_values(self.q_net, next_obs).argmax(dim=-1, keepdim=True)
+                next_q = th.gather(next_q, dim=-1, index=best)
+            else:
+                next_q = next_q.max(dim=-1, keepdim=True)[0]
+            rewards = th.as_tensor(batch.rewards, device=self.device).reshape(K, B, 1)
+            terminals = th.as_tensor(batch.terminals, device=self.device).reshape(K, B, 1)
+            target = rewards + (1 - terminals) * self.gamma * next_q
+            if self.targets is not None:
+                target = self.targets(batch.w, batch.sigma, target)
+        return target
+
+    def update(self, batch: Batch) -> np.ndarray:
+        """One gradient step of every member; returns the TD errors ``(K, B)``."""
+        K, B = batch.rewards.shape
+        target = self.td_target(batch, th.as_tensor(batch.next_observations, device=self.device))
+        obs = th.as_tensor(batch.observations, device=self.device)
+        actions = th.as_tensor(batch.actions, device=self.device).reshape(K, B, 1).long()
+        current = th.gather(self.q_values(self.q_net, obs), dim=-1, index=actions)
+        loss_fn = F.smooth_l1_loss if self.loss == "huber" else F.mse_loss
+        elementwise = loss_fn(current, target, reduction="none")
+        if self.prioritized:
+            elementwise = th.as_tensor(batch.weights, device=self.device).reshape(K, B, 1) * elementwise
+        per_member = elementwise.mean(dim=(1, 2))
+        self.optimizer.zero_grad()
+        per_member.sum().backward()
+        clip_grad_norm_per_member(self.q_net.parameters(), self.max_grad_norm)
+        self.optimizer.step()
+        self.n_updates += 1
+        if self.target_update_unit == "gradient_steps" and self.n_updates % self.target_update_interval == 0:
+            self.update_target()
+        self.last_losses = per_member.detach().cpu().numpy()
+        return (current - target).detach().reshape(K, B).cpu().numpy()
+
+    def update_target(self) -> None:
+        polyak(self.q_net.parameters(), self.q_net_target.parameters(), self.tau)
+
+    # -- members as SB3 agents ---------------------------------------------------------------------
+    def _sequential(self, q_network):
+        return q_network.q_net.net if self.dueling else q_network.q_net
+
+    def load_member(self, k: int, agent) -> None:
+        """Member ``k``'s networks from an ``AutomatonDQN`` (online and target)."""
+        self.q_net.load_member(k, self._sequential(agent.policy.q_net))
+        self.q_net_target.load_member(k, self._sequential(agent.policy.q_net_target))
+
+    def store_member(self, k: int, agent) -> None:
+        self.q_net.store_member(k, self._sequential(agent.policy.q_net))
+        self.q_net_target.store_member(k, self._sequential(agent.policy.q_net_target))
+
+    def modules(self) -> dict:
+        return {"q_net": self.q_net, "q_net_target": self.q_net_target}
+
+    def optimizers(self) -> dict:
+        return {"optimizer": self.optimizer}

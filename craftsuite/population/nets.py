@@ -1,0 +1,105 @@
+"""Networks of K members at once: each layer's weights stacked on a leading member axis.
+
+A ``StackedMLP`` holds K independent MLPs of one shape. Its forward takes ``(K, B, in)``
+and gives ``(K, B, out)`` with one ``torch.baddbmm`` per layer, so K small networks cost
+about what one larger matrix product costs (one TD3 update at batch 256, [64, 64], one
+core: 1.70 ms for one plain-torch member, 1.13 ms per member at K = 10-20).
+``torch.func.stack_module_state`` with ``vmap`` computes the same; ``baddbmm`` was faster
+for these sizes and keeps the parameters plain tensors that one Adam steps together.
+
+Members are copied from and to stable-baselines3's MLPs (``nn.Sequential`` of ``Linear``
+and activations), so a member can be saved as an ordinary SB3 policy.
+"""
+
+from __future__ import annotations
+
+import math
+
+import torch as th
+from torch import nn
+
+ACTIVATIONS = {nn.ReLU: th.relu, nn.Tanh: th.tanh, nn.LeakyReLU: nn.functional.leaky_relu}
+
+
+class StackedMLP(nn.Module):
+    """K MLPs ``sizes[0] -> ... -> sizes[-1]``, ``activation`` between layers and ``output``
+    (None, or e.g. ``th.tanh``) after the last; initialised as ``nn.Linear`` does, each
+    member from its own draws."""
+
+    def __init__(self, members: int, sizes: list[int], activation=th.relu, output=None, device=None):
+        super().__init__()
+        if members < 1:
+            raise ValueError(f"a population has at least one member, got {members}")
+        self.members, self.sizes = members, list(sizes)
+        self.activation, self.output = activation, output
+        self.weights = nn.ParameterList()
+        self.biases = nn.ParameterList()
+        for fan_in, fan_out in zip(sizes[:-1], sizes[1:]):
+            bound = 1 / math.sqrt(fan_in)  # nn.Linear's default: kaiming_uniform(a=sqrt(5)) and its bias bound
+            w = th.empty(members, fan_in, fan_out, device=device).uniform_(-bound, bound)
+            b = th.empty(members, 1, fan_out, device=device).uniform_(-bound, bound)
+            self.weights.append(nn.Parameter(w))
+            self.biases.append(nn.Parameter(b))
+
+    def forward(self, x: th.Tensor) -> th.Tensor:
+        last = len(self.weights) - 1
+        for i, (w, b) in enumerate(zip(self.weights, self.biases)):
+            x = th.baddbmm(b, x, w)
+            if i < last:
+                x = self.activation(x)
+        return x if self.output is None else self.output(x)
+
+    # -- members as SB3 modules --------------------------------------------------------------
+    def load_member(self, k: int, sequential: nn.Sequential) -> None:
+        """Member ``k``'s weights from an ``nn.Sequential`` of the same shape (SB3's MLPs)."""
+        linears = _linears(sequential, self.sizes)
+        with th.no_grad():
+            for w, b, lin in zip(self.weights, self.biases, linears):
+                w[k].copy_(lin.weight.T)
+                b[k, 0].copy_(lin.bias)
+
+    def store_member(self, k: int, sequential: nn.Sequential) -> None:
+        """Member ``k``'s weights into an ``nn.Sequential`` of the same shape."""
+        linears = _linears(sequential, self.sizes)
+        with th.no_grad():
+            for w, b, lin in zip(self.weights, self.biases, linears):
+                lin.weight.copy_(w[k].T)
+                lin.bias.copy_(b[k, 0])
+
+
+def _linears(sequential: nn.Module, sizes: list[int]) -> list[nn.Linear]:
+    linears = [m for m in sequential.modules() if isinstance(m, nn.Linear)]
+    shape = [linears[0].in_features, *(lin.out_features for lin in linears)] if linears else []
+    if shape != list(sizes):
+        raise ValueError(f"an MLP of sizes {shape} is not a member of a population of sizes {sizes}")
+    return linears
+
+
+def activation_of(activation_fn) -> callable:
+    """The function of SB3's ``activation_fn`` class (``nn.ReLU`` by default)."""
+    try:
+        return ACTIVATIONS[activation_fn]
+    except KeyError:
+        raise ValueError(f"the population engine supports the activations {[a.__name__ for a in ACTIVATIONS]}, "
+                         f"not {activation_fn!r}: use --engine sb3") from None
+
+
+def polyak(params, targets, tau: float) -> None:
+    """``target = (1 - tau) target + tau param``, as SB3's ``polyak_update`` computes it."""
+    with th.no_grad():
+        for p, t in zip(params, targets):
+            t.mul_(1 - tau)
+            th.add(t, p, alpha=tau, out=t)
+
+
+def clip_grad_norm_per_member(params, max_norm: float) -> None:
+    """``torch.nn.utils.clip_grad_norm_`` applied to each member alone: every member's
+    gradient scaled by max_norm / (its norm + 1e-6), at most 1."""
+    grads = [p.grad for p in params if p.grad is not None]
+    if not grads:
+        return
+    members = grads[0].shape[0]
+    norms = th.stack([g.reshape(members, -1).pow(2).sum(dim=1) for g in grads]).sum(dim=0).sqrt()
+    scale = (max_norm / (norms + 1e-6)).clamp(max=1.0)
+    for g in grads:
+        g.mul_(scale.reshape(members, *([1] * (g.dim() - 1))))

@@ -1,0 +1,218 @@
+"""Replay for K members at once: preallocated arrays with a leading member axis, a sum tree
+per member in one array, and CRM's counterfactuals made when a batch is sampled.
+
+Each member's transitions sit at the same positions of its own slice, written in step
+(members collect in lockstep), in the order SB3's buffer uses: a step of ``n_envs`` envs
+fills ``n_envs`` consecutive positions. Sampling follows ``agents.replay``: uniformly, or
+stratified by priority p ** alpha with importance weights (N P(i)) ** -beta over their
+maximum, new transitions at the maximum priority seen.
+
+CRM (``crm=CounterfactualView(...)``) stores each real step once, with its automaton
+transition ``(w, sigma, w')``. A leaf of the sum tree is a (step, live automaton state u)
+pair; sampling leaf (i, u) rewrites step i as read from u: the observation's one-hot, u' =
+delta(u, sigma), the reward with u's completion bonus for the real one, an end where u'
+accepts or is rejecting (``agents.crm.counterfactuals``, to which this is equal). Memory
+grows with the steps, not with the steps times the automaton's states.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from ..automata import Automaton
+
+
+class Batch(NamedTuple):
+    """One minibatch per member, each array ``(K, B, ...)``."""
+
+    observations: np.ndarray
+    actions: np.ndarray
+    next_observations: np.ndarray
+    rewards: np.ndarray  # (K, B) float32
+    terminals: np.ndarray  # (K, B) float32: 1 where the step ended the episode (not a time limit)
+    weights: np.ndarray  # (K, B) float32: importance weights (ones when uniform)
+    leaves: np.ndarray  # (K, B) int64: what update_priorities takes back
+    w: np.ndarray  # (K, B) automaton state the target reads (u for a counterfactual)
+    sigma: np.ndarray  # (K, B) label of the step
+
+
+class SumTrees:
+    """One binary sum tree per member, all in one ``(K, 2 * leaves)`` array: updates and
+    proportional sampling for every member in the same numpy operations."""
+
+    def __init__(self, members: int, capacity: int):
+        self.members = members
+        self.leaves = 1 << max(0, int(np.ceil(np.log2(max(capacity, 1)))))
+        self.tree = np.zeros((members, 2 * self.leaves))
+        self._rows = np.arange(members)[:, None]
+
+    def total(self) -> np.ndarray:
+        return self.tree[:, 1]
+
+    def update(self, leaves: np.ndarray, values: np.ndarray) -> None:
+        """Set ``values`` at ``leaves``, both ``(K, M)`` (or broadcastable)."""
+        nodes = np.asarray(leaves, dtype=np.int64) + self.leaves
+        rows = np.broadcast_to(self._rows, nodes.shape)
+        tree = self.tree
+        tree[rows, nodes] = values
+        while nodes[0, 0] > 1:  # every leaf sits at one depth: climb level by level
+            nodes = nodes // 2
+            tree[rows, nodes] = tree[rows, 2 * nodes] + tree[rows, 2 * nodes + 1]  # repeats write equal sums
+
+    def find(self, targets: np.ndarray) -> np.ndarray:
+        """For ``(K, B)`` targets, the leaf whose cumulative interval holds each."""
+        rows = np.broadcast_to(self._rows, targets.shape)
+        nodes = np.ones(targets.shape, dtype=np.int64)
+        targets = targets.copy()
+        while nodes[0, 0] < self.leaves:
+            left = 2 * nodes
+            mass = self.tree[rows, left]
+            right = targets >= mass
+            targets = np.where(right, targets - mass, targets)
+            nodes = np.where(right, left + 1, left)
+        return nodes - self.leaves
+
+    def values(self, leaves: np.ndarray) -> np.ndarray:
+        return self.tree[np.broadcast_to(self._rows, leaves.shape), leaves + self.leaves]
+
+
+class CounterfactualView:
+    """CRM's reading of one real step from every live automaton state (see the module
+    docstring). ``n_states`` one-hot entries end each observation."""
+
+    def __init__(self, automaton: Automaton, completion_reward: float):
+        self.delta = automaton.delta.astype(np.int64)
+        self.accepting = automaton.accepting.astype(np.float32)
+        self.ends = (automaton.accepting | automaton.rejecting).astype(np.float32)
+        self.live = np.flatnonzero(~(automaton.accepting | automaton.rejecting))
+        self.n_states, self.completion = automaton.n_states, float(completion_reward)
+        self._eye = np.eye(self.n_states, dtype=np.float32)
+
+    @property
+    def n_live(self) -> int:
+        return len(self.live)
+
+    def world_reward(self, rewards, w, sigma):
+        """The world's part of real rewards (steps, items): without the completion bonus.
+        Stored instead of the reward, so that a float32 replay does not hold 99.9 for -0.1."""
+        return rewards - self.completion * self.accepting[self.delta[w, sigma]]
+
+    def relabel(self, obs, next_obs, world_rewards, sigma, j):
+        """A stored step (obs, next_obs, world reward, sigma) as read from live state
+        ``live[j]``: (obs, next_obs, rewards, terminals, u)."""
+        u = self.live[j]
+        u_next = self.delta[u, sigma]
+        obs[..., -self.n_states:] = self._eye[u]
+        next_obs[..., -self.n_states:] = self._eye[u_next]
+        rewards = world_rewards.astype(np.float64) + self.completion * self.accepting[u_next]
+        return obs, next_obs, rewards.astype(np.float32), self.ends[u_next], u
+
+
+class PopulationReplay:
+    """Every member's replay, ``capacity`` transitions each (SB3's rounding: whole steps of
+    ``n_envs``). ``actions`` are ``action_shape`` of ``action_dtype`` per transition."""
+
+    def __init__(self, members: int, capacity: int, n_envs: int, obs_dim: int, action_shape: tuple,
+                 action_dtype=np.float32, *, prioritized: bool = True, alpha: float = 0.7, beta: float = 0.4,
+                 epsilon: float = 0.1, crm: CounterfactualView | None = None, seed: int = 0):
+        self.members, self.n_envs = members, n_envs
+        self.capacity = max(capacity // n_envs, 1) * n_envs
+        K, C = members, self.capacity
+        self.observations = np.zeros((K, C, obs_dim), dtype=np.float32)
+        self.next_observations = np.zeros((K, C, obs_dim), dtype=np.float32)
+        self.actions = np.zeros((K, C, *action_shape), dtype=action_dtype)
+        self.rewards = np.zeros((K, C), dtype=np.float32)
+        self.terminals = np.zeros((K, C), dtype=np.float32)
+        self.w = np.zeros((K, C), dtype=np.int64)
+        self.sigma = np.zeros((K, C), dtype=np.int64)
+        self.pos, self.full = 0, False
+        self.crm = crm
+        self.per_step = crm.n_live if crm is not None else 1  # leaves per stored transition
+        self.prioritized, self.alpha, self.beta, self.epsilon = prioritized, alpha, beta, epsilon
+        self.trees = SumTrees(K, C * self.per_step) if prioritized else None
+        self.max_priority = np.ones(K)
+        self.rng = np.random.default_rng(seed)
+        self._rows = np.arange(K)[:, None]
+
+    @property
+    def size(self) -> int:
+        """Transitions stored per member."""
+        return self.capacity if self.full else self.pos
+
+    def add(self, obs, next_obs, actions, rewards, terminals, w, sigma) -> None:
+        """One step of every member's ``n_envs`` envs: arrays ``(K, n_envs, ...)``."""
+        at = slice(self.pos, self.pos + self.n_envs)
+        self.observations[:, at] = obs
+        self.next_observations[:, at] = next_obs
+        self.actions[:, at] = np.asarray(actions).reshape(self.members, self.n_envs, *self.actions.shape[2:])
+        self.rewards[:, at] = rewards if self.crm is None else self.crm.world_reward(
+            np.asarray(rewards, dtype=np.float64), np.asarray(w), np.asarray(sigma))
+        self.terminals[:, at] = terminals
+        self.w[:, at] = w
+        self.sigma[:, at] = sigma
+        if self.trees is not None:
+            first = self.pos * self.per_step
+            leaves = np.broadcast_to(np.arange(first, first + self.n_envs * self.per_step), (self.members,
+                                                                                           self.n_envs * self.per_step))
+            self.trees.update(leaves, np.broadcast_to((self.max_priority ** self.alpha)[:, None], leaves.shape))
+        self.pos += self.n_envs
+        if self.pos == self.capacity:
+            self.full, self.pos = True, 0
+
+    def sample(self, batch_size: int) -> Batch:
+        size = self.size
+        if size == 0:
+            raise RuntimeError("cannot sample from an empty replay")
+        K, leaves_in_use = self.members, size * self.per_step
+        if self.trees is None:
+            leaves = self.rng.integers(0, leaves_in_use, size=(K, batch_size))
+            weights = np.ones((K, batch_size), dtype=np.float32)
+        else:
+            total = self.trees.total()[:, None]
+            targets = (np.arange(batch_size) + self.rng.random((K, batch_size))) * (total / batch_size)
+            leaves = np.minimum(self.trees.find(np.minimum(targets, total * (1 - 1e-12))), leaves_in_use - 1)
+            probs = self.trees.values(leaves) / total
+            weights = (leaves_in_use * probs) ** (-self.beta)
+            weights = (weights / weights.max(axis=1, keepdims=True)).astype(np.float32)
+        index, j = np.divmod(leaves, self.per_step)
+        rows = np.broadcast_to(self._rows, index.shape)
+        obs, next_obs = self.observations[rows, index], self.next_observations[rows, index]
+        rewards, terminals = self.rewards[rows, index], self.terminals[rows, index]
+        w, sigma = self.w[rows, index], self.sigma[rows, index]
+        if self.crm is not None:
+            obs, next_obs, rewards, terminals, w = self.crm.relabel(obs, next_obs, rewards, sigma, j)
+        return Batch(obs, self.actions[rows, index], next_obs, rewards, terminals, weights, leaves, w, sigma)
+
+    def update_priorities(self, leaves: np.ndarray, td_errors: np.ndarray) -> None:
+        """New priorities |TD error| + epsilon for the sampled leaves, ``(K, B)`` each."""
+        if self.trees is None:
+            return
+        priorities = np.abs(np.asarray(td_errors, dtype=np.float64)) + self.epsilon
+        self.max_priority = np.maximum(self.max_priority, priorities.max(axis=1))
+        self.trees.update(leaves, priorities ** self.alpha)
+
+    # -- checkpoints: one member's slice ----------------------------------------------------------
+    _ARRAYS = ("observations", "next_observations", "actions", "rewards", "terminals", "w", "sigma")
+
+    def member_state(self, k: int) -> dict:
+        """Member ``k``'s filled rows, priorities and sampling position (for its checkpoint)."""
+        n = self.size
+        state = {name: getattr(self, name)[k, :n].copy() for name in self._ARRAYS}
+        state.update(pos=self.pos, full=self.full, max_priority=float(self.max_priority[k]))
+        if self.trees is not None:
+            state["priorities"] = self.trees.tree[k, self.trees.leaves:self.trees.leaves + n * self.per_step].copy()
+        return state
+
+    def load_member(self, k: int, state: dict) -> None:
+        n = len(state["rewards"])
+        for name in self._ARRAYS:
+            getattr(self, name)[k, :n] = state[name]
+        self.pos, self.full = int(state["pos"]), bool(state["full"])
+        self.max_priority[k] = state["max_priority"]
+        if self.trees is not None and "priorities" in state:
+            priorities = state["priorities"]
+            single = SumTrees(1, self.trees.leaves)  # the member's tree rebuilt from its leaves
+            single.update(np.arange(len(priorities))[None], priorities[None])
+            self.trees.tree[k] = single.tree[0]

@@ -1,0 +1,43 @@
+"""The distilled target for K members: ``agents.distillation.DistilledTarget``'s rule with
+one count table per member (each member's own minibatches decide how far it trusts the
+teacher), the teacher's table shared."""
+
+from __future__ import annotations
+
+import numpy as np
+import torch as th
+
+from ..agents.distillation import DistilledTarget
+
+
+class MemberTargets:
+    """Q' = beta Q_teacher(w, sigma) + (1 - beta) Q_target, beta = rho ** count_k(w, sigma)
+    where the teacher has a value (``DistilledTarget``), counted per member ``k``."""
+
+    def __init__(self, rule: DistilledTarget, members: int):
+        self.rule = rule
+        self.members = members
+        self.n_labels = rule.q_teacher.shape[1]
+        self.cells = rule.q_teacher.size
+        self.counts = np.zeros((members, self.cells), dtype=np.int64)
+        self.last_weight = np.zeros(members)  # mean beta of each member's last minibatch
+
+    def __call__(self, w: np.ndarray, sigma: np.ndarray, q_target: th.Tensor) -> th.Tensor:
+        """``w``, ``sigma`` ``(K, B)``; ``q_target`` ``(K, B, 1)``."""
+        flat = w * self.n_labels + sigma
+        own = flat + (np.arange(self.members) * self.cells)[:, None]
+        mix = np.empty((2, *flat.shape), dtype=np.float32)
+        mix[0] = self.rule._seen_flat[flat] * self.rule.rho ** self.counts.reshape(-1)[own]  # beta
+        mix[1] = self.rule._teacher_flat[flat]
+        np.add.at(self.counts.reshape(-1), own.reshape(-1), 1)
+        self.last_weight = mix[0].mean(axis=1)
+        beta, teacher = th.from_numpy(mix).to(q_target.device).reshape(2, *q_target.shape)
+        return q_target + beta * (teacher - q_target)
+
+    def member(self, k: int) -> DistilledTarget:
+        """Member ``k``'s rule as an ``DistilledTarget`` with its counts (what a saved agent keeps)."""
+        import copy
+
+        rule = copy.deepcopy(self.rule)
+        rule.student_counts[...] = self.counts[k].reshape(rule.student_counts.shape)
+        return rule

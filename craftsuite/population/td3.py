@@ -1,0 +1,150 @@
+"""TD3 for K members in one set of stacked networks: ``agents.td3.AutomatonTD3``'s update
+(clipped double-Q with target policy smoothing, importance-weighted critic loss with
+prioritized replay, the delayed actor, Polyak averaging, the distilled target), computed
+for every member in the same tensor operations. One optimizer steps all members: Adam is
+elementwise, so each member's parameters move exactly as its own Adam would move them."""
+
+from __future__ import annotations
+
+
+import numpy as np
+import torch as th
+
+from .nets import StackedMLP, activation_of, polyak
+from .replay import Batch
+from .targets import MemberTargets
+
+
+def net_arch(policy_kwargs: dict, default) -> tuple[list[int], list[int]]:
+    """The actor's and the critics' hidden sizes from SB3's ``net_arch`` (a list for both,
+    or ``{"pi": [...], "qf": [...]}``)."""
+    arch = policy_kwargs.get("net_arch", default)
+    if isinstance(arch, dict):
+        return list(arch["pi"]), list(arch["qf"])
+    return list(arch), list(arch)
+
+
+class PopulationTD3:
+    """K TD3 learners. ``settings`` are a run's effective TD3 settings
+    (``methods.algorithm_settings("td3", ...)``); ``targets`` the members' distilled targets
+    (None from scratch)."""
+
+    algorithm = "td3"
+
+    def __init__(self, members: int, obs_dim: int, act_dim: int, settings: dict,
+                 targets: MemberTargets | None = None, device: str | th.device = "cpu"):
+        import torch.nn as nn
+
+        self.members, self.device = members, th.device(device)
+        policy_kwargs = settings.get("policy_kwargs") or {}
+        pi, qf = net_arch(policy_kwargs, [400, 300])
+        act = activation_of(policy_kwargs.get("activation_fn", nn.ReLU))
+        n_critics = policy_kwargs.get("n_critics", 2)
+        self.actor = StackedMLP(members, [obs_dim, *pi, act_dim], act, th.tanh, device=self.device)
+        self.critics = nn.ModuleList(StackedMLP(members, [obs_dim + act_dim, *qf, 1], act, device=self.device)
+                                     for _ in range(n_critics))
+        self.actor_target = StackedMLP(members, [obs_dim, *pi, act_dim], act, th.tanh, device=self.device)
+        self.critics_target = nn.ModuleList(StackedMLP(members, [obs_dim + act_dim, *qf, 1], act, device=self.device)
+                                            for _ in range(n_critics))
+        self.actor_target.load_state_dict(self.actor.state_dict())
+        self.critics_target.load_state_dict(self.critics.state_dict())
+        optimizer_kwargs = {**(policy_kwargs.get("optimizer_kwargs") or {})}
+        if self.device.type not in ("cpu", "cuda"):
+            optimizer_kwargs.pop("fused", None)
+        lr = float(settings["learning_rate"])
+        self.actor_optimizer = th.optim.Adam(self.actor.parameters(), lr=lr, **optimizer_kwargs)
+        self.critic_optimizer = th.optim.Adam(self.critics.parameters(), lr=lr, **optimizer_kwargs)
+        self.gamma, self.tau = float(settings["gamma"]), float(settings["tau"])
+        self.policy_noise, self.noise_clip = float(settings["target_policy_noise"]), float(settings["target_noise_clip"])
+        self.prioritized = bool(settings.get("prioritized", True))
+        self.targets = targets
+        self.n_updates = 0
+        self.last_losses = (np.zeros(members), np.zeros(members))  # critic, actor
+
+    # -- acting ------------------------------------------------------------------------------------
+    def act(self, observations: np.ndarray) -> np.ndarray:
+        """Greedy actions ``(K, n, act_dim)`` for observations ``(K, n, obs_dim)``."""
+        with th.no_grad():
+            return self.actor(th.as_tensor(observations, device=self.device)).cpu().numpy()
+
+    # -- learning ----------------------------------------------------------------------------------
+    def _tensor(self, array, shape=None) -> th.Tensor:
+        t = th.as_tensor(array, device=self.device)
+        return t if shape is None else t.reshape(shape)
+
+    def td_target(self, batch: Batch, next_obs: th.Tensor, actions: th.Tensor) -> th.Tensor:
+        """The one target rule (``AutomatonTD3._td_target`` for K members), ``(K, B, 1)``."""
+        K, B = batch.rewards.shape
+        with th.no_grad():
+            noise = actions.clone().data.normal_(0, self.policy_noise).clamp(-self.noise_clip, self.noise_clip)
+            next_actions = (self.actor_target(next_obs) + noise).clamp(-1, 1)
+            joint = th.cat([next_obs, next_actions], dim=2)
+            next_q = th.min(th.cat([q(joint) for q in self.critics_target], dim=2), dim=2, keepdim=True)[0]
+            target = (self._tensor(batch.rewards, (K, B, 1))
+                      + (1 - self._tensor(batch.terminals, (K, B, 1))) * self.gamma * next_q)
+            if self.targets is not None:
+                target = self.targets(batch.w, batch.sigma, target)
+        return target
+
+    def update(self, batch: Batch, delay: int) -> np.ndarray:
+        """One gradient step of every member on its minibatch; returns each sample's TD
+        error of the first critic ``(K, B)`` (for the priorities)."""
+        K, B = batch.rewards.shape
+        obs = self._tensor(batch.observations)
+        actions = self._tensor(batch.actions)
+        target = self.td_target(batch, self._tensor(batch.next_observations), actions)
+        joint = th.cat([obs, actions], dim=2)
+        current = [q(joint) for q in self.critics]
+        if self.prioritized:
+            weights = self._tensor(batch.weights, (K, B, 1))
+            per_member = sum((weights * (q - target) ** 2).mean(dim=(1, 2)) for q in current)
+        else:  # uniform replay: the mean squared error, as SB3
+            per_member = sum(((q - target) ** 2).mean(dim=(1, 2)) for q in current)
+        self.critic_optimizer.zero_grad()
+        per_member.sum().backward()  # members' losses are independent: each gets its own gradient
+        self.critic_optimizer.step()
+        td_errors = (current[0] - target).detach().reshape(K, B).cpu().numpy()
+        critic_losses = per_member.detach().cpu().numpy()
+
+        self.n_updates += 1
+        if self.n_updates % delay == 0:
+            actor_loss = -self.critics[0](th.cat([obs, self.actor(obs)], dim=2)).mean(dim=(1, 2))
+            self.actor_optimizer.zero_grad()
+            actor_loss.sum().backward()
+            self.actor_optimizer.step()
+            polyak(self.critics.parameters(), self.critics_target.parameters(), self.tau)
+            polyak(self.actor.parameters(), self.actor_target.parameters(), self.tau)
+            self.last_losses = (critic_losses, actor_loss.detach().cpu().numpy())
+        else:
+            self.last_losses = (critic_losses, self.last_losses[1])
+        return td_errors
+
+    # -- members as SB3 agents ---------------------------------------------------------------------
+    def load_member(self, k: int, agent) -> None:
+        """Member ``k``'s networks from an ``AutomatonTD3`` (its actor, critics and targets)."""
+        policy = agent.policy
+        self.actor.load_member(k, policy.actor.mu)
+        self.actor_target.load_member(k, policy.actor_target.mu)
+        for mine, theirs in zip(self.critics, policy.critic.q_networks):
+            mine.load_member(k, theirs)
+        for mine, theirs in zip(self.critics_target, policy.critic_target.q_networks):
+            mine.load_member(k, theirs)
+
+    def store_member(self, k: int, agent) -> None:
+        """Member ``k``'s networks into an ``AutomatonTD3`` of the same shape."""
+        policy = agent.policy
+        self.actor.store_member(k, policy.actor.mu)
+        self.actor_target.store_member(k, policy.actor_target.mu)
+        for mine, theirs in zip(self.critics, policy.critic.q_networks):
+            mine.store_member(k, theirs)
+        for mine, theirs in zip(self.critics_target, policy.critic_target.q_networks):
+            mine.store_member(k, theirs)
+
+    def modules(self) -> dict:
+        return {"actor": self.actor, "actor_target": self.actor_target, "critics": self.critics,
+                "critics_target": self.critics_target}
+
+    def optimizers(self) -> dict:
+        return {"actor_optimizer": self.actor_optimizer, "critic_optimizer": self.critic_optimizer}
+
+

@@ -1,0 +1,266 @@
+"""Population runs: the seeds of one suite cell trained in one process, each an ordinary run.
+
+``train_population(configs, root)`` takes the ``StudentConfig`` of every seed of one
+(task, world, method) cell and trains the unfinished ones together (``engine.Population``).
+Each member writes the run directory every other command reads, as ``train_student``
+does: ``config.json`` (its settings, ``engine`` among them, and provenance), ``episodes.csv``,
+``evals.csv``, ``progress.json``, and at the end ``model.zip`` (an SB3 agent that
+``load_agent`` loads) and ``result.json``. At each evaluation every member checkpoints its
+own state (``checkpoint/population.pt``: networks, optimizer moments, replay, counts,
+noise); a killed population resumes from the newest step every member has a checkpoint of.
+A population writes no TensorBoard logs.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import shutil
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import torch as th
+
+from ..configs import StudentConfig
+from ..files import atomic_path
+from ..methods import METHODS
+from ..runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir
+from .engine import EngineError, Population, check_supported
+from .envs import make_envs, step_records
+
+CHECKPOINT = "population.pt"
+
+
+def check_cell(configs: list[StudentConfig]) -> None:
+    """Raise ``EngineError`` unless ``configs`` are seeds of one cell: equal but for the seed."""
+    if not configs:
+        raise EngineError("a population needs at least one run")
+    first = {k: v for k, v in dataclasses.asdict(configs[0]).items() if k != "seed"}
+    for c in configs[1:]:
+        other = {k: v for k, v in dataclasses.asdict(c).items() if k != "seed"}
+        differ = sorted(k for k in first if first[k] != other[k])
+        if differ:
+            raise EngineError(f"a population trains the seeds of one cell; these runs also differ in {differ}")
+    seeds = [c.seed for c in configs]
+    if len(set(seeds)) != len(seeds):
+        raise EngineError(f"a population's seeds must differ, got {seeds}")
+
+
+def check_device(device: str) -> th.device:
+    """The torch device ``device`` names, if this machine has it (one clear line otherwise)."""
+    try:
+        dev = th.device(device)
+    except (RuntimeError, TypeError):
+        raise EngineError(f"--device {device!r} is not a torch device: use cpu or cuda") from None
+    if dev.type == "cuda" and not th.cuda.is_available():
+        raise EngineError(f"--device {device}: this machine has no CUDA GPU; use --device cpu")
+    if dev.type not in ("cpu", "cuda"):
+        raise EngineError(f"--device {device}: the population engine runs on cpu or cuda")
+    return dev
+
+
+def train_population(configs: list[StudentConfig], root, progress: bool = True, device: str = "cpu",
+                     desc: str | None = None) -> list[Path]:
+    """Train every seed of one cell together; returns each config's run directory."""
+    from ..agents import AutomatonQTable
+    from ..task_registry import resolve_task
+
+    check_cell(configs)
+    dev = check_device(device)
+    config = configs[0]
+    method = METHODS[config.method]
+    settings = config.effective()["hyperparameters"]
+    check_supported(config.method, settings)  # before any run directory exists
+    root = Path(root)
+    names = [c.run_name() for c in configs]
+    spec = resolve_task(config.task)
+    table = None
+    if method.needs_table and not all((root / n / "result.json").exists() for n in names):
+        if config.table is None:
+            raise ValueError(f"method {config.method!r} needs a teacher's table (table.npz of a teacher run)")
+        table = AutomatonQTable.load(config.table, spec.automaton)
+    with contextlib.ExitStack() as stack:
+        runs = [stack.enter_context(RunDir(root / n, c)) for n, c in zip(names, configs)]
+        todo = [(c, r) for c, r in zip(configs, runs) if not r.finished()]
+        if todo:
+            _train(todo, settings, table, spec, dev, progress,
+                   desc or f"{config.method} {config.task} {config.world} x{len(todo)}")
+    return [root / n for n in names]
+
+
+def _train(todo, settings, table, spec, device, progress, desc) -> None:
+    from tqdm import tqdm
+
+    configs, runs = [c for c, _ in todo], [r for _, r in todo]
+    config = configs[0]
+    K, n = len(configs), config.n_envs
+    start = time.perf_counter()
+    envs = make_envs(config.env_id, K * n, config.env_kwargs, config.product)
+    threads = th.get_num_threads()
+    if device.type == "cpu":
+        th.set_num_threads(1)  # small nets: one thread is fastest and leaves the other cores to other cells
+    try:
+        obs_dim = envs.single_observation_space.shape[0]
+        pop = Population(config.method, settings, [c.seed for c in configs], n, obs_dim, envs.single_action_space,
+                         spec.automaton, spec.completion_reward, config.steps, table, str(device))
+        _resume(pop, runs)
+        total = config.steps
+        with tqdm(total=K * total, initial=K * pop.num_timesteps, desc=desc, unit="step", disable=not progress,
+                  dynamic_ncols=True, mininterval=1.0) as bar:
+            _loop(pop, envs, configs, runs, bar)
+        for k, (c, run) in enumerate(todo):
+            _finish(pop, k, c, run, table, time.perf_counter() - start, str(device))
+    finally:
+        envs.close()
+        th.set_num_threads(threads)
+
+
+def _loop(pop: Population, envs, configs, runs, bar) -> None:
+    config = configs[0]
+    K, n, total, every = pop.K, pop.n_envs, config.steps, config.eval_every
+    seeds = [c.seed + j for c in configs for j in range(n)]  # as SB3's make_vec_env seeds each run's envs
+    obs, _ = envs.reset(seed=seeds)
+    returns, lengths = np.zeros(K * n), np.zeros(K * n, dtype=np.int64)
+    pending: list[list[dict]] = [[] for _ in range(K)]
+    next_eval = (pop.num_timesteps // every + 1) * every
+    next_flush = pop.num_timesteps + 1_000
+    while pop.num_timesteps < total:
+        shaped = obs.reshape(K, n, -1)
+        actions = pop.actions(shaped)
+        flat_actions = actions.reshape(K * n, *actions.shape[2:])
+        next_obs, rewards, terminated, truncated, info = envs.step(flat_actions)
+        ended = terminated | truncated
+        real_next, transitions, success = step_records(info, ended, next_obs)
+        pop.observe(shaped, real_next.reshape(K, n, -1), actions, rewards.reshape(K, n),
+                    terminated.reshape(K, n).astype(np.float32), transitions.reshape(K, n, 3))
+        returns += rewards
+        lengths += 1
+        if ended.any():
+            for i in np.flatnonzero(ended):
+                pending[i // n].append({"step": pop.num_timesteps, "return": round(float(returns[i]), 4),
+                                        "length": int(lengths[i]), "success": int(success[i])})
+            returns[ended], lengths[ended] = 0.0, 0
+            pop.episodes_ended(ended.reshape(K, n))
+        obs = next_obs
+        bar.update(K * n)
+        t = pop.num_timesteps
+        if t >= next_flush:
+            _flush(runs, pending, t, total)
+            next_flush = t + 1_000
+        if t >= next_eval or t >= total:
+            next_eval += every
+            _flush(runs, pending, t, total)
+            _evaluate(pop, configs, runs, t, bar)
+            _checkpoint(pop, runs)
+        pop.train()
+
+
+def _flush(runs, pending, step: int, total: int) -> None:
+    for run, rows in zip(runs, pending):
+        if rows:
+            run.append("episodes.csv", EPISODE_FIELDS, rows)
+            rows.clear()
+        run.write_progress(step, total)
+
+
+def evaluate_members(pop: Population, config: StudentConfig, seed: int) -> list[tuple[float, float, float]]:
+    """Each member's greedy (success, mean return, mean length) over ``config.eval_episodes``
+    fresh-seed episodes (seed + i, as ``training.evaluate``), all members' episodes stepped
+    as one vector env."""
+    K, E = pop.K, config.eval_episodes
+    envs = make_envs(config.env_id, K * E, config.env_kwargs, config.product)
+    try:
+        obs, _ = envs.reset(seed=[seed + i for _ in range(K) for i in range(E)])
+        active = np.ones(K * E, dtype=bool)
+        returns, lengths, wins = np.zeros(K * E), np.zeros(K * E), np.zeros(K * E, dtype=bool)
+        while active.any():
+            actions = pop.greedy(obs.reshape(K, E, -1))
+            obs, rewards, terminated, truncated, info = envs.step(actions.reshape(K * E, *actions.shape[2:]))
+            ended = terminated | truncated
+            _, _, success = step_records(info, ended, obs)
+            returns += np.where(active, rewards, 0.0)
+            lengths += active
+            finishing = active & ended
+            wins[finishing] = success[finishing]
+            active &= ~ended
+    finally:
+        envs.close()
+    shape = (K, E)
+    return [(float(w.mean()), float(r.mean()), float(l.mean()))
+            for w, r, l in zip(wins.reshape(shape), returns.reshape(shape), lengths.reshape(shape))]
+
+
+def _evaluate(pop, configs, runs, step, bar) -> None:
+    config = configs[0]
+    results = evaluate_members(pop, config, seed=10**7 + step)  # train_student's evaluation seeds
+    for run, (success, ret, length) in zip(runs, results):
+        run.append("evals.csv", EVAL_FIELDS, [{"step": step, "success": success, "return": round(ret, 4),
+                                                "episodes": config.eval_episodes, "length": round(length, 2)}])
+    bar.set_postfix(success=" ".join(f"{r[0]:.2f}" for r in results))
+
+
+def _checkpoint(pop: Population, runs) -> None:
+    """Every member's state into its ``checkpoint-new``, then each swapped in (``checkpoint``,
+    and the one before as ``checkpoint-old``)."""
+    from ..training import _swap_in
+
+    for k, run in enumerate(runs):
+        new = run.path / "checkpoint-new"
+        shutil.rmtree(new, ignore_errors=True)
+        new.mkdir()
+        with atomic_path(new / CHECKPOINT) as tmp:
+            th.save(pop.member_state(k), tmp)
+    for run in runs:
+        _swap_in(run)
+
+
+def _resume(pop: Population, runs) -> None:
+    """Load the newest step every member has a readable checkpoint of; else start afresh.
+    Either way each member's logs are trimmed to where it starts."""
+    found = []
+    for run in runs:
+        states = {}
+        for name in ("checkpoint-new", "checkpoint", "checkpoint-old"):
+            path = run.path / name / CHECKPOINT
+            if not path.exists():
+                continue
+            try:
+                state = th.load(path, weights_only=False, map_location=pop.learner.device)
+            except Exception as err:  # a damaged file: an older checkpoint may do
+                warnings.warn(f"{path} cannot be loaded ({type(err).__name__}: {err}); trying an older one",
+                              RuntimeWarning, stacklevel=2)
+                continue
+            states.setdefault(state["num_timesteps"], state)
+        found.append(states)
+    common = set(found[0]).intersection(*found[1:]) if found else set()
+    step = max(common) if common else 0
+    if common:
+        pop.load_states([states[step] for states in found])
+    for run in runs:
+        run.trim_logs(step)
+
+
+def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, seconds: float, device: str) -> None:
+    """Member ``k``'s model as an SB3 agent (``model.zip``), its result, its checkpoints gone."""
+    from ..agents.methods import make_agent
+
+    agent = make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=1,
+                       env_kwargs=config.env_kwargs, automaton_state=config.automaton_state,
+                       **config.effective()["hyperparameters"])
+    pop.learner.store_member(k, agent)
+    agent.num_timesteps, agent._n_updates = pop.num_timesteps, pop.learner.n_updates
+    if pop.learner.targets is not None:
+        agent.distill = pop.learner.targets.member(k)
+    with atomic_path(run.path / "model.zip") as tmp:
+        agent.save(tmp)
+    agent.get_env().close()
+    run.write_result({"kind": "student", "env_id": config.env_id, "method": config.method,
+                      "algorithm": METHODS[config.method].algorithm, "task": config.task, "seed": config.seed,
+                      "steps": int(pop.num_timesteps), "updates": int(pop.learner.n_updates),
+                      "product": config.product, "env_kwargs": config.env_kwargs, "model": "model.zip",
+                      "engine": "population", "members": pop.K, "device": device,
+                      "seconds_this_session": round(seconds, 1)})
+    for name in ("checkpoint", "checkpoint-old", "checkpoint-new"):
+        shutil.rmtree(run.path / name, ignore_errors=True)

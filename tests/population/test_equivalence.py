@@ -1,0 +1,94 @@
+"""The population engine's update is the SB3 agents' update: with one member, the same
+initial weights and the same minibatch, one gradient step leaves the same parameters."""
+
+import numpy as np
+import pytest
+import torch as th
+
+import craftsuite  # noqa: F401
+from craftsuite.agents.methods import make_agent
+from craftsuite.population.dqn import PopulationDQN
+from craftsuite.population.replay import Batch
+from craftsuite.population.targets import MemberTargets
+from craftsuite.population.td3 import PopulationTD3
+
+
+def _filled(method, env_id, **settings):
+    agent = make_agent(method, env_id, seed=3, n_envs=2, learning_starts=10**6, buffer_size=2_000, **settings)
+    agent.learn(400)  # random collection only: learning_starts is never reached
+    return agent
+
+
+def _batch(samples) -> Batch:
+    """An SB3 minibatch (``AutomatonSamples``) as the engine's, for one member."""
+    def one(t):
+        return np.asarray(t.cpu().numpy() if hasattr(t, "cpu") else t)[None]
+    dones = one(samples.dones)[..., 0]
+    return Batch(one(samples.observations), one(samples.actions), one(samples.next_observations),
+                 one(samples.rewards)[..., 0], dones, one(samples.weights)[..., 0], one(samples.indices),
+                 one(samples.w).astype(np.int64), one(samples.sigma).astype(np.int64))
+
+
+def _same_sample(agent, samples):
+    agent.replay_buffer.sample = lambda *args, **kwargs: samples
+
+
+def _close(a: th.Tensor, b: th.Tensor):
+    assert th.allclose(a, b, atol=1e-6, rtol=1e-5), (a - b).abs().max()
+
+
+@pytest.mark.parametrize("prioritized", [True, False])
+def test_td3_update_matches_automaton_td3(prioritized):
+    agent = _filled("td3-static", "CraftSuite/FirstTool-Kinematic-v0", batch_size=32, policy_delay=1,
+                    prioritized=prioritized, policy_kwargs={"net_arch": [32, 24]})
+    settings = agent_settings(agent, "td3", prioritized=prioritized, policy_kwargs={"net_arch": [32, 24]})
+    obs_dim = agent.observation_space.shape[0]
+    pop = PopulationTD3(1, obs_dim, 2, settings, MemberTargets(agent.distill, 1))
+    pop.targets.counts[0] = agent.distill.student_counts.reshape(-1)
+    pop.load_member(0, agent)
+    for step in range(3):  # the actor and targets move on each (delay 1); the teacher's weight fades
+        samples = agent.replay_buffer.sample(32)
+        _same_sample(agent, samples)
+        th.manual_seed(step)
+        agent.train(gradient_steps=1, batch_size=32)
+        th.manual_seed(step)
+        td = pop.update(_batch(samples), delay=1)
+    assert np.abs(td).sum() > 0
+    mine = _fresh_td3(agent)
+    pop.store_member(0, mine)
+    for name in ("actor", "actor_target", "critic", "critic_target"):
+        for a, b in zip(getattr(agent.policy, name).parameters(), getattr(mine.policy, name).parameters()):
+            _close(a, b)
+    np.testing.assert_array_equal(pop.targets.counts[0], agent.distill.student_counts.reshape(-1))
+
+
+@pytest.mark.parametrize("loss,prioritized", [("huber", True), ("mse", False)])
+def test_dqn_update_matches_automaton_dqn(loss, prioritized):
+    agent = _filled("static", "CraftSuite/FirstTool-Grid7-v0", batch_size=32, loss=loss, prioritized=prioritized,
+                    target_update_interval=2, target_update_unit="gradient_steps", max_grad_norm=0.05)
+    settings = agent_settings(agent, "dqn", loss=loss, prioritized=prioritized, target_update_interval=2,
+                              target_update_unit="gradient_steps", max_grad_norm=0.05)
+    pop = PopulationDQN(1, agent.observation_space.shape[0], 4, settings, MemberTargets(agent.distill, 1))
+    pop.targets.counts[0] = agent.distill.student_counts.reshape(-1)
+    pop.load_member(0, agent)
+    for step in range(3):  # the target network is copied after the second; clipping bites (0.05)
+        samples = agent.replay_buffer.sample(32)
+        _same_sample(agent, samples)
+        agent.train(gradient_steps=1, batch_size=32)
+        pop.update(_batch(samples))
+    mine = make_agent("static", "CraftSuite/FirstTool-Grid7-v0", seed=9, buffer_size=16)
+    pop.store_member(0, mine)
+    for name in ("q_net", "q_net_target"):
+        for a, b in zip(getattr(agent.policy, name).parameters(), getattr(mine.policy, name).parameters()):
+            _close(a, b)
+
+
+def agent_settings(agent, algorithm, **overrides) -> dict:
+    from craftsuite.methods import algorithm_settings
+
+    return algorithm_settings(algorithm, overrides)
+
+
+def _fresh_td3(like):
+    return make_agent("td3-static", "CraftSuite/FirstTool-Kinematic-v0", seed=11, buffer_size=16,
+                      policy_kwargs={"net_arch": [32, 24]})

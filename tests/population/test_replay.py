@@ -1,0 +1,83 @@
+"""The population's replay: its sum trees sample as the SB3 agents' tree does, and CRM's
+counterfactuals made at sampling equal those the CRM buffer stores."""
+
+import numpy as np
+import pytest
+
+import craftsuite  # noqa: F401
+from craftsuite.agents.crm import counterfactuals
+from craftsuite.agents.replay import SumTree
+from craftsuite.population.replay import CounterfactualView, PopulationReplay, SumTrees
+from craftsuite.task_registry import resolve_task
+
+
+def test_sum_trees_match_one_tree_per_member():
+    rng = np.random.default_rng(0)
+    trees, singles = SumTrees(3, 100), [SumTree(100) for _ in range(3)]
+    for _ in range(5):
+        leaves = rng.integers(0, 100, size=(3, 17))
+        values = rng.random((3, 17))
+        trees.update(leaves, values)
+        for k, tree in enumerate(singles):
+            for leaf, value in zip(leaves[k], values[k]):  # one at a time: repeats keep the last
+                tree.update(np.array([leaf]), np.array([value]))
+    targets = rng.random((3, 50)) * trees.total()[:, None]
+    found = trees.find(targets)
+    for k, tree in enumerate(singles):
+        assert trees.total()[k] == pytest.approx(tree.total())
+        np.testing.assert_array_equal(found[k], tree.find(targets[k]))
+
+
+def test_prioritized_sampling_follows_the_priorities():
+    replay = PopulationReplay(2, 64, 1, 3, (), np.int64, prioritized=True, alpha=1.0, seed=0)
+    for i in range(64):
+        replay.add(np.full((2, 1, 3), i), np.zeros((2, 1, 3)), np.zeros((2, 1)), np.zeros((2, 1)),
+                   np.zeros((2, 1)), np.zeros((2, 1)), np.zeros((2, 1)))
+    # member 0 puts all its mass on transition 5, member 1 spreads it evenly
+    replay.update_priorities(np.arange(64)[None].repeat(2, 0), np.array([[0.0] * 64, [1.0] * 64]))
+    replay.update_priorities(np.array([[5], [5]]), np.array([[1000.0], [1.0]]))
+    batch = replay.sample(256)
+    assert (batch.observations[0, :, 0] == 5).mean() > 0.9
+    assert len(np.unique(batch.observations[1, :, 0])) > 40
+    assert batch.weights.max(axis=1) == pytest.approx([1.0, 1.0])
+    assert batch.weights[0].min() < 0.1  # the over-sampled transition is weighted down
+
+
+@pytest.mark.parametrize("task", ["DungeonQuest", "DiamondMine"])
+def test_counterfactuals_at_sampling_equal_the_stored_ones(task):
+    spec = resolve_task(task)
+    automaton, S = spec.automaton, spec.automaton.n_states
+    view = CounterfactualView(automaton, spec.completion_reward)
+    rng = np.random.default_rng(1)
+    replay = PopulationReplay(1, 40, 1, 6 + S, (2,), crm=view, prioritized=False, seed=2)
+    stored = []
+    for i in range(40):
+        w = int(rng.choice(view.live))
+        sigma = int(rng.integers(automaton.delta.shape[1]))
+        obs, next_obs = rng.random(6 + S).astype(np.float32), rng.random(6 + S).astype(np.float32)
+        obs[-S:], next_obs[-S:] = np.eye(S)[w], np.eye(S)[automaton.delta[w, sigma]]
+        reward = -0.1 + spec.completion_reward * automaton.accepting[automaton.delta[w, sigma]]
+        action = rng.random(2)
+        terminal = bool(automaton.accepting[automaton.delta[w, sigma]] or automaton.rejecting[automaton.delta[w, sigma]])
+        replay.add(obs[None, None], next_obs[None, None], action[None, None], np.array([[reward]]),
+                   np.array([[terminal]]), np.array([[w]]), np.array([[sigma]]))
+        stored.append(counterfactuals(automaton, spec.completion_reward, obs, next_obs, action, reward, False,
+                                      w, sigma))
+    batch = replay.sample(300)
+    index, j = np.divmod(batch.leaves[0], view.n_live)
+    assert len(np.unique(j)) == view.n_live  # every live state is read
+    for b in range(300):
+        live, _, obs_u, next_u, _, rewards, dones, _ = stored[index[b]]
+        np.testing.assert_array_equal(batch.observations[0, b], obs_u[j[b]])
+        np.testing.assert_array_equal(batch.next_observations[0, b], next_u[j[b]])
+        assert batch.rewards[0, b] == pytest.approx(rewards[j[b]])
+        assert batch.terminals[0, b] == dones[j[b]]
+        assert batch.w[0, b] == live[j[b]]
+
+
+def test_crm_memory_holds_each_step_once():
+    spec = resolve_task("DiamondMine")
+    view = CounterfactualView(spec.automaton, spec.completion_reward)
+    replay = PopulationReplay(1, 1000, 1, 10, (2,), crm=view)
+    assert replay.observations.shape == (1, 1000, 10)  # not 1000 x the live states
+    assert replay.trees.leaves >= 1000 * view.n_live

@@ -32,6 +32,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/vector_envs.py
 	$(PY) benchmarks/training_steps.py --repeats 2
 	$(PY) benchmarks/student_throughput.py
+	$(PY) benchmarks/crm_memory.py
 	$(PY) benchmarks/teachers.py --quick
 	$(PY) benchmarks/interval_coverage.py
 

@@ -1,14 +1,17 @@
-"""Student throughput: transitions and gradient updates per second, per collection regime.
+"""Student throughput: transitions and gradient updates per second per core, SB3 agents
+beside the population engine, per collection regime.
 
-Usage: python benchmarks/student_throughput.py [--seconds 10] [--page PATH | --no-page]
+Usage: python benchmarks/student_throughput.py [--seconds 10] [--members 5] [--page PATH | --no-page]
 
-One process, one torch thread, Blind Craftsman, TD3 in the MuJoCo world and DQN on the
-10x10 grid: the package's defaults (one env, one update per transition; TD3 [400, 300])
-and the suites' regimes (``craftsuite.suites.TD3_REGIME`` / ``DQN_REGIME``: several envs
-per update, small networks), each with SB3's default Adam and with the fused Adam that
-``make_agent`` uses. Each row trains for about ``--seconds`` after 2,000 warm-up
-transitions. The reference column is what was measured for plain SB3 TD3 [400, 300] here
-before: about 85 transitions/s with one env, about 1,400 with 10 envs per gradient step.
+One process, one torch thread, Blind Craftsman: TD3 in the MuJoCo world and on the
+kinematic board, DQN on the 10x10 grid. SB3 rows: the package's defaults (one env, one
+update per transition; TD3 [400, 300]) and the suites' regimes (``craftsuite.suites.TD3_REGIME``
+/ ``DQN_REGIME``: several envs per update, small networks) with the fused Adam that
+``make_agent`` uses, each after 2,000 warm-up transitions. Population rows: the suites'
+regimes for ``--members`` seeds in one process (``craftsuite.population``), collecting from
+one vector env (native on the grid and the board), counted over all members, after the
+warm-up of random actions (``learning_starts``). Each row trains for about ``--seconds``.
+The reference column is the target of each population row, or what was measured before.
 """
 
 from __future__ import annotations
@@ -16,27 +19,36 @@ from __future__ import annotations
 import argparse
 import time
 
+import numpy as np
+
 import craftsuite  # noqa: F401
 from craftsuite.agents.methods import make_agent
+from craftsuite.methods import algorithm_settings
 from craftsuite.suites import DQN_REGIME, TD3_REGIME
 from _page import Report, add_page_argument  # benchmarks/ is on sys.path as a script
 
 CONT, GRID = "CraftSuite/BlindCraftsman-Cont-v0", "CraftSuite/BlindCraftsman-Grid10-v0"
-ROWS = [  # (label, method, env id, n_envs, algorithm settings, reference transitions/s)
-    ("TD3, package defaults (1 env, [400, 300], batch 64)", "td3", CONT, 1, {}, "~85 (SB3 TD3, 1 env)"),
-    ("TD3, suites' regime (10 envs, [64, 64], batch 256)", "td3", CONT, TD3_REGIME["td3_n_envs"],
-     TD3_REGIME["td3_hyperparameters"], "~1,400 (SB3 TD3 [400, 300], 10 envs)"),
-    ("DQN, package defaults (1 env, [64, 64])", "dqn", GRID, 1, {"env_kwargs": {"layout_seed": 1}}, ""),
-    ("DQN, suites' regime (4 envs, 2 updates per step)", "dqn", GRID, DQN_REGIME["dqn_n_envs"],
-     {**DQN_REGIME["dqn_hyperparameters"], "env_kwargs": {"layout_seed": 1}}, ""),
+KINEMATIC = "CraftSuite/BlindCraftsman-Kinematic-v0"
+TD3_N, DQN_N = TD3_REGIME["td3_n_envs"], DQN_REGIME["dqn_n_envs"]
+TD3_SET, DQN_SET = TD3_REGIME["td3_hyperparameters"], DQN_REGIME["dqn_hyperparameters"]
+SB3_ROWS = [  # (label, method, env id, n_envs, algorithm settings, reference transitions/s)
+    ("TD3, MuJoCo, package defaults (1 env, [400, 300], batch 64)", "td3", CONT, 1, {}, "~85 (SB3 TD3, 1 env)"),
+    ("TD3, MuJoCo, suites' regime (10 envs, [64, 64], batch 256)", "td3", CONT, TD3_N, TD3_SET, "2,052 (before)"),
+    ("TD3, kinematic, suites' regime", "td3", KINEMATIC, TD3_N, TD3_SET, ""),
+    ("DQN, Grid10, package defaults (1 env, [64, 64])", "dqn", GRID, 1, {"env_kwargs": {"layout_seed": 1}}, ""),
+    ("DQN, Grid10, suites' regime (4 envs, 2 updates per step)", "dqn", GRID, DQN_N,
+     {**DQN_SET, "env_kwargs": {"layout_seed": 1}}, "710 (before)"),
+]
+POPULATION_ROWS = [  # (label, method, env id, n_envs, settings, env keywords, target transitions/s)
+    ("TD3, MuJoCo, suites' regime", "td3", CONT, TD3_N, TD3_SET, {}, ">= 5,000"),
+    ("TD3, kinematic, suites' regime", "td3", KINEMATIC, TD3_N, TD3_SET, {}, ">= 8,000"),
+    ("DQN, Grid10, suites' regime", "dqn", GRID, DQN_N, DQN_SET, {"layout_seed": 1}, ">= 5,000"),
+    ("CRM (DQN), Grid10, suites' regime", "crm", GRID, DQN_N, DQN_SET, {"layout_seed": 1}, ""),
 ]
 
 
-def measure(method, env_id, n_envs, settings, fused: bool, seconds: float) -> tuple[float, float]:
-    settings = dict(settings)
-    policy_kwargs = dict(settings.pop("policy_kwargs", {}))
-    policy_kwargs["optimizer_kwargs"] = {"fused": fused}
-    agent = make_agent(method, env_id, n_envs=n_envs, buffer_size=200_000, policy_kwargs=policy_kwargs, **settings)
+def measure_sb3(method, env_id, n_envs, settings, seconds: float) -> tuple[float, float]:
+    agent = make_agent(method, env_id, n_envs=n_envs, buffer_size=200_000, **settings)
     agent.learn(2_000)
     steps, total = 1_000 * n_envs, 0.0
     transitions, updates = agent.num_timesteps, agent._n_updates
@@ -47,21 +59,69 @@ def measure(method, env_id, n_envs, settings, fused: bool, seconds: float) -> tu
     return (agent.num_timesteps - transitions) / total, (agent._n_updates - updates) / total
 
 
+def measure_population(method, env_id, n_envs, settings, env_kwargs, members: int, seconds: float,
+                       device: str = "cpu") -> tuple[float, float]:
+    """The engine's hot path (``population.train._loop`` without its logs): act, step the
+    vector env, store, learn."""
+    from craftsuite.methods import METHODS
+    from craftsuite.population import Population
+    from craftsuite.population.envs import make_envs, step_records
+    from craftsuite.task_registry import resolve_task
+
+    spec = resolve_task("BlindCraftsman")
+    product = METHODS[method].product
+    envs = make_envs(env_id, members * n_envs, env_kwargs, product)
+    pop = Population(method, algorithm_settings(METHODS[method].algorithm, {**settings, "buffer_size": 200_000}),
+                     list(range(members)), n_envs, envs.single_observation_space.shape[0], envs.single_action_space,
+                     spec.automaton, spec.completion_reward, 10**7, device=device)
+    obs, _ = envs.reset(seed=list(range(members * n_envs)))
+
+    def step():
+        nonlocal obs
+        shaped = obs.reshape(members, n_envs, -1)
+        actions = pop.actions(shaped)
+        next_obs, rewards, terminated, truncated, info = envs.step(actions.reshape(members * n_envs,
+                                                                                   *actions.shape[2:]))
+        ended = terminated | truncated
+        real_next, transitions, _ = step_records(info, ended, next_obs)
+        pop.observe(shaped, real_next.reshape(members, n_envs, -1), actions, rewards.reshape(members, n_envs),
+                    terminated.reshape(members, n_envs).astype(np.float32), transitions.reshape(members, n_envs, 3))
+        if ended.any():
+            pop.episodes_ended(ended.reshape(members, n_envs))
+        obs = next_obs
+        pop.train()
+
+    while pop.num_timesteps <= pop.learning_starts + 1_000:  # the warm-up, then some learning
+        step()
+    transitions, updates, start = pop.num_timesteps, pop.learner.n_updates, time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        for _ in range(50):
+            step()
+    total = time.perf_counter() - start
+    envs.close()
+    return members * (pop.num_timesteps - transitions) / total, members * (pop.learner.n_updates - updates) / total
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0)
+    parser.add_argument("--members", type=int, default=5, help="population size (default: 5, the suites' seeds)")
+    parser.add_argument("--device", default="cpu", help="the population's torch device (default: cpu)")
     add_page_argument(parser)
     args = parser.parse_args()
     import torch
 
     torch.set_num_threads(1)
     report = Report()
-    report("| student | Adam | transitions/s | updates/s | reference transitions/s |")
+    report("| student | engine | transitions/s | updates/s (all members) | reference transitions/s |")
     report("|---|---|---|---|---|")
-    for label, method, env_id, n_envs, settings, reference in ROWS:
-        for fused in (False, True):
-            tps, ups = measure(method, env_id, n_envs, settings, fused, args.seconds)
-            report(f"| {label} | {'fused' if fused else 'SB3 default'} | {tps:,.0f} | {ups:,.0f} | {reference} |")
+    for label, method, env_id, n_envs, settings, reference in SB3_ROWS:
+        tps, ups = measure_sb3(method, env_id, n_envs, settings, args.seconds)
+        report(f"| {label} | SB3 | {tps:,.0f} | {ups:,.0f} | {reference} |")
+    for label, method, env_id, n_envs, settings, env_kwargs, target in POPULATION_ROWS:
+        tps, ups = measure_population(method, env_id, n_envs, settings, env_kwargs, args.members, args.seconds,
+                                      args.device)
+        report(f"| {label} | population of {args.members} ({args.device}) | {tps:,.0f} | {ups:,.0f} | {target} |")
     report.save(__file__, __doc__, args)
 
 

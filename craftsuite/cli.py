@@ -273,7 +273,7 @@ def _student(args) -> int:
                            table=str(Path(args.table).resolve()) if args.table else None, eval_every=args.eval_every,
                            eval_episodes=args.eval_episodes, hyperparameters=_hyper(args.hyper, METHODS[args.method].algorithm),
                            layout_seed=args.layout_seed, world_kwargs=_json_object(args.env, "--env"),
-                           n_envs=args.n_envs, automaton_state=args.automaton_state)
+                           n_envs=args.n_envs, automaton_state=args.automaton_state, engine=args.engine)
     if METHODS[args.method].needs_table and not args.table:
         raise ValueError(f"method {args.method!r} needs --table (a teacher's table.npz: craftsuite teacher)")
     path = train_student(config, args.out)
@@ -311,10 +311,13 @@ def _transfer(args) -> int:
         changes["cont_world_kwargs"] = _json_object(args.env, "--env")
     if args.td3_hyper is not None:
         changes["td3_hyperparameters"] = {**suite.td3_hyperparameters, **_hyper(args.td3_hyper, "td3", "--td3-hyper")}
+    if args.engine is not None:
+        changes["engine"] = args.engine
     suite = dataclasses.replace(suite, **changes)
     print(f"suite {suite.name}: {suite.description}")
     out = args.out or f"runs/{args.suite}"
-    result = transfer(suite, out, workers=args.workers, ray=args.ray, video=not args.no_video, command=command_line())
+    result = transfer(suite, out, workers=args.workers, ray=args.ray, video=not args.no_video, command=command_line(),
+                      device=args.device)
     print(f"leaderboard: {result.leaderboard} (and .csv)")
     for plot in result.plots:
         print(f"learning curves: {plot}")
@@ -390,6 +393,7 @@ DEBUG_HELP = "on an error, show the full traceback instead of one line"
 
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
+    from .configs import ENGINES
     from .methods import METHODS
     from .suites import SUITES
     from .task_registry import SPEC_SUFFIX, ladder
@@ -471,6 +475,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--env", help="JSON gymnasium.make keywords beyond the registered world, e.g. the "
                    "fine-control MuJoCo world '{\"frame_skip\": 2, \"max_episode_steps\": 1000}'")
     p.add_argument("--layout-seed", type=int, help="grid worlds: one fixed instance (default: a new one per episode)")
+    p.add_argument("--engine", choices=ENGINES, default="sb3", help="sb3 (default: one SB3 agent) or population "
+                   "(the same run by the population engine)")
     p.add_argument("--automaton-state", type=_on_off, metavar="on|off",
                    help="whether a distilled student sees the automaton state (default: as its method; the paper's "
                    "authors' students did not)")
@@ -499,6 +505,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=_positive, help="parallel local processes (default: one per core)")
     p.add_argument("--ray", metavar="ADDRESS", help="run the students on Ray ('local' starts one here)")
     p.add_argument("--no-video", action="store_true", help="skip the rollout video of the best student")
+    p.add_argument("--engine", choices=ENGINES, help="what trains the students: population (each cell's seeds in "
+                   "one process) or sb3 (one SB3 agent per run); default: the suite's")
+    p.add_argument("--device", default="cpu", help="the population engine's torch device: cpu (default) or cuda")
     p.set_defaults(run=_transfer)
 
     p = sub.add_parser("leaderboard", help="leaderboard (Markdown, CSV) and learning curves from run directories")

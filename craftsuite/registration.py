@@ -68,7 +68,9 @@ make_kinematic.metadata = {"render_modes": ["rgb_array"], "render_fps": 8}
 
 
 _VECTOR = {"grid": "craftsuite.envs.vector:make_grid_vector",
-           "kinematic": "craftsuite.envs.vector:make_kinematic_vector"}
+           "kinematic": "craftsuite.envs.vector:make_kinematic_vector",
+           # a module of its own: craftsuite.envs.vector stays free of MuJoCo
+           "continuous": "craftsuite.envs.continuous_vector:make_continuous_vector"}
 
 
 def _register(spec: TaskSpec) -> list[str]:
@@ -76,10 +78,11 @@ def _register(spec: TaskSpec) -> list[str]:
     # worker processes of vector envs need not re-register it, and EnvSpec.to_json works
     task = carried(spec)
     # (id, entry point, vector entry point, kwargs, max steps); the vector entry points are
-    # the natively vectorized worlds of craftsuite.envs.vector (make_vec's "vector_entry_point")
+    # the natively vectorized worlds of craftsuite.envs.vector and, for the MuJoCo ids,
+    # craftsuite.envs.continuous_vector (make_vec's "vector_entry_point"; strings, imported lazily)
     worlds = [(grid_id(spec.name, size), "make_grid", _VECTOR["grid"], {"size": size}, spec.grid.max_steps)
               for size in spec.grid.sizes]
-    worlds.append((cont_id(spec.name), "make_continuous", None, {}, spec.continuous.max_steps))
+    worlds.append((cont_id(spec.name), "make_continuous", _VECTOR["continuous"], {}, spec.continuous.max_steps))
     worlds.append((kinematic_id(spec.name), "make_kinematic", _VECTOR["kinematic"], {}, KINEMATIC.max_steps))
     for env_id, entry, vector_entry, kwargs, max_steps in worlds:
         if env_id in gym.registry:

@@ -72,6 +72,9 @@ class Suite:
     # gymnasium.make keywords of the MuJoCo students' world beyond the registered one; the
     # leaderboard names each in its world label
     cont_world_kwargs: dict = field(default_factory=dict)
+    # what trains the students: "population" (the seeds of each cell in one process,
+    # craftsuite.population) or "sb3" (one SB3 agent per run); teachers are SB3 agents
+    engine: str = "population"
 
     def rungs(self) -> list[TaskSpec]:
         """The suite's tasks, easiest first."""
@@ -128,7 +131,7 @@ class Suite:
                             world_kwargs=dict(self.cont_world_kwargs) if world == CONT else {},
                             n_envs=self.td3_n_envs if cont else self.dqn_n_envs,
                             automaton_state=None if self.students_see_automaton or not METHODS[method].distill
-                            else False))
+                            else False, engine=self.engine))
         if not out:
             raise ValueError(f"no method of {list(self.methods)} runs in the worlds {list(self.worlds)} "
                              f"({', '.join(f'{w}: {methods_for(w)}' for w in self.worlds)})")
@@ -188,7 +191,8 @@ SUITES = {s.name: s for s in (
     Suite("paper", "the paper's protocol as the authors' code ran it: the paper's methods and baselines on its tasks "
           "in the grid, MuJoCo and kinematic worlds, 20 seeds, 2M steps of 10 envs (20M transitions) per run",
           tags=("paper",), worlds=("Grid10", "Cont", "Kinematic"), methods=PAPER_METHODS, seeds=20,
-          student_steps=20_000_000, eval_every=500_000, teacher_max_steps=20_000_000, **PAPER_PROTOCOL),
+          student_steps=20_000_000, eval_every=500_000, teacher_max_steps=20_000_000, **PAPER_PROTOCOL,
+          engine="sb3"),  # the authors' residual CNN is not in the population engine
     # the transfer target (a distilled student at 80% greedy success in at most half the
     # transitions its algorithm needs from scratch) on the paper's three tasks: scratch, the
     # paper's method and the transfer method, in the standard suite's collection regimes, with
@@ -203,6 +207,26 @@ SUITES = {s.name: s for s in (
                                                                     "buffer_size": 200_000},
           **DQN_REGIME),
 )}
+
+
+def _population_job(configs: list[dict], root: str, task: str | dict | None = None, device: str = "cpu") -> list[str]:
+    """The seeds of one cell in a worker process, as one population (``craftsuite.population``)."""
+    _start_worker(task)
+    from .population import train_population
+
+    return [str(p) for p in train_population([StudentConfig(**c) for c in configs], root, progress=False,
+                                             device=device)]
+
+
+def cells(configs: list[StudentConfig]) -> list[list[StudentConfig]]:
+    """The population engine's jobs: configs equal but for the seed, together, in order;
+    each SB3 config alone."""
+    groups: dict[str, list[StudentConfig]] = {}
+    for c in configs:
+        key = json.dumps({k: v for k, v in dataclasses.asdict(c).items() if k != "seed"}, sort_keys=True) \
+            if c.engine == "population" else c.run_name()
+        groups.setdefault(key, []).append(c)
+    return list(groups.values())
 
 
 def _student_job(config: dict, root: str, task: str | dict | None = None) -> str:
@@ -297,26 +321,32 @@ class _Workers:
 
 def run_students(configs: list[StudentConfig], root, workers: int | None = None, ray: str | None = None,
                  progress: bool = True, teachers: dict[str, TeacherConfig] | None = None, teacher_root=None,
-                 log=print) -> list[Path]:
+                 log=print, device: str = "cpu") -> list[Path]:
     """Run students in parallel (processes or Ray) with one progress bar over all their
-    transitions. With ``teachers`` (by task, trained under ``teacher_root``), each
-    teacher runs first in the same pool and its task's distilled students start when it
-    is done; the other students start at once."""
+    transitions: one job per SB3 run, one per population (the seeds of a cell, ``cells``).
+    With ``teachers`` (by task, trained under ``teacher_root``), each teacher runs first in
+    the same pool and its task's distilled students start when it is done; the other
+    students start at once. ``device`` is the populations' torch device."""
     from tqdm import tqdm
 
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     teachers = teachers or {}
-    waiting = {task: [c for c in configs if c.task == task and METHODS[c.method].needs_table] for task in teachers}
-    ready = [c for c in configs if not (c.task in teachers and METHODS[c.method].needs_table)]
+    jobs = cells(configs)
+    waiting = {task: [job for job in jobs if job[0].task == task and METHODS[job[0].method].needs_table]
+               for task in teachers}
+    ready = [job for job in jobs if not (job[0].task in teachers and METHODS[job[0].method].needs_table)]
     total = sum(c.steps for c in configs)
-    workers_ = _Workers(len(configs) + len(teachers), workers, ray)
+    workers_ = _Workers(len(jobs) + len(teachers), workers, ray)
     with tqdm(total=total, desc=f"{len(configs)} student runs", unit="step", disable=not progress,
               dynamic_ncols=True) as bar:
         runs = [(c, root / c.run_name()) for c in configs]  # named once: a name hashes the run's settings
 
-        def submit_student(c: StudentConfig) -> Future:
-            return workers_.submit(_student_job, dataclasses.asdict(c), str(root), _carried(c.task))
+        def submit(job: list[StudentConfig]) -> Future:
+            if job[0].engine == "population":
+                return workers_.submit(_population_job, [dataclasses.asdict(c) for c in job], str(root),
+                                       _carried(job[0].task), device)
+            return workers_.submit(_student_job, dataclasses.asdict(job[0]), str(root), _carried(job[0].task))
 
         def poll():
             done = 0
@@ -333,8 +363,8 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
         try:
             pending = {workers_.submit(_teacher_job, dataclasses.asdict(t), str(teacher_root), _carried(t.task)): task
                        for task, t in teachers.items()}
-            students = {c.run_name(): submit_student(c) for c in ready}
-            while pending or not all(f.done() for f in students.values()):
+            futures = {id(job): (job, submit(job)) for job in ready}
+            while pending or not all(f.done() for _, f in futures.values()):
                 time.sleep(0.5)
                 poll()
                 for future in [f for f in pending if f.done()]:
@@ -345,18 +375,22 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                     (bar.write if progress else log)(
                         f"teacher {task}: {result['steps']:,} steps, greedy success {result['success']:.2f} "
                         f"({reached} {teachers[task].target_success:.0%}) -> {path}")
-                    for c in waiting.pop(task):
-                        students[c.run_name()] = submit_student(c)
-                for future in students.values():
+                    for job in waiting.pop(task):
+                        futures[id(job)] = (job, submit(job))
+                for _, future in futures.values():
                     if future.done() and future.exception() is not None:
                         raise future.exception()  # a worker's error, at once rather than at the end
-            paths = [students[c.run_name()].result() for c in configs]
+            paths = {}
+            for job, future in futures.values():
+                result = future.result()
+                for c, path in zip(job, result if isinstance(result, list) else [result]):
+                    paths[c.run_name()] = path
         except BaseException:
             workers_.close(abort=True)
             raise
         workers_.close()
         poll()
-    return [Path(p) for p in paths]
+    return [Path(paths[c.run_name()]) for c in configs]
 
 
 @dataclass(frozen=True)
@@ -370,9 +404,10 @@ class TransferResult:
 
 
 def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None = None, video: bool = True,
-             progress: bool = True, log=print, command: list[str] | None = None) -> TransferResult:
+             progress: bool = True, log=print, command: list[str] | None = None, device: str = "cpu") -> TransferResult:
     """The suite end to end: teachers and distillation, students, leaderboard, plots, video.
 
+    ``device``: the torch device of the population engine's students (``cpu``, ``cuda``).
     ``command``: how this run was asked for, as ``provenance.json`` records it (the CLI
     passes its command line); by default, this Python call."""
     from . import leaderboard
@@ -383,14 +418,14 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     session, clock = start_session(command), time.perf_counter()
     out = Path(out)
     configs = suite.student_configs(out / "teachers")
-    _check_students(configs)  # fail before any training
+    _check_students(configs, device)  # fail before any training
     read(out)  # a damaged provenance record, too
     out.mkdir(parents=True, exist_ok=True)
     atomic_write(out / "suite.json", json.dumps(dataclasses.asdict(suite), indent=2) + "\n")
     record_session(out, session, None)  # if this session is killed, its command and commit stay on record
     teachers = suite.teachers()
     students = run_students(configs, out / "students", workers=workers, ray=ray, progress=progress,
-                            teachers=teachers, teacher_root=out / "teachers", log=log)
+                            teachers=teachers, teacher_root=out / "teachers", log=log, device=device)
     board = leaderboard.build(out / "students")
     board_md = leaderboard.write(board, out)
     plots = leaderboard.plot_curves(out / "students", out, board)
@@ -404,13 +439,23 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
                           students, board_md, plots, movie)
 
 
-def _check_students(configs: list[StudentConfig]) -> None:
+def _check_students(configs: list[StudentConfig], device: str = "cpu") -> None:
     """Build each kind of student once, untrained, from scratch (the teachers' tables do not
-    exist yet): a misspelt world setting or algorithm setting (``--env``, ``--td3-hyper``) is
-    named now, not in a worker after the teachers have trained."""
+    exist yet): a misspelt world setting or algorithm setting (``--env``, ``--td3-hyper``),
+    or a run the population engine cannot train, is named now, not in a worker after the
+    teachers have trained."""
     import craftsuite  # noqa: F401  (registers the ids)
 
     from .agents.methods import make_agent
+
+    if any(c.engine == "population" for c in configs):
+        from .population import check_supported
+        from .population.train import check_device
+
+        check_device(device)
+        for c in configs:
+            if c.engine == "population":
+                check_supported(c.method, c.effective()["hyperparameters"])
 
     kinds = {(c.env_id, c.world, c.n_envs, json.dumps(c.env_kwargs, sort_keys=True),
               json.dumps(c.hyperparameters, sort_keys=True)) for c in configs}

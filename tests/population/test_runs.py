@@ -1,0 +1,126 @@
+"""Population members are ordinary runs: each writes the run directory the other commands
+read, its model loads as an SB3 agent acting as the member did, a killed population resumes
+from its checkpoint, and bad input is refused before anything is written."""
+
+import json
+
+import numpy as np
+import pytest
+import torch as th
+
+import craftsuite  # noqa: F401
+from craftsuite.agents.methods import load_agent
+from craftsuite.configs import StudentConfig
+from craftsuite.population import EngineError, train_population
+from craftsuite.population import train as population_train
+from craftsuite.runs import read_csv
+
+TD3 = {"batch_size": 32, "learning_starts": 200, "policy_kwargs": {"net_arch": [16, 16]}, "prioritized": False,
+       "action_noise": {"type": "persistent", "sigma": 0.6, "resample": 0.1}}
+DQN = {"batch_size": 32, "learning_starts": 200, "policy_kwargs": {"net_arch": [16, 16]}, "gradient_steps": 2}
+
+
+def _cell(method="td3", world="Kinematic", task="Reach", seeds=(0, 1, 2), steps=1_200, **kw):
+    hyper = TD3 if world in ("Kinematic", "Cont") else DQN
+    return [StudentConfig(task=task, method=method, world=world, seed=s, steps=steps, eval_every=400,
+                          eval_episodes=3, hyperparameters=hyper, n_envs=4, engine="population", **kw)
+            for s in seeds]
+
+
+def test_members_write_ordinary_runs(tmp_path):
+    configs = _cell()
+    paths = train_population(configs, tmp_path, progress=False)
+    assert [p.name for p in paths] == [c.run_name() for c in configs]
+    for config, path in zip(configs, paths):
+        result = json.loads((path / "result.json").read_text())
+        assert (result["engine"], result["members"], result["steps"], result["seed"]) == \
+            ("population", 3, 1_200, config.seed)
+        assert result["updates"] == (1_200 - 200) // 4  # one update per step of 4 envs once learning starts
+        assert [int(r["step"]) for r in read_csv(path / "evals.csv")] == [400, 800, 1200]
+        assert json.loads((path / "config.json").read_text())["engine"] == "population"
+        assert not (path / "checkpoint").exists()
+    agent = load_agent(paths[1] / "model.zip")
+    assert type(agent).__name__ == "AutomatonTD3" and agent.num_timesteps == 1_200
+    # a second call trains nothing: every member is finished
+    assert train_population(configs, tmp_path, progress=False) == paths
+
+
+def test_a_members_model_acts_as_the_member(tmp_path, monkeypatch):
+    seen = {}
+    finish = population_train._finish
+
+    def spy(pop, k, *args):
+        seen["pop"] = pop
+        finish(pop, k, *args)
+
+    monkeypatch.setattr(population_train, "_finish", spy)
+    paths = train_population(_cell("product-dqn", "Grid7", "FirstTool", seeds=(4, 5), layout_seed=0),
+                             tmp_path, progress=False)
+    pop = seen["pop"]
+    obs = np.random.default_rng(0).random((2, 7, pop.replay.observations.shape[-1])).astype(np.float32)
+    greedy = pop.greedy(obs)
+    for k, path in enumerate(paths):
+        agent = load_agent(path / "model.zip")
+        np.testing.assert_array_equal(agent.predict(obs[k], deterministic=True)[0], greedy[k])
+
+
+def test_a_killed_population_resumes_from_its_checkpoint(tmp_path, monkeypatch):
+    configs = _cell("crm", "Grid7", "FirstTool", seeds=(0, 1), layout_seed=0)
+    evaluate = population_train._evaluate
+    calls = {"n": 0}
+
+    def dies_at_the_second(pop, configs, runs, step, bar):
+        calls["n"] += 1
+        if calls["n"] == 2:
+            raise KeyboardInterrupt
+        evaluate(pop, configs, runs, step, bar)
+
+    monkeypatch.setattr(population_train, "_evaluate", dies_at_the_second)
+    with pytest.raises(KeyboardInterrupt):
+        train_population(configs, tmp_path, progress=False)
+    first = [read_csv(tmp_path / c.run_name() / "evals.csv") for c in configs]
+    assert [len(e) for e in first] == [1, 1]
+    monkeypatch.setattr(population_train, "_evaluate", evaluate)
+    loaded = {}
+    load = population_train.Population.load_states
+
+    def spy(self, states):
+        loaded["steps"] = [s["num_timesteps"] for s in states]
+        load(self, states)
+        loaded["replay"] = self.replay.size
+
+    monkeypatch.setattr(population_train.Population, "load_states", spy)
+    paths = train_population(configs, tmp_path, progress=False)
+    assert loaded == {"steps": [400, 400], "replay": 400}  # resumed with its replay, not from step 0
+    for path, before in zip(paths, first):
+        evals = read_csv(path / "evals.csv")
+        assert evals[0] == before[0] and [int(r["step"]) for r in evals] == [400, 800, 1200]
+        steps = [int(r["step"]) for r in read_csv(path / "episodes.csv")]
+        assert steps == sorted(steps)
+        assert len(json.loads((path / "config.json").read_text())["provenance"]) == 2
+
+
+def test_bad_input_leaves_nothing_behind(tmp_path):
+    with pytest.raises(EngineError, match="features_extractor 'residual-cnn'.*--engine sb3"):
+        train_population([StudentConfig(task="Reach", method="dqn", world="Grid7", steps=100, engine="population",
+                                        hyperparameters={"features_extractor": "residual-cnn"})], tmp_path)
+    with pytest.raises(EngineError, match="n-step returns.*--engine sb3"):
+        train_population([StudentConfig(task="Reach", method="td3", world="Kinematic", engine="population",
+                                         hyperparameters={"n_steps": 3})], tmp_path)
+    with pytest.raises(EngineError, match="differ in \\['steps'\\]"):
+        train_population(_cell(seeds=(0,)) + _cell(seeds=(1,), steps=800), tmp_path)
+    with pytest.raises(EngineError, match="seeds must differ"):
+        train_population(_cell(seeds=(0, 0)), tmp_path)
+    with pytest.raises(EngineError, match="not a torch device"):
+        train_population(_cell(), tmp_path, device="gpu0")
+    if not th.cuda.is_available():
+        with pytest.raises(EngineError, match="no CUDA GPU; use --device cpu"):
+            train_population(_cell(), tmp_path, device="cuda")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(not th.cuda.is_available(), reason="needs a CUDA GPU")
+def test_a_population_trains_on_the_gpu(tmp_path):
+    paths = train_population(_cell(), tmp_path, progress=False, device="cuda")
+    assert json.loads((paths[0] / "result.json").read_text())["device"] == "cuda"
+    load_agent(paths[0] / "model.zip")

@@ -64,7 +64,9 @@ def measure_population(method, env_id, n_envs, settings, env_kwargs, members: in
     """The engine's hot path (``population.train._loop`` without its logs): act, step the
     vector env, store, learn."""
     from craftsuite.methods import METHODS
+    from craftsuite.ids import parse_id, world_kind
     from craftsuite.population import Population
+    from craftsuite.population.engine import sparse_width
     from craftsuite.population.envs import make_envs, step_records
     from craftsuite.task_registry import resolve_task
 
@@ -73,7 +75,8 @@ def measure_population(method, env_id, n_envs, settings, env_kwargs, members: in
     envs = make_envs(env_id, members * n_envs, env_kwargs, product)
     pop = Population(method, algorithm_settings(METHODS[method].algorithm, {**settings, "buffer_size": 200_000}),
                      list(range(members)), n_envs, envs.single_observation_space.shape[0], envs.single_action_space,
-                     spec.automaton, spec.completion_reward, 10**7, device=device)
+                     spec.automaton, spec.completion_reward, 10**7, device=device,
+                     sparse_width=sparse_width(spec, world_kind(parse_id(env_id)[1]), product))
     obs, _ = envs.reset(seed=list(range(members * n_envs)))
 
     def step():

@@ -10,7 +10,7 @@ import torch as th
 import torch.nn.functional as F
 
 from .nets import StackedMLP, activation_of, clip_grad_norm_per_member, polyak
-from .replay import Batch
+from .replay import Batch, SparseRows
 from .targets import MemberTargets
 
 
@@ -54,12 +54,20 @@ class PopulationDQN:
         advantage = out[..., 1:]
         return out[..., :1] + advantage - advantage.mean(dim=-1, keepdim=True)
 
+    def inputs(self, observations):
+        """A minibatch's observations as the networks take them: a tensor, or the
+        ``(index, value)`` tensors of ``SparseRows``."""
+        if isinstance(observations, SparseRows):
+            return (th.as_tensor(observations.index, device=self.device),
+                    th.as_tensor(observations.value, device=self.device))
+        return th.as_tensor(observations, device=self.device)
+
     def act(self, observations: np.ndarray) -> np.ndarray:
         """Greedy actions ``(K, n)`` for observations ``(K, n, obs_dim)``."""
         with th.no_grad():
             return self.q_values(self.q_net, th.as_tensor(observations, device=self.device)).argmax(dim=-1).cpu().numpy()
 
-    def td_target(self, batch: Batch, next_obs: th.Tensor) -> th.Tensor:
+    def td_target(self, batch: Batch, next_obs) -> th.Tensor:
         """The one target rule (``AutomatonDQN._td_target`` for K members), ``(K, B, 1)``."""
         K, B = batch.rewards.shape
         with th.no_grad():
@@ -79,8 +87,8 @@ class PopulationDQN:
     def update(self, batch: Batch) -> np.ndarray:
         """One gradient step of every member; returns the TD errors ``(K, B)``."""
         K, B = batch.rewards.shape
-        target = self.td_target(batch, th.as_tensor(batch.next_observations, device=self.device))
-        obs = th.as_tensor(batch.observations, device=self.device)
+        target = self.td_target(batch, self.inputs(batch.next_observations))
+        obs = self.inputs(batch.observations)
         actions = th.as_tensor(batch.actions, device=self.device).reshape(K, B, 1).long()
         current = th.gather(self.q_values(self.q_net, obs), dim=-1, index=actions)
         loss_fn = F.smooth_l1_loss if self.loss == "huber" else F.mse_loss

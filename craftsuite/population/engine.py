@@ -88,15 +88,26 @@ def member_table(method: str, automaton, completion_reward: float, table: Automa
     return table
 
 
+def sparse_width(spec, world_kind: str, product: bool) -> int | None:
+    """The most nonzero entries a grid observation of ``spec`` can have (the agent, the
+    obstacles, every object, every inventory count, the automaton state), which its replay
+    stores instead of the whole vector; None for the continuous worlds, whose observations
+    are dense."""
+    if world_kind != "Grid":
+        return None
+    return 1 + len(spec.grid.obstacles) + sum(o.count for o in spec.objects) + len(spec.inventory) + int(product)
+
+
 class Population:
     """K members' learner, replay and exploration over one vector env of K x ``n_envs``.
 
     ``seeds`` are the members' run seeds: member k's envs reset from seed_k + j (as SB3's
-    ``make_vec_env`` seeds them), its noise from seed_k (as ``make_agent``)."""
+    ``make_vec_env`` seeds them), its noise from seed_k (as ``make_agent``). ``sparse_width``:
+    a DQN replay's observations stored as their nonzero entries (``sparse_width``)."""
 
     def __init__(self, method: str, settings: dict, seeds: list[int], n_envs: int, obs_dim: int,
                  action_space, automaton, completion_reward: float, total_steps: int,
-                 table: AutomatonQTable | None = None, device: str = "cpu"):
+                 table: AutomatonQTable | None = None, device: str = "cpu", sparse_width: int | None = None):
         check_supported(method, settings)
         row = METHODS[method]
         self.method, self.row, self.settings = method, row, settings
@@ -122,10 +133,11 @@ class Population:
             spec = settings.get("action_noise")
             self.noises = [make_action_noise(spec, self.act_dim, seed, n_envs) if spec else None for seed in seeds]
         buffer = settings.get("replay_buffer_kwargs") or {}
-        crm = CounterfactualView(automaton, completion_reward) if row.crm else None
+        crm = CounterfactualView(automaton, completion_reward, obs_dim) if row.crm else None
         self.replay = PopulationReplay(self.K, int(settings["buffer_size"]), n_envs, obs_dim, action_shape,
                                        action_dtype, prioritized=bool(settings.get("prioritized", True)),
-                                       crm=crm, seed=seeds[0] + 1, **buffer)
+                                       crm=crm, seed=seeds[0] + 1, sparse_width=sparse_width if self.discrete else None,
+                                       **buffer)
         self.batch_size = int(settings["batch_size"])
         self.learning_starts = int(settings["learning_starts"])
         self.gradient_steps = int(settings.get("gradient_steps", 1))

@@ -41,13 +41,27 @@ class StackedMLP(nn.Module):
             self.weights.append(nn.Parameter(w))
             self.biases.append(nn.Parameter(b))
 
-    def forward(self, x: th.Tensor) -> th.Tensor:
+    def forward(self, x) -> th.Tensor:
+        """``x``: a ``(K, B, in)`` tensor, or ``(index, value)`` tensors ``(K, B, width)``
+        of its nonzero entries (``replay.SparseRows``), whose first layer is then a sum of
+        ``width`` weight rows per sample (``embedding_bag``) instead of a dense product."""
         last = len(self.weights) - 1
         for i, (w, b) in enumerate(zip(self.weights, self.biases)):
-            x = th.baddbmm(b, x, w)
+            if i == 0 and isinstance(x, tuple):
+                x = self._sparse_first_layer(*x)
+            else:
+                x = th.baddbmm(b, x, w)
             if i < last:
                 x = self.activation(x)
         return x if self.output is None else self.output(x)
+
+    def _sparse_first_layer(self, index: th.Tensor, value: th.Tensor) -> th.Tensor:
+        w, b = self.weights[0], self.biases[0]
+        K, B, width = index.shape
+        rows = index + (th.arange(K, device=index.device) * w.shape[1]).reshape(K, 1, 1)  # member k's rows
+        out = nn.functional.embedding_bag(rows.reshape(K * B, width), w.reshape(-1, w.shape[2]),
+                                          per_sample_weights=value.reshape(K * B, width), mode="sum")
+        return out.reshape(K, B, -1) + b
 
     # -- members as SB3 modules --------------------------------------------------------------
     def load_member(self, k: int, sequential: nn.Sequential) -> None:

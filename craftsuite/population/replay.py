@@ -27,15 +27,55 @@ from ..automata import Automaton
 class Batch(NamedTuple):
     """One minibatch per member, each array ``(K, B, ...)``."""
 
-    observations: np.ndarray
+    observations: np.ndarray  # or SparseRows
     actions: np.ndarray
-    next_observations: np.ndarray
+    next_observations: np.ndarray  # or SparseRows
     rewards: np.ndarray  # (K, B) float32
     terminals: np.ndarray  # (K, B) float32: 1 where the step ended the episode (not a time limit)
     weights: np.ndarray  # (K, B) float32: importance weights (ones when uniform)
     leaves: np.ndarray  # (K, B) int64: what update_priorities takes back
     w: np.ndarray  # (K, B) automaton state the target reads (u for a counterfactual)
     sigma: np.ndarray  # (K, B) label of the step
+
+
+class SparseRows(NamedTuple):
+    """Observations as their nonzero entries: ``index`` and ``value`` ``(..., width)``,
+    ascending, padded with index 0 and value 0. A grid's observation (one-hot planes, a
+    few inventory counts, the automaton one-hot) has a few dozen nonzeros in hundreds of
+    entries: stored so, it takes a tenth of the memory, and a network's first layer reads
+    it as a sum of a few weight rows (``nets.StackedMLP``) instead of a dense product."""
+
+    index: np.ndarray  # int64
+    value: np.ndarray  # float32
+
+    @property
+    def shape(self) -> tuple:
+        return self.index.shape
+
+
+def sparse_rows(dense: np.ndarray, width: int) -> SparseRows:
+    """The nonzero entries of each row of ``dense`` ``(..., d)``, padded to ``width``.
+
+    Raises:
+        ValueError: a row with more than ``width`` nonzeros.
+    """
+    nonzero = dense != 0
+    most = int(nonzero.sum(axis=-1).max(initial=0))
+    if most > width:
+        raise ValueError(f"an observation has {most} nonzero entries, more than the {width} the replay stores")
+    order = np.argsort(~nonzero, axis=-1, kind="stable")[..., :width]  # nonzero columns first, ascending
+    value = np.take_along_axis(dense, order, axis=-1).astype(np.float32)
+    index = np.where(value != 0, order, 0)
+    return SparseRows(index.astype(np.int64), value)
+
+
+def one_hot_at(rows: SparseRows, column: np.ndarray) -> SparseRows:
+    """``rows`` whose last nonzero entry (the automaton state's one-hot, the observation's
+    last columns) moves to ``column``."""
+    last = (rows.value != 0).sum(axis=-1) - 1
+    index = rows.index.copy()
+    np.put_along_axis(index, last[..., None], np.asarray(column)[..., None], axis=-1)
+    return SparseRows(index, rows.value)
 
 
 class SumTrees:
@@ -92,7 +132,8 @@ class CounterfactualView:
     """CRM's reading of one real step from every live automaton state (see the module
     docstring). ``n_states`` one-hot entries end each observation."""
 
-    def __init__(self, automaton: Automaton, completion_reward: float):
+    def __init__(self, automaton: Automaton, completion_reward: float, obs_dim: int):
+        self.obs_dim = obs_dim
         self.delta = automaton.delta.astype(np.int64)
         self.accepting = automaton.accepting.astype(np.float32)
         self.ends = (automaton.accepting | automaton.rejecting).astype(np.float32)
@@ -114,24 +155,39 @@ class CounterfactualView:
         ``live[j]``: (obs, next_obs, rewards, terminals, u)."""
         u = self.live[j]
         u_next = self.delta[u, sigma]
-        obs[..., -self.n_states:] = self._eye[u]
-        next_obs[..., -self.n_states:] = self._eye[u_next]
+        if isinstance(obs, SparseRows):
+            first = self.obs_dim - self.n_states
+            obs, next_obs = one_hot_at(obs, first + u), one_hot_at(next_obs, first + u_next)
+        else:
+            obs[..., -self.n_states:] = self._eye[u]
+            next_obs[..., -self.n_states:] = self._eye[u_next]
         rewards = world_rewards.astype(np.float64) + self.completion * self.accepting[u_next]
         return obs, next_obs, rewards.astype(np.float32), self.ends[u_next], u
 
 
 class PopulationReplay:
     """Every member's replay, ``capacity`` transitions each (SB3's rounding: whole steps of
-    ``n_envs``). ``actions`` are ``action_shape`` of ``action_dtype`` per transition."""
+    ``n_envs``). ``actions`` are ``action_shape`` of ``action_dtype`` per transition. With
+    ``sparse_width``, observations are stored and sampled as ``SparseRows`` of that width
+    (at least the most nonzero entries an observation of the world can have)."""
 
     def __init__(self, members: int, capacity: int, n_envs: int, obs_dim: int, action_shape: tuple,
                  action_dtype=np.float32, *, prioritized: bool = True, alpha: float = 0.7, beta: float = 0.4,
-                 epsilon: float = 0.1, crm: CounterfactualView | None = None, seed: int = 0):
+                 epsilon: float = 0.1, crm: CounterfactualView | None = None, seed: int = 0,
+                 sparse_width: int | None = None):
         self.members, self.n_envs = members, n_envs
         self.capacity = max(capacity // n_envs, 1) * n_envs
         K, C = members, self.capacity
-        self.observations = np.zeros((K, C, obs_dim), dtype=np.float32)
-        self.next_observations = np.zeros((K, C, obs_dim), dtype=np.float32)
+        self.sparse_width = sparse_width
+        if sparse_width is None:
+            self._observation_arrays = ("observations", "next_observations")
+            self.observations = np.zeros((K, C, obs_dim), dtype=np.float32)
+            self.next_observations = np.zeros((K, C, obs_dim), dtype=np.float32)
+        else:
+            self._observation_arrays = ("obs_index", "obs_value", "next_index", "next_value")
+            for name in ("obs", "next"):
+                setattr(self, f"{name}_index", np.zeros((K, C, sparse_width), dtype=np.int64))
+                setattr(self, f"{name}_value", np.zeros((K, C, sparse_width), dtype=np.float32))
         self.actions = np.zeros((K, C, *action_shape), dtype=action_dtype)
         self.rewards = np.zeros((K, C), dtype=np.float32)
         self.terminals = np.zeros((K, C), dtype=np.float32)
@@ -154,8 +210,12 @@ class PopulationReplay:
     def add(self, obs, next_obs, actions, rewards, terminals, w, sigma) -> None:
         """One step of every member's ``n_envs`` envs: arrays ``(K, n_envs, ...)``."""
         at = slice(self.pos, self.pos + self.n_envs)
-        self.observations[:, at] = obs
-        self.next_observations[:, at] = next_obs
+        if self.sparse_width is None:
+            self.observations[:, at] = obs
+            self.next_observations[:, at] = next_obs
+        else:
+            self.obs_index[:, at], self.obs_value[:, at] = sparse_rows(np.asarray(obs), self.sparse_width)
+            self.next_index[:, at], self.next_value[:, at] = sparse_rows(np.asarray(next_obs), self.sparse_width)
         self.actions[:, at] = np.asarray(actions).reshape(self.members, self.n_envs, *self.actions.shape[2:])
         self.rewards[:, at] = rewards if self.crm is None else self.crm.world_reward(
             np.asarray(rewards, dtype=np.float64), np.asarray(w), np.asarray(sigma))
@@ -193,7 +253,11 @@ class PopulationReplay:
             return array.reshape(K * self.capacity, *array.shape[2:]).take(flat, axis=0).reshape(
                 K, batch_size, *array.shape[2:])
 
-        obs, next_obs = take(self.observations), take(self.next_observations)
+        if self.sparse_width is None:
+            obs, next_obs = take(self.observations), take(self.next_observations)
+        else:
+            obs = SparseRows(take(self.obs_index), take(self.obs_value))
+            next_obs = SparseRows(take(self.next_index), take(self.next_value))
         rewards, terminals, w, sigma = take(self.rewards), take(self.terminals), take(self.w), take(self.sigma)
         if self.crm is not None:
             obs, next_obs, rewards, terminals, w = self.crm.relabel(obs, next_obs, rewards, sigma, j)
@@ -208,12 +272,16 @@ class PopulationReplay:
         self.trees.update(leaves, priorities ** self.alpha)
 
     # -- checkpoints: one member's slice ----------------------------------------------------------
-    _ARRAYS = ("observations", "next_observations", "actions", "rewards", "terminals", "w", "sigma")
+    _ARRAYS = ("actions", "rewards", "terminals", "w", "sigma")
+
+    @property
+    def _arrays(self) -> tuple[str, ...]:
+        return self._observation_arrays + self._ARRAYS
 
     def member_state(self, k: int) -> dict:
         """Member ``k``'s filled rows, priorities and sampling position (for its checkpoint)."""
         n = self.size
-        state = {name: getattr(self, name)[k, :n].copy() for name in self._ARRAYS}
+        state = {name: getattr(self, name)[k, :n].copy() for name in self._arrays}
         state.update(pos=self.pos, full=self.full, max_priority=float(self.max_priority[k]))
         if self.trees is not None:
             state["priorities"] = self.trees.tree[k, self.trees.leaves:self.trees.leaves + n * self.per_step].copy()
@@ -221,7 +289,7 @@ class PopulationReplay:
 
     def load_member(self, k: int, state: dict) -> None:
         n = len(state["rewards"])
-        for name in self._ARRAYS:
+        for name in self._arrays:
             getattr(self, name)[k, :n] = state[name]
         self.pos, self.full = int(state["pos"]), bool(state["full"])
         self.max_priority[k] = state["max_priority"]

@@ -27,7 +27,7 @@ from ..configs import StudentConfig
 from ..files import atomic_path
 from ..methods import METHODS
 from ..runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir
-from .engine import EngineError, Population, check_supported
+from .engine import EngineError, Population, check_supported, sparse_width
 from .envs import make_envs, step_records
 
 CHECKPOINT = "population.pt"
@@ -103,8 +103,11 @@ def _train(todo, settings, table, spec, device, progress, desc) -> None:
         th.set_num_threads(1)  # small nets: one thread is fastest and leaves the other cores to other cells
     try:
         obs_dim = envs.single_observation_space.shape[0]
+        from ..ids import world_kind
+
         pop = Population(config.method, settings, [c.seed for c in configs], n, obs_dim, envs.single_action_space,
-                         spec.automaton, spec.completion_reward, config.steps, table, str(device))
+                         spec.automaton, spec.completion_reward, config.steps, table, str(device),
+                         sparse_width(spec, world_kind(config.world), config.product))
         _resume(pop, runs)
         total = config.steps
         with tqdm(total=K * total, initial=K * pop.num_timesteps, desc=desc, unit="step", disable=not progress,

@@ -8,7 +8,7 @@ import torch as th
 import craftsuite  # noqa: F401
 from craftsuite.agents.methods import make_agent
 from craftsuite.population.dqn import PopulationDQN
-from craftsuite.population.replay import Batch
+from craftsuite.population.replay import Batch, sparse_rows
 from craftsuite.population.targets import MemberTargets
 from craftsuite.population.td3 import PopulationTD3
 
@@ -62,8 +62,11 @@ def test_td3_update_matches_automaton_td3(prioritized):
     np.testing.assert_array_equal(pop.targets.counts[0], agent.distill.student_counts.reshape(-1))
 
 
-@pytest.mark.parametrize("loss,prioritized", [("huber", True), ("mse", False)])
-def test_dqn_update_matches_automaton_dqn(loss, prioritized):
+@pytest.mark.parametrize("loss,prioritized,sparse", [("huber", True, False), ("mse", False, False),
+                                                     ("huber", True, True)])
+def test_dqn_update_matches_automaton_dqn(loss, prioritized, sparse):
+    """``sparse``: the minibatch's observations as their nonzero entries, as the grid
+    students' replay stores them (the first layer a sum of weight rows)."""
     agent = _filled("static", "CraftSuite/FirstTool-Grid7-v0", batch_size=32, loss=loss, prioritized=prioritized,
                     target_update_interval=2, target_update_unit="gradient_steps", max_grad_norm=0.05)
     settings = agent_settings(agent, "dqn", loss=loss, prioritized=prioritized, target_update_interval=2,
@@ -75,7 +78,12 @@ def test_dqn_update_matches_automaton_dqn(loss, prioritized):
         samples = agent.replay_buffer.sample(32)
         _same_sample(agent, samples)
         agent.train(gradient_steps=1, batch_size=32)
-        pop.update(_batch(samples))
+        batch = _batch(samples)
+        if sparse:
+            width = int((batch.observations != 0).sum(axis=-1).max())
+            batch = batch._replace(observations=sparse_rows(batch.observations, width),
+                                   next_observations=sparse_rows(batch.next_observations, width))
+        pop.update(batch)
     mine = make_agent("static", "CraftSuite/FirstTool-Grid7-v0", seed=9, buffer_size=16)
     pop.store_member(0, mine)
     for name in ("q_net", "q_net_target"):

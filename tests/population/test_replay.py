@@ -7,7 +7,7 @@ import pytest
 import craftsuite  # noqa: F401
 from craftsuite.agents.crm import counterfactuals
 from craftsuite.agents.replay import SumTree
-from craftsuite.population.replay import CounterfactualView, PopulationReplay, SumTrees
+from craftsuite.population.replay import CounterfactualView, PopulationReplay, SumTrees, sparse_rows
 from craftsuite.task_registry import resolve_task
 
 
@@ -43,13 +43,14 @@ def test_prioritized_sampling_follows_the_priorities():
     assert batch.weights[0].min() < 0.1  # the over-sampled transition is weighted down
 
 
-@pytest.mark.parametrize("task", ["DungeonQuest", "DiamondMine"])
-def test_counterfactuals_at_sampling_equal_the_stored_ones(task):
+@pytest.mark.parametrize("task,sparse", [("DungeonQuest", False), ("DiamondMine", False), ("DiamondMine", True)])
+def test_counterfactuals_at_sampling_equal_the_stored_ones(task, sparse):
     spec = resolve_task(task)
     automaton, S = spec.automaton, spec.automaton.n_states
-    view = CounterfactualView(automaton, spec.completion_reward)
+    view = CounterfactualView(automaton, spec.completion_reward, 6 + S)
     rng = np.random.default_rng(1)
-    replay = PopulationReplay(1, 40, 1, 6 + S, (2,), crm=view, prioritized=False, seed=2)
+    replay = PopulationReplay(1, 40, 1, 6 + S, (2,), crm=view, prioritized=False, seed=2,
+                              sparse_width=7 if sparse else None)
     stored = []
     for i in range(40):
         w = int(rng.choice(view.live))
@@ -64,6 +65,9 @@ def test_counterfactuals_at_sampling_equal_the_stored_ones(task):
         stored.append(counterfactuals(automaton, spec.completion_reward, obs, next_obs, action, reward, False,
                                       w, sigma))
     batch = replay.sample(300)
+    if sparse:  # back to dense rows, to compare
+        batch = batch._replace(observations=dense(batch.observations, 6 + S),
+                               next_observations=dense(batch.next_observations, 6 + S))
     index, j = np.divmod(batch.leaves[0], view.n_live)
     assert len(np.unique(j)) == view.n_live  # every live state is read
     for b in range(300):
@@ -75,9 +79,26 @@ def test_counterfactuals_at_sampling_equal_the_stored_ones(task):
         assert batch.w[0, b] == live[j[b]]
 
 
+def dense(rows, width):
+    index, value = rows.index.reshape(-1, rows.index.shape[-1]), rows.value.reshape(-1, rows.index.shape[-1])
+    out = np.zeros((len(index), width), dtype=np.float32)
+    np.add.at(out, (np.arange(len(index))[:, None], index), value)  # padding adds 0 to column 0
+    return out.reshape(*rows.index.shape[:-1], width)
+
+
+def test_sparse_rows_round_trip_and_refuse_overflow():
+    rng = np.random.default_rng(3)
+    x = (rng.random((4, 5, 30)) < 0.15) * rng.random((4, 5, 30)).astype(np.float32)
+    x[0, 0, 0] = 0.5  # a nonzero in column 0, where padding points
+    rows = sparse_rows(x, 30)
+    np.testing.assert_array_equal(dense(rows, 30), x)
+    with pytest.raises(ValueError, match="more than the 2 the replay stores"):
+        sparse_rows(x, 2)
+
+
 def test_crm_memory_holds_each_step_once():
     spec = resolve_task("DiamondMine")
-    view = CounterfactualView(spec.automaton, spec.completion_reward)
+    view = CounterfactualView(spec.automaton, spec.completion_reward, 10)
     replay = PopulationReplay(1, 1000, 1, 10, (2,), crm=view)
     assert replay.observations.shape == (1, 1000, 10)  # not 1000 x the live states
     assert replay.trees.leaves >= 1000 * view.n_live

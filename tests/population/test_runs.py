@@ -57,7 +57,7 @@ def test_a_members_model_acts_as_the_member(tmp_path, monkeypatch):
     paths = train_population(_cell("product-dqn", "Grid7", "FirstTool", seeds=(4, 5), layout_seed=0),
                              tmp_path, progress=False)
     pop = seen["pop"]
-    obs = np.random.default_rng(0).random((2, 7, pop.replay.observations.shape[-1])).astype(np.float32)
+    obs = np.random.default_rng(0).random((2, 7, pop.learner.q_net.sizes[0])).astype(np.float32)
     greedy = pop.greedy(obs)
     for k, path in enumerate(paths):
         agent = load_agent(path / "model.zip")

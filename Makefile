@@ -33,6 +33,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/training_steps.py --repeats 2
 	$(PY) benchmarks/student_throughput.py
 	$(PY) benchmarks/crm_memory.py
+	$(PY) benchmarks/engine_equivalence.py
 	$(PY) benchmarks/teachers.py --quick
 	$(PY) benchmarks/interval_coverage.py
 

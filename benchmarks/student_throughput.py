@@ -1,14 +1,15 @@
 """Student throughput: transitions and gradient updates per second per core, SB3 agents
 beside the population engine, per collection regime.
 
-Usage: python benchmarks/student_throughput.py [--seconds 10] [--members 5] [--page PATH | --no-page]
+Usage: python benchmarks/student_throughput.py [--seconds 10] [--members 5 10] [--page PATH | --no-page]
 
 One process, one torch thread, Blind Craftsman: TD3 in the MuJoCo world and on the
 kinematic board, DQN on the 10x10 grid. SB3 rows: the package's defaults (one env, one
 update per transition; TD3 [400, 300]) and the suites' regimes (``craftsuite.suites.TD3_REGIME``
 / ``DQN_REGIME``: several envs per update, small networks) with the fused Adam that
 ``make_agent`` uses, each after 2,000 warm-up transitions. Population rows: the suites'
-regimes for ``--members`` seeds in one process (``craftsuite.population``), collecting from
+regimes for populations of ``--members`` seeds in one process (5: a suite's cell; 10: the
+seeds the engines were compared with) (``craftsuite.population``), collecting from
 one vector env (native on the grid and the board), counted over all members, after the
 warm-up of random actions (``learning_starts``). Each row trains for about ``--seconds``.
 The reference column is the target of each population row, or what was measured before.
@@ -108,7 +109,8 @@ def measure_population(method, env_id, n_envs, settings, env_kwargs, members: in
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0)
-    parser.add_argument("--members", type=int, default=5, help="population size (default: 5, the suites' seeds)")
+    parser.add_argument("--members", type=int, nargs="+", default=[5, 10],
+                        help="population sizes (default: 5, a suite cell's seeds, and 10)")
     parser.add_argument("--device", default="cpu", help="the population's torch device (default: cpu)")
     add_page_argument(parser)
     args = parser.parse_args()
@@ -122,9 +124,10 @@ def main():
         tps, ups = measure_sb3(method, env_id, n_envs, settings, args.seconds)
         report(f"| {label} | SB3 | {tps:,.0f} | {ups:,.0f} | {reference} |")
     for label, method, env_id, n_envs, settings, env_kwargs, target in POPULATION_ROWS:
-        tps, ups = measure_population(method, env_id, n_envs, settings, env_kwargs, args.members, args.seconds,
-                                      args.device)
-        report(f"| {label} | population of {args.members} ({args.device}) | {tps:,.0f} | {ups:,.0f} | {target} |")
+        for members in args.members:
+            tps, ups = measure_population(method, env_id, n_envs, settings, env_kwargs, members, args.seconds,
+                                          args.device)
+            report(f"| {label} | population of {members} ({args.device}) | {tps:,.0f} | {ups:,.0f} | {target} |")
     report.save(__file__, __doc__, args)
 
 

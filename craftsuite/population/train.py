@@ -97,7 +97,9 @@ def _train(todo, settings, table, spec, device, progress, desc) -> None:
     config = configs[0]
     K, n = len(configs), config.n_envs
     start = time.perf_counter()
+    stack = contextlib.ExitStack()
     envs = make_envs(config.env_id, K * n, config.env_kwargs, config.product)
+    stack.callback(envs.close)
     threads = th.get_num_threads()
     if device.type == "cpu":
         th.set_num_threads(1)  # small nets: one thread is fastest and leaves the other cores to other cells
@@ -110,17 +112,19 @@ def _train(todo, settings, table, spec, device, progress, desc) -> None:
                          sparse_width(spec, world_kind(config.world), config.product))
         _resume(pop, runs)
         total = config.steps
+        eval_envs = make_envs(config.env_id, K * config.eval_episodes, config.env_kwargs, config.product)
+        stack.callback(eval_envs.close)
         with tqdm(total=K * total, initial=K * pop.num_timesteps, desc=desc, unit="step", disable=not progress,
                   dynamic_ncols=True, mininterval=1.0) as bar:
-            _loop(pop, envs, configs, runs, bar)
+            _loop(pop, envs, eval_envs, configs, runs, bar)
         for k, (c, run) in enumerate(todo):
             _finish(pop, k, c, run, table, time.perf_counter() - start, str(device))
     finally:
-        envs.close()
+        stack.close()
         th.set_num_threads(threads)
 
 
-def _loop(pop: Population, envs, configs, runs, bar) -> None:
+def _loop(pop: Population, envs, eval_envs, configs, runs, bar) -> None:
     config = configs[0]
     K, n, total, every = pop.K, pop.n_envs, config.steps, config.eval_every
     seeds = [c.seed + j for c in configs for j in range(n)]  # as SB3's make_vec_env seeds each run's envs
@@ -155,7 +159,7 @@ def _loop(pop: Population, envs, configs, runs, bar) -> None:
         if t >= next_eval or t >= total:
             next_eval += every
             _flush(runs, pending, t, total)
-            _evaluate(pop, configs, runs, t, bar)
+            _evaluate(pop, configs, runs, t, bar, eval_envs)
             _checkpoint(pop, runs)
         pop.train()
 
@@ -168,12 +172,15 @@ def _flush(runs, pending, step: int, total: int) -> None:
         run.write_progress(step, total)
 
 
-def evaluate_members(pop: Population, config: StudentConfig, seed: int) -> list[tuple[float, float, float]]:
+def evaluate_members(pop: Population, config: StudentConfig, seed: int, envs=None) -> list[tuple[float, float, float]]:
     """Each member's greedy (success, mean return, mean length) over ``config.eval_episodes``
     fresh-seed episodes (seed + i, as ``training.evaluate``), all members' episodes stepped
-    as one vector env."""
+    as one vector env: ``envs`` (K x episodes of the run's world, kept between evaluations
+    by the caller, which closes it), else one made and closed here."""
     K, E = pop.K, config.eval_episodes
-    envs = make_envs(config.env_id, K * E, config.env_kwargs, config.product)
+    own = envs is None
+    if own:
+        envs = make_envs(config.env_id, K * E, config.env_kwargs, config.product)
     try:
         obs, _ = envs.reset(seed=[seed + i for _ in range(K) for i in range(E)])
         active = np.ones(K * E, dtype=bool)
@@ -189,15 +196,16 @@ def evaluate_members(pop: Population, config: StudentConfig, seed: int) -> list[
             wins[finishing] = success[finishing]
             active &= ~ended
     finally:
-        envs.close()
+        if own:
+            envs.close()
     shape = (K, E)
     return [(float(w.mean()), float(r.mean()), float(l.mean()))
             for w, r, l in zip(wins.reshape(shape), returns.reshape(shape), lengths.reshape(shape))]
 
 
-def _evaluate(pop, configs, runs, step, bar) -> None:
+def _evaluate(pop, configs, runs, step, bar, envs=None) -> None:
     config = configs[0]
-    results = evaluate_members(pop, config, seed=10**7 + step)  # train_student's evaluation seeds
+    results = evaluate_members(pop, config, seed=10**7 + step, envs=envs)  # train_student's evaluation seeds
     for run, (success, ret, length) in zip(runs, results):
         run.append("evals.csv", EVAL_FIELDS, [{"step": step, "success": success, "return": round(ret, 4),
                                                 "episodes": config.eval_episodes, "length": round(length, 2)}])

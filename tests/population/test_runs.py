@@ -69,11 +69,11 @@ def test_a_killed_population_resumes_from_its_checkpoint(tmp_path, monkeypatch):
     evaluate = population_train._evaluate
     calls = {"n": 0}
 
-    def dies_at_the_second(pop, configs, runs, step, bar):
+    def dies_at_the_second(*args):
         calls["n"] += 1
         if calls["n"] == 2:
             raise KeyboardInterrupt
-        evaluate(pop, configs, runs, step, bar)
+        evaluate(*args)
 
     monkeypatch.setattr(population_train, "_evaluate", dies_at_the_second)
     with pytest.raises(KeyboardInterrupt):

@@ -281,10 +281,10 @@ class PopulationReplay:
     def member_state(self, k: int) -> dict:
         """Member ``k``'s filled rows, priorities and sampling position (for its checkpoint)."""
         n = self.size
-        state = {name: getattr(self, name)[k, :n].copy() for name in self._arrays}
+        state = {name: getattr(self, name)[k, :n] for name in self._arrays}  # views: saving copies them once
         state.update(pos=self.pos, full=self.full, max_priority=float(self.max_priority[k]))
         if self.trees is not None:
-            state["priorities"] = self.trees.tree[k, self.trees.leaves:self.trees.leaves + n * self.per_step].copy()
+            state["priorities"] = self.trees.tree[k, self.trees.leaves:self.trees.leaves + n * self.per_step]
         return state
 
     def load_member(self, k: int, state: dict) -> None:

@@ -124,3 +124,31 @@ def test_a_population_trains_on_the_gpu(tmp_path):
     paths = train_population(_cell(), tmp_path, progress=False, device="cuda")
     assert json.loads((paths[0] / "result.json").read_text())["device"] == "cuda"
     load_agent(paths[0] / "model.zip")
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["transfer", "--suite", "quick", "--device", "gpu0"], "--device 'gpu0' is not a torch device"),
+    (["transfer", "--suite", "quick", "--td3-hyper", '{"n_steps": 3}'],
+     "method 'td3': the population engine does not support n-step returns (n_steps=3); run it with --engine sb3"),
+    (["student", "Reach", "--world", "Grid10", "--method", "dqn", "--engine", "population", "--hyper",
+      '{"features_extractor": "residual-cnn"}'], "does not support features_extractor 'residual-cnn'"),
+])
+def test_the_command_line_refuses_what_the_engine_cannot_run(argv, message, tmp_path, capsys):
+    from craftsuite.cli import main
+
+    assert main([*argv, "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0]
+    assert not (tmp_path / "out").exists()
+
+
+def test_suites_train_each_cell_as_one_population():
+    from craftsuite.suites import SUITES, cells
+
+    configs = SUITES["standard"].student_configs("teachers")
+    jobs = cells(configs)
+    assert all(len(job) == SUITES["standard"].seeds for job in jobs)
+    assert sorted(c.seed for c in jobs[0]) == list(range(SUITES["standard"].seeds))
+    assert {c.engine for c in configs} == {"population"}
+    sb3 = SUITES["paper"].student_configs("teachers")
+    assert {c.engine for c in sb3} == {"sb3"} and len(cells(sb3)) == len(sb3)  # one job per SB3 run

@@ -106,6 +106,40 @@ def measure_population(method, env_id, n_envs, settings, env_kwargs, members: in
     return members * (pop.num_timesteps - transitions) / total, members * (pop.learner.n_updates - updates) / total
 
 
+def _kind(method: str, env_id: str) -> tuple[str, bool]:
+    """What sets a student's speed here: its world (MuJoCo, kinematic, grid) and whether it replays
+    counterfactuals."""
+    from craftsuite.ids import parse_id
+    from craftsuite.methods import METHODS
+
+    return parse_id(env_id)[1].rstrip("0123456789"), METHODS[method].crm
+
+
+def suite_projection(name: str, rates: dict, sb3_rates: dict, cores: int = 2) -> str:
+    """The suite's student transitions over the rates just measured, on ``cores`` cores: a
+    projection (teachers, evaluations and the tail of the last runs left out)."""
+    from craftsuite.ids import parse_id
+    from craftsuite.methods import METHODS
+    from craftsuite.suites import SUITES
+
+    configs = SUITES[name].student_configs("teachers")
+    seconds = {"population": 0.0, "sb3": 0.0}
+    for c in configs:
+        kind = (parse_id(c.env_id)[1].rstrip("0123456789"), METHODS[c.method].crm)
+        seconds["population"] += c.steps / rates.get(kind, rates.get((kind[0], False), float("nan")))
+        seconds["sb3"] += c.steps / sb3_rates.get((kind[0], False), float("nan"))
+    total = sum(c.steps for c in configs)
+
+    def hours(s):
+        return f"{s / cores / 3600:.1f} h"
+
+    return (f"The `{name}` suite's students ({len(configs)} runs, {total:,} transitions) at these rates on "
+            f"{cores} cores: {hours(seconds['population'])} with the population engine (5 seeds a population), "
+            f"{hours(seconds['sb3'])} with one SB3 agent per run, its CRM counted at its DQN rate (a projection: "
+            f"teachers and evaluations not counted; the whole suite with SB3 students took 2 h 50 min when last "
+            f"run).")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0)
@@ -120,14 +154,21 @@ def main():
     report = Report()
     report("| student | engine | transitions/s | updates/s (all members) | reference transitions/s |")
     report("|---|---|---|---|---|")
+    rates, sb3_rates = {}, {}  # transitions/s per (world kind, algorithm, crm), for the projection
     for label, method, env_id, n_envs, settings, reference in SB3_ROWS:
         tps, ups = measure_sb3(method, env_id, n_envs, settings, args.seconds)
+        if n_envs > 1:
+            sb3_rates.setdefault(_kind(method, env_id), tps)
         report(f"| {label} | SB3 | {tps:,.0f} | {ups:,.0f} | {reference} |")
     for label, method, env_id, n_envs, settings, env_kwargs, target in POPULATION_ROWS:
         for members in args.members:
             tps, ups = measure_population(method, env_id, n_envs, settings, env_kwargs, members, args.seconds,
                                           args.device)
             report(f"| {label} | population of {members} ({args.device}) | {tps:,.0f} | {ups:,.0f} | {target} |")
+            if members == 5:
+                rates[_kind(method, env_id)] = tps
+    report("")
+    report(suite_projection("standard", rates, sb3_rates))
     report.save(__file__, __doc__, args)
 
 

@@ -222,7 +222,7 @@ def cells(configs: list[StudentConfig]) -> list[list[StudentConfig]]:
     """The population engine's jobs: configs equal but for the seed, together, in order;
     each SB3 config alone."""
     groups: dict[str, list[StudentConfig]] = {}
-    for c in configs:
+    for c in {c.run_name(): c for c in configs}.values():  # a run asked for twice is one run
         key = json.dumps({k: v for k, v in dataclasses.asdict(c).items() if k != "seed"}, sort_keys=True) \
             if c.engine == "population" else c.run_name()
         groups.setdefault(key, []).append(c)

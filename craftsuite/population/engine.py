@@ -53,6 +53,8 @@ def check_supported(method: str, settings: dict) -> None:
     unknown = sorted(set(settings) - _READ[algorithm])
     if unknown:
         why = f"the settings {unknown}"
+    elif settings.get("optimize_memory_usage"):
+        why = "optimize_memory_usage (its replay keeps next observations; a grid's as their nonzero entries)"
     elif settings.get("n_steps", 1) != 1:
         why = f"n-step returns (n_steps={settings['n_steps']})"
     elif settings.get("features_extractor", "flatten") != "flatten":
@@ -115,6 +117,7 @@ class Population:
         self.total_steps = total_steps
         self.rng = np.random.default_rng(seeds[0])
         th.manual_seed(seeds[0])
+        np.random.seed(seeds[0])  # SB3's normal and OU noises draw from numpy's global stream (as set_random_seed)
         targets = None
         if row.distill is not None:
             rule = DistilledTarget(member_table(method, automaton, completion_reward, table), automaton,
@@ -169,6 +172,12 @@ class Population:
             if noise is not None:
                 actions[k] = np.clip(actions[k] + np.asarray(noise()).reshape(n, self.act_dim), -1, 1)
         return actions
+
+    def restart_noise(self) -> None:
+        """Every env's exploration noise anew, as SB3 does at the start of each ``learn``."""
+        for noise in getattr(self, "noises", []):
+            if noise is not None:
+                noise.reset()
 
     def episodes_ended(self, ended: np.ndarray) -> None:
         """Restart the exploration noise of the envs whose episode ended (``(K, n)`` mask)."""

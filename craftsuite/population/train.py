@@ -7,7 +7,8 @@ does: ``config.json`` (its settings, ``engine`` among them, and provenance), ``e
 ``evals.csv``, ``progress.json``, and at the end ``model.zip`` (an SB3 agent that
 ``load_agent`` loads) and ``result.json``. At each evaluation every member checkpoints its
 own state (``checkpoint/population.pt``: networks, optimizer moments, replay, counts,
-noise); a killed population resumes from the newest step every member has a checkpoint of.
+noise), after the step's updates; a killed population resumes from the newest step every
+member has a checkpoint of.
 A population writes no TensorBoard logs.
 """
 
@@ -15,22 +16,22 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import json
 import shutil
 import time
-import warnings
 from pathlib import Path
 
 import numpy as np
 import torch as th
 
 from ..configs import StudentConfig
-from ..files import atomic_path
+from ..files import atomic_path, atomic_write
 from ..methods import METHODS
 from ..runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir
 from .engine import EngineError, Population, check_supported, sparse_width
 from .envs import make_envs, step_records
 
-CHECKPOINT = "population.pt"
+CHECKPOINT, STEP = "population.pt", "step.json"  # a member's state, and the step it was saved at
 
 
 def check_cell(configs: list[StudentConfig]) -> None:
@@ -129,6 +130,7 @@ def _loop(pop: Population, envs, eval_envs, configs, runs, bar) -> None:
     K, n, total, every = pop.K, pop.n_envs, config.steps, config.eval_every
     seeds = [c.seed + j for c in configs for j in range(n)]  # as SB3's make_vec_env seeds each run's envs
     obs, _ = envs.reset(seed=seeds)
+    pop.restart_noise()
     returns, lengths = np.zeros(K * n), np.zeros(K * n, dtype=np.int64)
     pending: list[list[dict]] = [[] for _ in range(K)]
     next_eval = (pop.num_timesteps // every + 1) * every
@@ -156,12 +158,14 @@ def _loop(pop: Population, envs, eval_envs, configs, runs, bar) -> None:
         if t >= next_flush:
             _flush(runs, pending, t, total)
             next_flush = t + 1_000
-        if t >= next_eval or t >= total:
+        evaluate = t >= next_eval or t >= total
+        if evaluate:  # before this step's updates, as SB3's callback runs before its train()
             next_eval += every
             _flush(runs, pending, t, total)
             _evaluate(pop, configs, runs, t, bar, eval_envs)
-            _checkpoint(pop, runs)
         pop.train()
+        if evaluate:  # after them, so that a resumed population has taken every update of its steps
+            _checkpoint(pop, runs)
 
 
 def _flush(runs, pending, step: int, total: int) -> None:
@@ -213,8 +217,9 @@ def _evaluate(pop, configs, runs, step, bar, envs=None) -> None:
 
 
 def _checkpoint(pop: Population, runs) -> None:
-    """Every member's state into its ``checkpoint-new``, then each swapped in (``checkpoint``,
-    and the one before as ``checkpoint-old``)."""
+    """Every member's state into its ``checkpoint-new`` (``population.pt``, and ``step.json``
+    saying its step, read on resume without loading the state), then each swapped in
+    (``checkpoint``, and the one before as ``checkpoint-old``)."""
     from ..training import _swap_in
 
     for k, run in enumerate(runs):
@@ -223,32 +228,55 @@ def _checkpoint(pop: Population, runs) -> None:
         new.mkdir()
         with atomic_path(new / CHECKPOINT) as tmp:
             th.save(pop.member_state(k), tmp)
+        atomic_write(new / STEP, json.dumps({"num_timesteps": pop.num_timesteps}))
     for run in runs:
         _swap_in(run)
 
 
+def _saved_steps(run: RunDir) -> dict[int, Path]:
+    """A member's complete checkpoints by step, newest directory first for each step."""
+    found = {}
+    for name in ("checkpoint-new", "checkpoint", "checkpoint-old"):
+        folder = run.path / name
+        try:
+            step = json.loads((folder / STEP).read_text())["num_timesteps"]
+        except (OSError, ValueError, KeyError, TypeError):
+            continue  # none, or written only in part: not a checkpoint
+        if (folder / CHECKPOINT).exists():
+            found.setdefault(int(step), folder / CHECKPOINT)
+    return found
+
+
 def _resume(pop: Population, runs) -> None:
-    """Load the newest step every member has a readable checkpoint of; else start afresh.
-    Either way each member's logs are trimmed to where it starts."""
-    found = []
-    for run in runs:
-        states = {}
-        for name in ("checkpoint-new", "checkpoint", "checkpoint-old"):
-            path = run.path / name / CHECKPOINT
-            if not path.exists():
-                continue
-            try:
-                state = th.load(path, weights_only=False, map_location=pop.learner.device)
-            except Exception as err:  # a damaged file: an older checkpoint may do
-                warnings.warn(f"{path} cannot be loaded ({type(err).__name__}: {err}); trying an older one",
-                              RuntimeWarning, stacklevel=2)
-                continue
-            states.setdefault(state["num_timesteps"], state)
-        found.append(states)
-    common = set(found[0]).intersection(*found[1:]) if found else set()
-    step = max(common) if common else 0
-    if common:
-        pop.load_states([states[step] for states in found])
+    """Load the newest step every member has a checkpoint of (a kill between two members'
+    swaps leaves the one before), and trim each member's logs to it. With no checkpoint at
+    all, the population starts at step 0. A checkpoint that cannot be loaded is an error that
+    names it (nothing is deleted); so is a population whose members share no step."""
+    from ..training import _RESOURCES, CheckpointError
+
+    found = [_saved_steps(run) for run in runs]
+    if not any(found):
+        for run in runs:
+            run.trim_logs(0)
+        return
+    common = set(found[0]).intersection(*found[1:])
+    if not common:
+        raise CheckpointError(
+            f"the population of {', '.join(str(r.path) for r in runs)} cannot resume: its members' checkpoints "
+            f"are at different steps ({', '.join(str(sorted(f)) for f in found)}). Move their checkpoint "
+            "directories aside to train them again from step 0, or choose another output directory")
+    step = max(common)
+    states = []
+    for steps in found:
+        path = steps[step]
+        try:
+            states.append(th.load(path, weights_only=False, map_location=pop.learner.device))
+        except _RESOURCES:
+            raise  # the machine's limits, not the file's fault
+        except Exception as err:  # a damaged file
+            raise CheckpointError(f"{path} cannot be loaded ({type(err).__name__}: {err}): move it aside to "
+                                  "resume from the checkpoint before it, or train the population again") from None
+    pop.load_states(states)
     for run in runs:
         run.trim_logs(step)
 

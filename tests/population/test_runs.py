@@ -93,11 +93,48 @@ def test_a_killed_population_resumes_from_its_checkpoint(tmp_path, monkeypatch):
     paths = train_population(configs, tmp_path, progress=False)
     assert loaded == {"steps": [400, 400], "replay": 400}  # resumed with its replay, not from step 0
     for path, before in zip(paths, first):
+        assert json.loads((path / "result.json").read_text())["updates"] == 2 * (1_200 - 200) // 4  # none lost
         evals = read_csv(path / "evals.csv")
         assert evals[0] == before[0] and [int(r["step"]) for r in evals] == [400, 800, 1200]
         steps = [int(r["step"]) for r in read_csv(path / "episodes.csv")]
         assert steps == sorted(steps)
         assert len(json.loads((path / "config.json").read_text())["provenance"]) == 2
+
+
+def test_a_population_that_cannot_resume_says_so_and_deletes_nothing(tmp_path, monkeypatch):
+    from craftsuite.training import CheckpointError
+
+    configs = _cell(seeds=(0, 1))
+    evaluate, calls = population_train._evaluate, {"n": 0}
+
+    def dies_at_the_second(*args):
+        calls["n"] += 1
+        if calls["n"] == 2:
+            raise KeyboardInterrupt
+        evaluate(*args)
+
+    monkeypatch.setattr(population_train, "_evaluate", dies_at_the_second)
+    with pytest.raises(KeyboardInterrupt):
+        train_population(configs, tmp_path, progress=False)
+    monkeypatch.setattr(population_train, "_evaluate", evaluate)
+    damaged = tmp_path / configs[1].run_name() / "checkpoint" / "population.pt"
+    damaged.write_bytes(b"not a checkpoint")
+    with pytest.raises(CheckpointError, match=f"{damaged}.* cannot be loaded"):
+        train_population(configs, tmp_path, progress=False)
+    (tmp_path / configs[1].run_name() / "checkpoint" / "step.json").write_text('{"num_timesteps": 800}')
+    with pytest.raises(CheckpointError, match=r"different steps \(\[400\], \[800\]\)"):
+        train_population(configs, tmp_path, progress=False)
+    assert all(len(read_csv(tmp_path / c.run_name() / "evals.csv")) == 1 for c in configs)  # logs kept
+
+
+def test_a_population_is_reproducible(tmp_path):
+    configs = [c.__class__(**{**c.__dict__, "hyperparameters": {**TD3, "action_noise": {"type": "normal", "sigma": 0.3}}})
+               for c in _cell(seeds=(0, 1), steps=800)]
+    first = train_population(configs, tmp_path / "a", progress=False)
+    again = train_population(configs, tmp_path / "b", progress=False)
+    for a, b in zip(first, again):
+        assert (a / "episodes.csv").read_text() == (b / "episodes.csv").read_text()
+        assert (a / "evals.csv").read_text() == (b / "evals.csv").read_text()
 
 
 def test_bad_input_leaves_nothing_behind(tmp_path):

@@ -28,16 +28,17 @@ from gymnasium.vector import AutoresetMode
 
 from ..spec import TaskSpec
 from .continuous import _FAR, TOP_SPEED, ContinuousWorldEnv
-from .vector import CraftVectorEnv, _check_kwargs
+from .vector import PlanarVectorEnv, _check_kwargs
 
 
-class ContinuousVectorEnv(CraftVectorEnv):
+class ContinuousVectorEnv(PlanarVectorEnv):
     """``num_envs`` episodes of the MuJoCo world (see ``ContinuousWorldEnv``): one shared
     ``MjModel``, an ``MjData`` per env; agent positions and velocities as (N, 2) arrays,
     object slots as (N, n_objects) arrays."""
 
     # the single MuJoCo id's keywords; width/height/status_panel only shape frames, which
     # this does not draw (render_mode must stay None)
+    WHAT = "thrust"
     KEYWORDS = ("product", "render_mode", "width", "height", "frame_skip", "status_panel",
                 "max_episode_steps", "autoreset_mode")
 
@@ -82,19 +83,6 @@ class ContinuousVectorEnv(CraftVectorEnv):
         self._present[i] = True
         self._inside[i] = False
 
-    def _check_actions(self, actions) -> np.ndarray:
-        try:
-            a = np.asarray(actions, dtype=np.float64)
-        except (TypeError, ValueError):
-            a = None
-        if a is None or a.shape != (self.num_envs, 2):
-            raise ValueError(f"invalid actions {actions!r}: expected {self.num_envs} rows of 2 numbers "
-                             "(thrust along x and y) in [-1, 1]")
-        if not np.isfinite(a).all():
-            raise ValueError(f"invalid actions: NaN or infinite thrust in rows "
-                             f"{np.flatnonzero(~np.isfinite(a).all(axis=1)).tolist()}")
-        return np.clip(a, -1.0, 1.0)
-
     def _move(self, actions, active):
         """``ContinuousWorldEnv.step`` for the active envs, up to the automaton."""
         model, nstep = self.model, self.frame_skip
@@ -122,35 +110,10 @@ class ContinuousVectorEnv(CraftVectorEnv):
         self._write_observation(offsets)
         return rewards, masks
 
-    def _touch(self, i: int, inside: np.ndarray, rewards: np.ndarray, masks: np.ndarray) -> None:
-        """``PlanarWorld._touch`` for env i (``_remove``: the slot is parked far away)."""
-        inv, rules, labeller = self._inventories[i], self.rules, self.labeller
-        reward = float(rewards[i])
-        gained, arrived, touched = 0, -1, False
-        for j in np.flatnonzero(inside).tolist():
-            kind = self._kinds[j]
-            entered = not self._inside[i, j]
-            outcome = rules.touch(inv, kind, entered)
-            if entered and not self._is_item[j]:
-                arrived = kind
-            if outcome is None:
-                continue
-            touched = True
-            reward += outcome.reward
-            gained |= outcome.gained
-            if outcome.consumed:
-                self._present[i, j] = False
-                self._positions[i, j] = _FAR
-                self._offset_scale[i, j] = 0.0
-                inside[j] = False
-        rewards[i] = reward
-        if touched:
-            scale, off = rules.scale, self._inv_offset
-            for s, count in enumerate(inv):
-                self._obs[i, off + s] = count / scale[s]
-            self._levels[i] = labeller.levels(inv)
-        if touched or arrived >= 0:
-            masks[i] = labeller(inv, gained, arrived)
+    def _remove(self, i: int, j: int) -> None:
+        """As the single world's ``_remove``: the slot parked far away, its offset zeroed."""
+        self._positions[i, j] = _FAR
+        self._offset_scale[i, j] = 0.0
 
     def _write_observation(self, offsets: np.ndarray) -> None:
         """``ContinuousWorldEnv._write_observation`` for all envs (the inventory is written on

@@ -36,6 +36,31 @@ def within_boxes(points: np.ndarray, boxes: np.ndarray, margin: float = 0.0) -> 
     return (gap < boxes[:, 2] + margin).any(axis=1)
 
 
+def touch_slots(rules, inv: list[int], kinds, is_item, inside: np.ndarray, was_inside, reward: float,
+                consume) -> tuple[float, int, int, bool]:
+    """The rules' reading of the object slots within reach (``inside``, cleared where a slot
+    is consumed): items are touched while within reach, places act on entering their zone
+    (not ``was_inside``). ``consume(j)`` removes slot j; ``inv`` changes in place. Returns
+    (reward plus the touches', inventory bits gained, place kind entered or -1, whether any
+    rule acted). One piece of code for the continuous worlds and their vector envs."""
+    gained, arrived, touched = 0, -1, False
+    for j in np.flatnonzero(inside).tolist():
+        kind = kinds[j]
+        entered = not was_inside[j]
+        outcome = rules.touch(inv, kind, entered)
+        if entered and not is_item[j]:
+            arrived = kind
+        if outcome is None:
+            continue
+        touched = True
+        reward += outcome.reward
+        gained |= outcome.gained
+        if outcome.consumed:
+            consume(j)
+            inside[j] = False
+    return reward, gained, arrived, touched
+
+
 class PlanarWorld(CraftWorld):
     """Base of the continuous worlds. Subclasses set, per object slot, ``_kinds`` (its
     object kind), ``_is_item``, ``_present``, ``_inside`` (the agent was within reach at the
@@ -119,28 +144,18 @@ class PlanarWorld(CraftWorld):
         """Apply the rules to every object whose zone the agent is in; return (label, reward).
         An item is touched while within reach, a place acts on entering its zone."""
         inv = self.inventory_counts
-        gained, arrived, touched = 0, -1, False
-        for i in np.flatnonzero(inside).tolist():
-            kind = self._kinds[i]
-            entered = not self._inside[i]
-            outcome = self.rules.touch(inv, kind, entered)
-            if entered and not self._is_item[i]:
-                arrived = kind
-            if outcome is None:
-                continue
-            touched = True
-            reward += outcome.reward
-            gained |= outcome.gained
-            if outcome.consumed:
-                self._present[i] = False
-                self._remove(i)
-                inside[i] = False
+        reward, gained, arrived, touched = touch_slots(self.rules, inv, self._kinds, self._is_item, inside,
+                                                       self._inside, reward, self._consume)
         if touched:
             self._write_inventory()
             self._level_mask = self.labeller.levels(inv)
         if touched or arrived >= 0:
             mask = self.labeller(inv, gained, arrived)
         return mask, reward
+
+    def _consume(self, i: int) -> None:
+        self._present[i] = False
+        self._remove(i)
 
     def _remove(self, i: int) -> None:
         """What else consuming slot ``i`` changes (``_present`` is cleared already)."""

@@ -51,7 +51,7 @@ from ..wrappers import AutomatonObservation
 from .cells import EMPTY, MOVES
 from .grid import GridWorldEnv
 from .kinematic import KinematicWorldEnv
-from .planar import within_boxes
+from .planar import touch_slots, within_boxes
 
 _NO_TRANSITION = -1  # info["transition"] rows of envs that did not step
 
@@ -371,7 +371,51 @@ class GridVectorEnv(CraftVectorEnv):
             masks[i] = labeller(inv, 0, arrived)
 
 
-class KinematicVectorEnv(CraftVectorEnv):
+class PlanarVectorEnv(CraftVectorEnv):
+    """What the kinematic board's and the MuJoCo world's vector envs share, as their single
+    worlds share ``PlanarWorld``: two numbers an action (``WHAT`` they are), and the rules'
+    reading of a touch. Subclasses keep (N, n_objects) ``_present``/``_inside`` arrays and
+    define ``_remove(i, j)``: what consuming slot j of env i changes besides ``_present``."""
+
+    WHAT = "displacement"
+
+    def _check_actions(self, actions) -> np.ndarray:
+        try:
+            a = np.asarray(actions, dtype=np.float64)
+        except (TypeError, ValueError):
+            a = None
+        if a is None or a.shape != (self.num_envs, 2):
+            raise ValueError(f"invalid actions {actions!r}: expected {self.num_envs} rows of 2 numbers "
+                             f"({self.WHAT} along x and y) in [-1, 1]")
+        if not np.isfinite(a).all():
+            raise ValueError(f"invalid actions: NaN or infinite {self.WHAT} in rows "
+                             f"{np.flatnonzero(~np.isfinite(a).all(axis=1)).tolist()}")
+        return np.clip(a, -1.0, 1.0)
+
+    def _remove(self, i: int, j: int) -> None:
+        """What else consuming slot ``j`` of env ``i`` changes."""
+
+    def _touch(self, i: int, inside: np.ndarray, rewards: np.ndarray, masks: np.ndarray) -> None:
+        """``PlanarWorld._touch`` for env i: items within reach, places on entering."""
+        inv, rules, labeller = self._inventories[i], self.rules, self.labeller
+
+        def consume(j: int) -> None:
+            self._present[i, j] = False
+            self._remove(i, j)
+
+        reward, gained, arrived, touched = touch_slots(rules, inv, self._kinds, self._is_item, inside,
+                                                       self._inside[i], float(rewards[i]), consume)
+        rewards[i] = reward
+        if touched:
+            scale, off = rules.scale, self._inv_offset
+            for s, count in enumerate(inv):
+                self._obs[i, off + s] = count / scale[s]
+            self._levels[i] = labeller.levels(inv)
+        if touched or arrived >= 0:
+            masks[i] = labeller(inv, gained, arrived)
+
+
+class KinematicVectorEnv(PlanarVectorEnv):
     """``num_envs`` episodes on the kinematic board (see ``KinematicWorldEnv``): positions
     as (N, 2), object slots as (N, n_objects) arrays."""
 
@@ -405,19 +449,6 @@ class KinematicVectorEnv(CraftVectorEnv):
         self._present[i] = True
         self._inside[i] = False
 
-    def _check_actions(self, actions) -> np.ndarray:
-        try:
-            a = np.asarray(actions, dtype=np.float64)
-        except (TypeError, ValueError):
-            a = None
-        if a is None or a.shape != (self.num_envs, 2):
-            raise ValueError(f"invalid actions {actions!r}: expected {self.num_envs} rows of 2 numbers "
-                             "(displacement along x and y) in [-1, 1]")
-        if not np.isfinite(a).all():
-            raise ValueError(f"invalid actions: NaN or infinite displacement in rows "
-                             f"{np.flatnonzero(~np.isfinite(a).all(axis=1)).tolist()}")
-        return np.clip(a, -1.0, 1.0)
-
     def _move(self, actions, active):
         """``KinematicWorldEnv.step`` for the active envs, up to the automaton."""
         target = self._position + self._step_size * actions
@@ -437,34 +468,6 @@ class KinematicVectorEnv(CraftVectorEnv):
         self._inside[on] = inside[on]
         self._write_observation(offsets)
         return rewards, masks
-
-    def _touch(self, i: int, inside: np.ndarray, rewards: np.ndarray, masks: np.ndarray) -> None:
-        """``PlanarWorld._touch`` for env i: items within reach, places on entering."""
-        inv, rules, labeller = self._inventories[i], self.rules, self.labeller
-        reward = float(rewards[i])
-        gained, arrived, touched = 0, -1, False
-        for j in np.flatnonzero(inside).tolist():
-            kind = self._kinds[j]
-            entered = not self._inside[i, j]
-            outcome = rules.touch(inv, kind, entered)
-            if entered and not self._is_item[j]:
-                arrived = kind
-            if outcome is None:
-                continue
-            touched = True
-            reward += outcome.reward
-            gained |= outcome.gained
-            if outcome.consumed:
-                self._present[i, j] = False
-                inside[j] = False
-        rewards[i] = reward
-        if touched:
-            scale, off = rules.scale, self._inv_offset
-            for s, count in enumerate(inv):
-                self._obs[i, off + s] = count / scale[s]
-            self._levels[i] = labeller.levels(inv)
-        if touched or arrived >= 0:
-            masks[i] = labeller(inv, gained, arrived)
 
     def _write_observation(self, offsets: np.ndarray) -> None:
         """``KinematicWorldEnv._write_observation`` for all envs (the inventory is written on

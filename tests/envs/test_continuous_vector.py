@@ -60,22 +60,9 @@ def state(model, data):
     return out
 
 
-def test_plain_observations_and_reset_mask_equal_sync():
+def test_plain_observations_equal_sync():
     assert compare("CraftSuite/Reach-Cont-v0", "NextStep", steps=60, n=3, product=False,
                    max_episode_steps=20)["truncated"]
-    native, sync = make_pair("CraftSuite/DungeonQuest-Cont-v0", n=4, product=True)
-    assert_same(native.reset(seed=[5, None, 7, 8])[0][[0, 2, 3]], sync.reset(seed=[5, None, 7, 8])[0][[0, 2, 3]])
-    native.reset(seed=1), sync.reset(seed=1)
-    for _ in range(3):
-        actions = sync.action_space.sample()
-        native.step(actions), sync.step(actions)
-    mask = np.array([False, True, False, True])
-    got, want = native.reset(options={"reset_mask": mask.copy()}), sync.reset(options={"reset_mask": mask.copy()})
-    assert_same(got[0], want[0], "obs")
-    assert_same(engine_part(got[1])[2], want[1], "info")
-    actions = sync.action_space.sample()
-    got, want = native.step(actions), sync.step(actions)
-    assert_same(got[0], want[0], "obs after the masked reset")
 
 
 def test_registered_cont_ids_make_it_and_check_keywords():

@@ -140,7 +140,8 @@ def test_fixed_grid_layout_equals_sync():
     assert compare("CraftSuite/DungeonQuest-Grid7-v0", "SameStep", steps=80, layout_seed=4)["truncated"]
 
 
-@pytest.mark.parametrize("env_id", ["CraftSuite/DungeonQuest-Grid7-v0", "CraftSuite/DungeonQuest-Kinematic-v0"])
+@pytest.mark.parametrize("env_id", ["CraftSuite/DungeonQuest-Grid7-v0", "CraftSuite/DungeonQuest-Kinematic-v0",
+                                    "CraftSuite/DungeonQuest-Cont-v0"])
 def test_reset_mask_and_seed_lists_equal_sync(env_id):
     native, sync = make_pair(env_id, n=4, product=True)
     assert_same(native.reset(seed=[5, None, 7, 8])[0][[0, 2, 3]], sync.reset(seed=[5, None, 7, 8])[0][[0, 2, 3]])
@@ -152,6 +153,8 @@ def test_reset_mask_and_seed_lists_equal_sync(env_id):
     got, want = native.reset(options={"reset_mask": mask.copy()}), sync.reset(options={"reset_mask": mask.copy()})
     assert_same(got[0], want[0], "obs")
     assert_same(engine_part(got[1])[2], want[1], "info")
+    actions = sync.action_space.sample()
+    assert_same(native.step(actions)[0], sync.step(actions)[0], "obs after the masked reset")
 
 
 def test_registered_ids_make_native_vector_envs():

@@ -64,10 +64,8 @@ def test_a_members_model_acts_as_the_member(tmp_path, monkeypatch):
         np.testing.assert_array_equal(agent.predict(obs[k], deterministic=True)[0], greedy[k])
 
 
-def test_a_killed_population_resumes_from_its_checkpoint(tmp_path, monkeypatch):
-    configs = _cell("crm", "Grid7", "FirstTool", seeds=(0, 1), layout_seed=0)
-    evaluate = population_train._evaluate
-    calls = {"n": 0}
+def _killed_at_the_second_evaluation(configs, root, monkeypatch) -> None:
+    evaluate, calls = population_train._evaluate, {"n": 0}
 
     def dies_at_the_second(*args):
         calls["n"] += 1
@@ -75,12 +73,17 @@ def test_a_killed_population_resumes_from_its_checkpoint(tmp_path, monkeypatch):
             raise KeyboardInterrupt
         evaluate(*args)
 
-    monkeypatch.setattr(population_train, "_evaluate", dies_at_the_second)
-    with pytest.raises(KeyboardInterrupt):
-        train_population(configs, tmp_path, progress=False)
+    with monkeypatch.context() as patch:
+        patch.setattr(population_train, "_evaluate", dies_at_the_second)
+        with pytest.raises(KeyboardInterrupt):
+            train_population(configs, root, progress=False)
+
+
+def test_a_killed_population_resumes_from_its_checkpoint(tmp_path, monkeypatch):
+    configs = _cell("crm", "Grid7", "FirstTool", seeds=(0, 1), layout_seed=0)
+    _killed_at_the_second_evaluation(configs, tmp_path, monkeypatch)
     first = [read_csv(tmp_path / c.run_name() / "evals.csv") for c in configs]
     assert [len(e) for e in first] == [1, 1]
-    monkeypatch.setattr(population_train, "_evaluate", evaluate)
     loaded = {}
     load = population_train.Population.load_states
 
@@ -105,18 +108,7 @@ def test_a_population_that_cannot_resume_says_so_and_deletes_nothing(tmp_path, m
     from craftsuite.training import CheckpointError
 
     configs = _cell(seeds=(0, 1))
-    evaluate, calls = population_train._evaluate, {"n": 0}
-
-    def dies_at_the_second(*args):
-        calls["n"] += 1
-        if calls["n"] == 2:
-            raise KeyboardInterrupt
-        evaluate(*args)
-
-    monkeypatch.setattr(population_train, "_evaluate", dies_at_the_second)
-    with pytest.raises(KeyboardInterrupt):
-        train_population(configs, tmp_path, progress=False)
-    monkeypatch.setattr(population_train, "_evaluate", evaluate)
+    _killed_at_the_second_evaluation(configs, tmp_path, monkeypatch)
     damaged = tmp_path / configs[1].run_name() / "checkpoint" / "population.pt"
     damaged.write_bytes(b"not a checkpoint")
     with pytest.raises(CheckpointError, match=f"{damaged}.* cannot be loaded"):

@@ -45,7 +45,6 @@ class PopulationDQN:
         self.target_update_interval = int(settings["target_update_interval"])
         self.targets = targets
         self.n_updates = 0
-        self.last_losses = np.zeros(members)
 
     def q_values(self, net: StackedMLP, observations: th.Tensor) -> th.Tensor:
         out = net(observations)
@@ -103,7 +102,6 @@ class PopulationDQN:
         self.n_updates += 1
         if self.target_update_unit == "gradient_steps" and self.n_updates % self.target_update_interval == 0:
             self.update_target()
-        self.last_losses = per_member.detach().cpu().numpy()
         return (current - target).detach().reshape(K, B).cpu().numpy()
 
     def update_target(self) -> None:

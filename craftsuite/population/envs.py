@@ -22,11 +22,6 @@ def make_envs(env_id: str, num_envs: int, env_kwargs: dict, product: bool) -> gy
     return gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="sync", vector_kwargs=vector_kwargs, **kwargs)
 
 
-def _column(info: dict, key: str, default) -> np.ndarray:
-    values = info.get(key)
-    return np.full(len(default), default[0]) if values is None else values
-
-
 def step_records(info: dict, ended: np.ndarray, next_obs: np.ndarray):
     """From a same-step-autoreset step's ``info``: the real next observations (the final one
     where an episode ended), the automaton transitions ``(N, 3)`` and success flags of the

@@ -20,7 +20,6 @@ class MemberTargets:
         self.n_labels = rule.q_teacher.shape[1]
         self.cells = rule.q_teacher.size
         self.counts = np.zeros((members, self.cells), dtype=np.int64)
-        self.last_weight = np.zeros(members)  # mean beta of each member's last minibatch
 
     def __call__(self, w: np.ndarray, sigma: np.ndarray, q_target: th.Tensor) -> th.Tensor:
         """``w``, ``sigma`` ``(K, B)``; ``q_target`` ``(K, B, 1)``."""
@@ -30,7 +29,6 @@ class MemberTargets:
         mix[0] = self.rule._seen_flat[flat] * self.rule.rho ** self.counts.reshape(-1)[own]  # beta
         mix[1] = self.rule._teacher_flat[flat]
         np.add.at(self.counts.reshape(-1), own.reshape(-1), 1)
-        self.last_weight = mix[0].mean(axis=1)
         beta, teacher = th.from_numpy(mix).to(q_target.device).reshape(2, *q_target.shape)
         return q_target + beta * (teacher - q_target)
 

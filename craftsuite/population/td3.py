@@ -59,7 +59,6 @@ class PopulationTD3:
         self.prioritized = bool(settings.get("prioritized", True))
         self.targets = targets
         self.n_updates = 0
-        self.last_losses = (np.zeros(members), np.zeros(members))  # critic, actor
 
     # -- acting ------------------------------------------------------------------------------------
     def act(self, observations: np.ndarray) -> np.ndarray:
@@ -104,7 +103,6 @@ class PopulationTD3:
         per_member.sum().backward()  # members' losses are independent: each gets its own gradient
         self.critic_optimizer.step()
         td_errors = (current[0] - target).detach().reshape(K, B).cpu().numpy()
-        critic_losses = per_member.detach().cpu().numpy()
 
         self.n_updates += 1
         if self.n_updates % delay == 0:
@@ -114,9 +112,6 @@ class PopulationTD3:
             self.actor_optimizer.step()
             polyak(self.critics.parameters(), self.critics_target.parameters(), self.tau)
             polyak(self.actor.parameters(), self.actor_target.parameters(), self.tau)
-            self.last_losses = (critic_losses, actor_loss.detach().cpu().numpy())
-        else:
-            self.last_losses = (critic_losses, self.last_losses[1])
         return td_errors
 
     # -- members as SB3 agents ---------------------------------------------------------------------

@@ -113,7 +113,9 @@ def clip_grad_norm_per_member(params, max_norm: float) -> None:
     if not grads:
         return
     members = grads[0].shape[0]
-    norms = th.stack([g.reshape(members, -1).pow(2).sum(dim=1) for g in grads]).sum(dim=0).sqrt()
+    # as clip_grad_norm_ computes it: each tensor's norm, then the norm of those (per member)
+    norms = th.linalg.vector_norm(th.stack([th.linalg.vector_norm(g.reshape(members, -1), dim=1) for g in grads]),
+                                  dim=0)
     scale = (max_norm / (norms + 1e-6)).clamp(max=1.0)
     for g in grads:
         g.mul_(scale.reshape(members, *([1] * (g.dim() - 1))))

@@ -22,8 +22,6 @@ from __future__ import annotations
 import argparse
 import time
 
-import numpy as np
-
 import craftsuite  # noqa: F401
 from craftsuite.agents.methods import make_agent
 from craftsuite.methods import algorithm_settings
@@ -66,11 +64,11 @@ def measure_population(method, env_id, n_envs, settings, env_kwargs, members: in
                        device: str = "cpu") -> tuple[float, float]:
     """The engine's hot path (``population.train._loop`` without its logs): act, step the
     vector env, store, learn."""
-    from craftsuite.methods import METHODS
     from craftsuite.ids import parse_id, world_kind
+    from craftsuite.methods import METHODS
     from craftsuite.population import Population
     from craftsuite.population.engine import sparse_width
-    from craftsuite.population.envs import make_envs, step_records
+    from craftsuite.population.envs import make_envs
     from craftsuite.task_registry import resolve_task
 
     spec = resolve_task("BlindCraftsman")
@@ -84,17 +82,7 @@ def measure_population(method, env_id, n_envs, settings, env_kwargs, members: in
 
     def step():
         nonlocal obs
-        shaped = obs.reshape(members, n_envs, -1)
-        actions = pop.actions(shaped)
-        next_obs, rewards, terminated, truncated, info = envs.step(actions.reshape(members * n_envs,
-                                                                                   *actions.shape[2:]))
-        ended = terminated | truncated
-        real_next, transitions, _ = step_records(info, ended, next_obs)
-        pop.observe(shaped, real_next.reshape(members, n_envs, -1), actions, rewards.reshape(members, n_envs),
-                    terminated.reshape(members, n_envs).astype(np.float32), transitions.reshape(members, n_envs, 3))
-        if ended.any():
-            pop.episodes_ended(ended.reshape(members, n_envs))
-        obs = next_obs
+        obs = pop.step(envs, obs)[0]
         pop.train()
 
     while pop.num_timesteps <= pop.learning_starts + 1_000:  # the warm-up, then some learning

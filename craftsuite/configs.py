@@ -8,7 +8,7 @@ leaderboard.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from . import ids
@@ -125,6 +125,10 @@ class StudentConfig:
 
     def run_name(self) -> str:
         return f"student-{self.task}-{self.world}-{self.method}-s{self.seed}-{config_key(self)}"
+
+    def cell(self) -> dict:
+        """Every field but the seed: what the seeds of one suite cell share (a population)."""
+        return {k: v for k, v in asdict(self).items() if k != "seed"}
 
 
 def _check_n_envs(n_envs) -> None:

@@ -224,8 +224,7 @@ def cells(configs: list[StudentConfig]) -> list[list[StudentConfig]]:
     each SB3 config alone."""
     groups: dict[str, list[StudentConfig]] = {}
     for c in {c.run_name(): c for c in configs}.values():  # a run asked for twice is one run
-        key = json.dumps({k: v for k, v in dataclasses.asdict(c).items() if k != "seed"}, sort_keys=True) \
-            if c.engine == "population" else c.run_name()
+        key = json.dumps(c.cell(), sort_keys=True) if c.engine == "population" else c.run_name()
         groups.setdefault(key, []).append(c)
     return list(groups.values())
 

@@ -324,6 +324,16 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
         return run.path
 
 
+def student_result(config: StudentConfig, algorithm: str, steps: int, updates: int, seconds: float,
+                   **more) -> dict:
+    """A finished student's ``result.json``, whichever engine trained it (``more``: what
+    that engine adds, e.g. the population's size)."""
+    return {"kind": "student", "env_id": config.env_id, "method": config.method, "algorithm": algorithm,
+            "task": config.task, "seed": config.seed, "steps": int(steps), "updates": int(updates),
+            "product": config.product, "env_kwargs": config.env_kwargs, "model": "model.zip",
+            **more, "seconds_this_session": round(seconds, 1)}
+
+
 def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
     """A student (or baseline) run under ``root``; returns its directory."""
     from .agents import AutomatonQTable
@@ -363,12 +373,8 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
                        desc=f"{config.method} {config.task} s{config.seed}")
         with atomic_path(run.path / "model.zip") as tmp:
             agent.save(tmp)
-        run.write_result({"kind": "student", "env_id": config.env_id, "method": config.method,
-                          "algorithm": agent.algorithm,
-                          "task": config.task, "seed": config.seed, "steps": int(agent.num_timesteps),
-                          "updates": int(agent._n_updates), "product": config.product,
-                          "env_kwargs": config.env_kwargs, "model": "model.zip",
-                          "seconds_this_session": round(time.perf_counter() - start, 1)})
+        run.write_result(student_result(config, agent.algorithm, agent.num_timesteps, agent._n_updates,
+                                        time.perf_counter() - start))
         # a finished run is reused, never resumed (a larger budget is another run): its replay
         # buffer, up to gigabytes (CRM keeps one row per live automaton state), is dead weight
         shutil.rmtree(run.checkpoint.parent, ignore_errors=True)

@@ -53,10 +53,7 @@ class AutomatonTD3(NStepOwner, TD3):
                          policy_delay=self.policy_delay_at(0), **kwargs)
 
     def policy_delay_at(self, step: int) -> int:
-        for until, delay in self.delay_schedule:
-            if until is None or step < until:
-                return delay
-        return self.delay_schedule[-1][1]
+        return delay_at(self.delay_schedule, step)
 
     def _td_target(self, data: AutomatonSamples) -> th.Tensor:
         with th.no_grad():
@@ -110,6 +107,14 @@ class AutomatonTD3(NStepOwner, TD3):
         self.logger.record("train/critic_loss", np.mean(critic_losses))
         if self.distill is not None:
             self.logger.record("train/teacher_weight", self.distill.last_weight)
+
+
+def delay_at(schedule: tuple, step: int) -> int:
+    """The actor's delay in force at ``step`` under a ``_delay_schedule``."""
+    for until, delay in schedule:
+        if until is None or step < until:
+            return delay
+    return schedule[-1][1]
 
 
 def _delay_schedule(schedule, policy_delay) -> tuple:

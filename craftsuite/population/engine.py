@@ -18,9 +18,10 @@ import torch as th
 
 from ..agents.distillation import AutomatonQTable, DistilledTarget, static_distillation
 from ..agents.noise import make_action_noise
-from ..agents.td3 import _delay_schedule
+from ..agents.td3 import _delay_schedule, delay_at
 from ..methods import METHODS
 from .dqn import PopulationDQN
+from .envs import step_records
 from .replay import CounterfactualView, PopulationReplay
 from .targets import MemberTargets
 from .td3 import PopulationTD3
@@ -128,6 +129,7 @@ class Population:
             self.n_actions = int(action_space.n)
             self.learner = PopulationDQN(self.K, obs_dim, self.n_actions, settings, targets, device)
             action_shape, action_dtype = (), np.int64
+            self.noises = []  # epsilon-greedy explores instead
         else:
             self.act_dim = int(action_space.shape[-1])
             self.learner = PopulationTD3(self.K, obs_dim, self.act_dim, settings, targets, device)
@@ -175,18 +177,35 @@ class Population:
 
     def restart_noise(self) -> None:
         """Every env's exploration noise anew, as SB3 does at the start of each ``learn``."""
-        for noise in getattr(self, "noises", []):
+        for noise in self.noises:
             if noise is not None:
                 noise.reset()
 
     def episodes_ended(self, ended: np.ndarray) -> None:
         """Restart the exploration noise of the envs whose episode ended (``(K, n)`` mask)."""
-        if self.discrete:
+        if not self.noises:
             return
         for k, j in zip(*np.nonzero(ended)):
             noise = self.noises[k]
             if noise is not None:
                 noise.reset(indices=[int(j)]) if self.n_envs > 1 else noise.reset()
+
+    def step(self, envs, obs: np.ndarray):
+        """One step of every member's envs: act on ``obs`` ``(K * n_envs, obs_dim)``, step
+        ``envs`` (same-step autoreset, ``envs.make_envs``), store the transitions, restart
+        the noise of envs whose episode ended. Returns (next observations, rewards, ended,
+        success) of the ``K * n_envs`` envs."""
+        K, n = self.K, self.n_envs
+        shaped = obs.reshape(K, n, -1)
+        actions = self.actions(shaped)
+        next_obs, rewards, terminated, truncated, info = envs.step(actions.reshape(K * n, *actions.shape[2:]))
+        ended = terminated | truncated
+        real_next, transitions, success = step_records(info, ended, next_obs)
+        self.observe(shaped, real_next.reshape(K, n, -1), actions, rewards.reshape(K, n),
+                     terminated.reshape(K, n).astype(np.float32), transitions.reshape(K, n, 3))
+        if ended.any():
+            self.episodes_ended(ended.reshape(K, n))
+        return next_obs, rewards, ended, success
 
     # -- learning ----------------------------------------------------------------------------------
     def observe(self, obs, next_obs, actions, rewards, terminated, transitions) -> None:
@@ -204,17 +223,11 @@ class Population:
             return
         if self.n_calls % self.train_every:
             return
-        delay = None if self.discrete else self.policy_delay()
+        delay = None if self.discrete else delay_at(self.delay_schedule, self.num_timesteps)
         for _ in range(self.gradient_steps):
             batch = self.replay.sample(self.batch_size)
             td = self.learner.update(batch) if self.discrete else self.learner.update(batch, delay)
             self.replay.update_priorities(batch.leaves, td)
-
-    def policy_delay(self) -> int:
-        for until, delay in self.delay_schedule:
-            if until is None or self.num_timesteps < until:
-                return delay
-        return self.delay_schedule[-1][1]
 
     def greedy(self, obs: np.ndarray) -> np.ndarray:
         return self.learner.act(obs)

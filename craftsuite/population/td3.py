@@ -115,24 +115,20 @@ class PopulationTD3:
         return td_errors
 
     # -- members as SB3 agents ---------------------------------------------------------------------
+    def _pairs(self, agent) -> list:
+        """Each stacked network beside its SB3 counterpart in an ``AutomatonTD3``."""
+        policy = agent.policy
+        return [(self.actor, policy.actor.mu), (self.actor_target, policy.actor_target.mu),
+                *zip(self.critics, policy.critic.q_networks), *zip(self.critics_target, policy.critic_target.q_networks)]
+
     def load_member(self, k: int, agent) -> None:
         """Member ``k``'s networks from an ``AutomatonTD3`` (its actor, critics and targets)."""
-        policy = agent.policy
-        self.actor.load_member(k, policy.actor.mu)
-        self.actor_target.load_member(k, policy.actor_target.mu)
-        for mine, theirs in zip(self.critics, policy.critic.q_networks):
-            mine.load_member(k, theirs)
-        for mine, theirs in zip(self.critics_target, policy.critic_target.q_networks):
+        for mine, theirs in self._pairs(agent):
             mine.load_member(k, theirs)
 
     def store_member(self, k: int, agent) -> None:
         """Member ``k``'s networks into an ``AutomatonTD3`` of the same shape."""
-        policy = agent.policy
-        self.actor.store_member(k, policy.actor.mu)
-        self.actor_target.store_member(k, policy.actor_target.mu)
-        for mine, theirs in zip(self.critics, policy.critic.q_networks):
-            mine.store_member(k, theirs)
-        for mine, theirs in zip(self.critics_target, policy.critic_target.q_networks):
+        for mine, theirs in self._pairs(agent):
             mine.store_member(k, theirs)
 
     def modules(self) -> dict:

@@ -15,7 +15,6 @@ A population writes no TensorBoard logs.
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import json
 import shutil
 import time
@@ -26,6 +25,7 @@ import torch as th
 
 from ..configs import StudentConfig
 from ..files import atomic_path, atomic_write
+from ..ids import world_kind
 from ..methods import METHODS
 from ..runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir
 from .engine import EngineError, Population, check_supported, sparse_width
@@ -38,9 +38,9 @@ def check_cell(configs: list[StudentConfig]) -> None:
     """Raise ``EngineError`` unless ``configs`` are seeds of one cell: equal but for the seed."""
     if not configs:
         raise EngineError("a population needs at least one run")
-    first = {k: v for k, v in dataclasses.asdict(configs[0]).items() if k != "seed"}
+    first = configs[0].cell()
     for c in configs[1:]:
-        other = {k: v for k, v in dataclasses.asdict(c).items() if k != "seed"}
+        other = c.cell()
         differ = sorted(k for k in first if first[k] != other[k])
         if differ:
             raise EngineError(f"a population trains the seeds of one cell; these runs also differ in {differ}")
@@ -106,8 +106,6 @@ def _train(todo, settings, table, spec, device, progress, desc) -> None:
         th.set_num_threads(1)  # small nets: one thread is fastest and leaves the other cores to other cells
     try:
         obs_dim = envs.single_observation_space.shape[0]
-        from ..ids import world_kind
-
         pop = Population(config.method, settings, [c.seed for c in configs], n, obs_dim, envs.single_action_space,
                          spec.automaton, spec.completion_reward, config.steps, table, str(device),
                          sparse_width(spec, world_kind(config.world), config.product))
@@ -136,14 +134,7 @@ def _loop(pop: Population, envs, eval_envs, configs, runs, bar) -> None:
     next_eval = (pop.num_timesteps // every + 1) * every
     next_flush = pop.num_timesteps + 1_000
     while pop.num_timesteps < total:
-        shaped = obs.reshape(K, n, -1)
-        actions = pop.actions(shaped)
-        flat_actions = actions.reshape(K * n, *actions.shape[2:])
-        next_obs, rewards, terminated, truncated, info = envs.step(flat_actions)
-        ended = terminated | truncated
-        real_next, transitions, success = step_records(info, ended, next_obs)
-        pop.observe(shaped, real_next.reshape(K, n, -1), actions, rewards.reshape(K, n),
-                    terminated.reshape(K, n).astype(np.float32), transitions.reshape(K, n, 3))
+        obs, rewards, ended, success = pop.step(envs, obs)
         returns += rewards
         lengths += 1
         if ended.any():
@@ -151,8 +142,6 @@ def _loop(pop: Population, envs, eval_envs, configs, runs, bar) -> None:
                 pending[i // n].append({"step": pop.num_timesteps, "return": round(float(returns[i]), 4),
                                         "length": int(lengths[i]), "success": int(success[i])})
             returns[ended], lengths[ended] = 0.0, 0
-            pop.episodes_ended(ended.reshape(K, n))
-        obs = next_obs
         bar.update(K * n)
         t = pop.num_timesteps
         if t >= next_flush:
@@ -284,6 +273,7 @@ def _resume(pop: Population, runs) -> None:
 def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, seconds: float, device: str) -> None:
     """Member ``k``'s model as an SB3 agent (``model.zip``), its result, its checkpoints gone."""
     from ..agents.methods import make_agent
+    from ..training import student_result
 
     agent = make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=1,
                        env_kwargs=config.env_kwargs, automaton_state=config.automaton_state,
@@ -295,11 +285,7 @@ def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, 
     with atomic_path(run.path / "model.zip") as tmp:
         agent.save(tmp)
     agent.get_env().close()
-    run.write_result({"kind": "student", "env_id": config.env_id, "method": config.method,
-                      "algorithm": METHODS[config.method].algorithm, "task": config.task, "seed": config.seed,
-                      "steps": int(pop.num_timesteps), "updates": int(pop.learner.n_updates),
-                      "product": config.product, "env_kwargs": config.env_kwargs, "model": "model.zip",
-                      "engine": "population", "members": pop.K, "device": device,
-                      "seconds_this_session": round(seconds, 1)})
+    run.write_result(student_result(config, pop.learner.algorithm, pop.num_timesteps, pop.learner.n_updates, seconds,
+                                    engine="population", members=pop.K, device=device))
     for name in ("checkpoint", "checkpoint-old", "checkpoint-new"):
         shutil.rmtree(run.path / name, ignore_errors=True)

@@ -8,8 +8,9 @@ from __future__ import annotations
 import numpy as np
 import torch as th
 import torch.nn.functional as F
+from stable_baselines3.common.utils import polyak_update  # elementwise: stacked members too
 
-from .nets import StackedMLP, activation_of, clip_grad_norm_per_member, polyak
+from .nets import StackedMLP, activation_of, clip_grad_norm_per_member
 from .replay import Batch, SparseRows
 from .targets import MemberTargets
 
@@ -105,7 +106,7 @@ class PopulationDQN:
         return (current - target).detach().reshape(K, B).cpu().numpy()
 
     def update_target(self) -> None:
-        polyak(self.q_net.parameters(), self.q_net_target.parameters(), self.tau)
+        polyak_update(self.q_net.parameters(), self.q_net_target.parameters(), self.tau)
 
     # -- members as SB3 agents ---------------------------------------------------------------------
     def _sequential(self, q_network):

@@ -98,14 +98,6 @@ def activation_of(activation_fn) -> callable:
                          f"not {activation_fn!r}: use --engine sb3") from None
 
 
-def polyak(params, targets, tau: float) -> None:
-    """``target = (1 - tau) target + tau param``, as SB3's ``polyak_update`` computes it."""
-    with th.no_grad():
-        for p, t in zip(params, targets):
-            t.mul_(1 - tau)
-            th.add(t, p, alpha=tau, out=t)
-
-
 def clip_grad_norm_per_member(params, max_norm: float) -> None:
     """``torch.nn.utils.clip_grad_norm_`` applied to each member alone: every member's
     gradient scaled by max_norm / (its norm + 1e-6), at most 1."""

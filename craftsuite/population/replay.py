@@ -48,10 +48,6 @@ class SparseRows(NamedTuple):
     index: np.ndarray  # int64
     value: np.ndarray  # float32
 
-    @property
-    def shape(self) -> tuple:
-        return self.index.shape
-
 
 def sparse_rows(dense: np.ndarray, width: int) -> SparseRows:
     """The nonzero entries of each row of ``dense`` ``(..., d)``, padded to ``width``.

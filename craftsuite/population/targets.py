@@ -20,14 +20,18 @@ class MemberTargets:
         self.n_labels = rule.q_teacher.shape[1]
         self.cells = rule.q_teacher.size
         self.counts = np.zeros((members, self.cells), dtype=np.int64)
+        # the rule's public tables, flat: one fancy index per array per minibatch
+        self._seen = rule.seen.reshape(-1).astype(np.float32)
+        self._teacher = rule.q_teacher.reshape(-1)
+        self._offsets = (np.arange(members) * self.cells)[:, None]  # member k's counts
 
     def __call__(self, w: np.ndarray, sigma: np.ndarray, q_target: th.Tensor) -> th.Tensor:
         """``w``, ``sigma`` ``(K, B)``; ``q_target`` ``(K, B, 1)``."""
         flat = w * self.n_labels + sigma
-        own = flat + (np.arange(self.members) * self.cells)[:, None]
+        own = flat + self._offsets
         mix = np.empty((2, *flat.shape), dtype=np.float32)
-        mix[0] = self.rule._seen_flat[flat] * self.rule.rho ** self.counts.reshape(-1)[own]  # beta
-        mix[1] = self.rule._teacher_flat[flat]
+        mix[0] = self._seen[flat] * self.rule.rho ** self.counts.reshape(-1)[own]  # beta
+        mix[1] = self._teacher[flat]
         np.add.at(self.counts.reshape(-1), own.reshape(-1), 1)
         beta, teacher = th.from_numpy(mix).to(q_target.device).reshape(2, *q_target.shape)
         return q_target + beta * (teacher - q_target)

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 import torch as th
+from stable_baselines3.common.utils import polyak_update  # elementwise: stacked members too
 
-from .nets import StackedMLP, activation_of, polyak
+from .nets import StackedMLP, activation_of
 from .replay import Batch
 from .targets import MemberTargets
 
@@ -110,8 +111,8 @@ class PopulationTD3:
             self.actor_optimizer.zero_grad()
             actor_loss.sum().backward()
             self.actor_optimizer.step()
-            polyak(self.critics.parameters(), self.critics_target.parameters(), self.tau)
-            polyak(self.actor.parameters(), self.actor_target.parameters(), self.tau)
+            polyak_update(self.critics.parameters(), self.critics_target.parameters(), self.tau)
+            polyak_update(self.actor.parameters(), self.actor_target.parameters(), self.tau)
         return td_errors
 
     # -- members as SB3 agents ---------------------------------------------------------------------

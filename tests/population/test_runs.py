@@ -41,8 +41,10 @@ def test_members_write_ordinary_runs(tmp_path):
         assert not (path / "checkpoint").exists()
     agent = load_agent(paths[1] / "model.zip")
     assert type(agent).__name__ == "AutomatonTD3" and agent.num_timesteps == 1_200
-    # a second call trains nothing: every member is finished
+    # a second call trains nothing: every member is finished, its records left as they were
+    records = [(p / "result.json").read_text() + (p / "config.json").read_text() for p in paths]
     assert train_population(configs, tmp_path, progress=False) == paths
+    assert [(p / "result.json").read_text() + (p / "config.json").read_text() for p in paths] == records
 
 
 def test_a_members_model_acts_as_the_member(tmp_path, monkeypatch):

@@ -1,8 +1,8 @@
 """Labelling: what happened in a step -> the set of true propositions, as a bitmask.
 
 One ``Labeller`` per task, shared by every world of the task. Events (``obtained``,
-``arrived``, ``reached``) are true on the step they happen; levels (``at_least``) are true
-while they hold. Bit ``i`` of the mask is ``propositions[i]``, the automaton's bit order.
+``arrived``, ``reached``) are true on the step they happen; levels (``at_least``,
+``exactly``) are true while they hold. Bit ``i`` of the mask is ``propositions[i]``, the automaton's bit order.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ class Labeller:
         slot = {n: i for i, n in enumerate(spec.inventory)}
         kind = {o.name: k for k, o in enumerate(spec.objects)}
         self.propositions = tuple(order)
-        self._obtained, self._arrived, self._at_least, self._reached = [], [], [], []
+        self._obtained, self._arrived, self._at_least, self._exactly, self._reached = [], [], [], [], []
         for bit, name in enumerate(order):
             p = by_name[name]
             if p.kind == "obtained":
@@ -29,6 +29,8 @@ class Labeller:
                 self._arrived.append((1 << bit, kind[p.subject]))
             elif p.kind == "at_least":
                 self._at_least.append((1 << bit, slot[p.subject], p.value))
+            elif p.kind == "exactly":
+                self._exactly.append((1 << bit, slot[p.subject], p.value))
             else:
                 self._reached.append((1 << bit, slot[p.subject], p.value))
 
@@ -37,6 +39,9 @@ class Labeller:
         mask = 0
         for bit, s, k in self._at_least:
             if inv[s] >= k:
+                mask |= bit
+        for bit, s, k in self._exactly:
+            if inv[s] == k:
                 mask |= bit
         return mask
 
@@ -53,6 +58,10 @@ class Labeller:
             if place == arrived:
                 mask |= bit
         return mask
+
+    def arrived_bits(self, place: int) -> int:
+        """The bits of the ``arrived`` propositions about place kind ``place``."""
+        return sum(bit for bit, kind in self._arrived if kind == place)
 
     def names(self, mask: int) -> tuple[str, ...]:
         return tuple(p for i, p in enumerate(self.propositions) if mask >> i & 1)

@@ -52,15 +52,17 @@ make_continuous.metadata = {"render_modes": ["rgb_array"], "render_fps": 4}  # t
 
 
 def make_kinematic(task: str | TaskSpec, product: bool = False, render_mode: str | None = None,
-                   width: int = 240, height: int = 240, status_panel: bool = False) -> gym.Env:
-    """Entry point of the kinematic ids (the authors' continuous toy, no MuJoCo);
+                   width: int = 240, height: int = 240, status_panel: bool = False, size: int = 7,
+                   observation: str = "authors") -> gym.Env:
+    """Entry point of the kinematic ids (the authors' continuous toy and rules, no MuJoCo);
     ``product=True`` adds the automaton one-hot, ``width`` x ``height`` the frame,
-    ``status_panel=True`` draws the inventory and automaton state under each frame."""
+    ``status_panel=True`` draws the inventory and automaton state under each frame,
+    ``size`` is the board's side (7 or 10), ``observation`` "authors" or "craftsuite"."""
     from .envs.kinematic import KinematicWorldEnv
     from .wrappers import AutomatonObservation
 
     env = KinematicWorldEnv(task, render_mode=render_mode, width=width, height=height,
-                            status_panel=status_panel)
+                            status_panel=status_panel, size=size, observation=observation)
     return AutomatonObservation(env) if product else env
 
 

@@ -186,8 +186,11 @@ class ContinuousScriptedPolicy(ScriptedPolicy):
                 return np.zeros(2, dtype=np.float32)
             away = pos - e._positions[near[0]]
             return self._steer(away / (np.linalg.norm(away) + 1e-9) * TOP_SPEED, vel)
+        # on the board an item touched at capacity is lost: full items are unsafe too
+        full = {k for k, obj in enumerate(e.task.objects[:e.rules.n_items])
+                if obj.capacity is not None and inv[e.rules.inventory_names.index(obj.name)] >= obj.capacity}
         unsafe = [i for i in np.flatnonzero(present)
-                  if kinds[i] != target and not self.planner.harmless(w, inv, int(kinds[i]))]
+                  if (kinds[i] != target and not self.planner.harmless(w, inv, int(kinds[i]))) or kinds[i] in full]
         blocked = self.static.copy()
         for i in unsafe:
             ox, oy = e._positions[i]
@@ -238,8 +241,11 @@ class KinematicScriptedPolicy(ScriptedPolicy):
         pos, w, inv = e.agent_position, e.automaton_state, tuple(e.inventory_counts)
         kinds = np.array(e._kinds)
         present = e._present
+        # on the board an item touched at capacity is lost: full items are unsafe too
+        full = {k for k, obj in enumerate(e.task.objects[:e.rules.n_items])
+                if obj.capacity is not None and inv[e.rules.inventory_names.index(obj.name)] >= obj.capacity}
         unsafe = [i for i in np.flatnonzero(present)
-                  if kinds[i] != target and not self.planner.harmless(w, inv, int(kinds[i]))]
+                  if (kinds[i] != target and not self.planner.harmless(w, inv, int(kinds[i]))) or kinds[i] in full]
         # a place acts on entering: an instance we stand in counts once we have left it
         goals = np.flatnonzero((kinds == target) & present & ~e._inside)
         avoid = e._positions[unsafe + np.flatnonzero((kinds == target) & e._inside).tolist()]

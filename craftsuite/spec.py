@@ -17,6 +17,7 @@ Format (see ``tasks/blind_craftsman.toml`` for a full example)::
     factory = { arrived = "factory" }# event: the agent entered a factory this step
     tools3 = { at_least = { tools = 3 } }   # level: holding >= 3 tools
     gold1 = { reached = { gold = 1 } }      # event: gold count went up to exactly 1
+    silver1 = { exactly = { silver = 1 } }  # level: holding exactly 1 silver
 
     [items.wood]                     # picked up by stepping on it
     count = 3                        # how many on the map
@@ -28,6 +29,8 @@ Format (see ``tasks/blind_craftsman.toml`` for a full example)::
     [places.factory]                 # stays on the map, acts on arrival
     count = 1
     placement = "corner"             # "random" (default) or "corner" (top-left cell)
+    kinematic = { reward = 1.0 }     # the kinematic board's tile (all keys optional; items too):
+                                     # requires, reward, consumable, ends_episode, label
 
     [[recipes]]                      # at = a place (on arrival) or omitted (anywhere,
     at = "factory"                   # checked after every pickup)
@@ -67,7 +70,7 @@ from .ids import TASK_NAME
 from .paths import assets_dir, tasks_dir
 
 __all__ = [
-    "LEVELS", "SpecError", "TaskSpec", "Item", "Place", "Recipe", "Proposition", "GridConfig", "ContinuousConfig",
+    "LEVELS", "SpecError", "TaskSpec", "Item", "Place", "BoardTile", "Recipe", "Proposition", "GridConfig", "ContinuousConfig",
     "load_spec", "builtin_specs",
 ]
 
@@ -82,6 +85,25 @@ class SpecError(ValueError):
 
 
 @dataclass(frozen=True)
+class BoardTile:
+    """How an object acts on the kinematic board, which follows the authors' tiles
+    (``MineWorldTileType``): on every step the agent is within reach and the inventory meets
+    ``requires`` (and the tile's change leaves no count negative), the tile applies its
+    change, pays ``reward``, leaves the board if ``consumable`` and ends the episode if
+    ``ends_episode``. ``label``: ``"acts"`` (an ``arrived`` proposition of a place is true on
+    the steps it acts) or ``"cell"`` (true while the agent's position, truncated to
+    integers, is the place's cell: the authors' ``at_home``). None fields take the object's
+    defaults: an item is consumable, needs its ``requires``, pays its ``reward``; a place
+    stays, needs nothing, pays 0. The grid and MuJoCo worlds ignore this table."""
+
+    requires: dict[str, int] | None = None
+    reward: float | None = None
+    consumable: bool | None = None
+    ends_episode: bool = False
+    label: str = "acts"
+
+
+@dataclass(frozen=True)
 class Item:
     name: str
     count: int
@@ -91,6 +113,7 @@ class Item:
     excludes: tuple[str, ...] = ()
     color: str = "#888888"
     symbol: str = "?"
+    kinematic: BoardTile = BoardTile()
 
 
 @dataclass(frozen=True)
@@ -100,6 +123,7 @@ class Place:
     placement: str = "random"
     color: str = "#888888"
     symbol: str = "?"
+    kinematic: BoardTile = BoardTile()
 
 
 @dataclass(frozen=True)
@@ -115,8 +139,9 @@ class Proposition:
     """What makes one atomic proposition true after a step.
 
     kind: ``obtained`` (event: ``subject``'s count went up), ``arrived`` (event: entered
-    a ``subject`` place), ``at_least`` (level: count of ``subject`` >= ``value``) or
-    ``reached`` (event: count of ``subject`` went up to exactly ``value``).
+    a ``subject`` place), ``at_least`` (level: count of ``subject`` >= ``value``),
+    ``exactly`` (level: count of ``subject`` == ``value``) or ``reached`` (event: count of
+    ``subject`` went up to exactly ``value``).
     """
 
     name: str
@@ -247,11 +272,18 @@ class TaskSpec:
         Proposition order is bit order: keep the tables' key order (JSON does)."""
 
         def proposition(p: Proposition) -> dict:
-            return {p.kind: {p.subject: p.value} if p.kind in ("at_least", "reached") else p.subject}
+            return {p.kind: {p.subject: p.value} if p.kind in COUNTED else p.subject}
+
+        def tile(t: BoardTile) -> dict:
+            out = {"ends_episode": t.ends_episode, "label": t.label}
+            for key in ("requires", "reward", "consumable"):
+                if getattr(t, key) is not None:
+                    out[key] = dict(t.requires) if key == "requires" else getattr(t, key)
+            return out
 
         def item(i: Item) -> dict:
             out = {"count": i.count, "reward": i.reward, "requires": dict(i.requires), "excludes": list(i.excludes),
-                   "color": i.color, "symbol": i.symbol}
+                   "color": i.color, "symbol": i.symbol, "kinematic": tile(i.kinematic)}
             return out if i.capacity is None else {**out, "capacity": i.capacity}
 
         def recipe(r: Recipe) -> dict:
@@ -262,7 +294,8 @@ class TaskSpec:
             "name": self.name, "formula": self.formula, "description": self.description, "tags": list(self.tags),
             "propositions": {p.name: proposition(p) for p in self.propositions},
             "items": {i.name: item(i) for i in self.items},
-            "places": {p.name: {"count": p.count, "placement": p.placement, "color": p.color, "symbol": p.symbol}
+            "places": {p.name: {"count": p.count, "placement": p.placement, "color": p.color, "symbol": p.symbol,
+                                "kinematic": tile(p.kinematic)}
                        for p in self.places},
             "recipes": [recipe(r) for r in self.recipes],
             "rewards": {"step": self.step_reward, "completion": self.completion_reward},
@@ -289,6 +322,9 @@ class TaskSpec:
 
         return hashlib.sha256(json.dumps(rules(self), sort_keys=True).encode()).hexdigest()[:12]
 
+
+# proposition kinds whose argument is one inventory count, { name = k }
+COUNTED = ("at_least", "exactly", "reached")
 
 # Readable defaults for objects a spec gives no colour; the paper's Figure 1c colours first.
 _PALETTE = ["#8b5a2b", "#d9822b", "#3d7dd8", "#7b4fb5", "#2ca58d", "#d64550", "#e0c341",
@@ -408,7 +444,7 @@ def _build(r: _Reader, data: dict, path: Path | None) -> TaskSpec:
     raw_recipes, inventory = _inventory(r, data, raw_items)
     looks = _Looks(r)
     items = _items(r, raw_items, inventory, looks)
-    places = _places(r, raw_places, looks)
+    places = _places(r, raw_places, looks, inventory)
     recipes = _recipes(r, raw_recipes, raw_places, inventory)
     props = _propositions(r, data, raw_places, inventory)
     formula = _formula(r, data, props)
@@ -485,7 +521,7 @@ def _items(r: _Reader, raw_items: dict, inventory: set[str], looks: _Looks) -> t
     for obj, table in raw_items.items():
         where = f"items.{obj}"
         table = r.table(table, where)
-        r.keys(table, {"count", "reward", "capacity", "requires", "excludes", "color", "symbol"}, where)
+        r.keys(table, {"count", "reward", "capacity", "requires", "excludes", "color", "symbol", "kinematic"}, where)
         excludes = table.get("excludes", [])
         if not isinstance(excludes, list) or any(e not in inventory for e in excludes):
             r.fail(f"{where}.excludes", f"must list inventory names from {sorted(inventory)}, got {excludes!r}")
@@ -501,16 +537,39 @@ def _items(r: _Reader, raw_items: dict, inventory: set[str], looks: _Looks) -> t
             requires=r.counts(table.get("requires", {}), f"{where}.requires", inventory),
             excludes=tuple(excludes),
             color=color, symbol=symbol,
+            kinematic=_board_tile(r, table, where, inventory, place=False),
         ))
     return tuple(items)
 
 
-def _places(r: _Reader, raw_places: dict, looks: _Looks) -> tuple[Place, ...]:
+def _board_tile(r: _Reader, table: dict, where: str, inventory: set[str], place: bool) -> BoardTile:
+    """An object's ``kinematic`` table (see ``BoardTile``)."""
+    where = f"{where}.kinematic"
+    raw = r.table(table.get("kinematic", {}), where)
+    r.keys(raw, {"requires", "reward", "consumable", "ends_episode", "label"}, where)
+    for key in ("consumable", "ends_episode"):
+        if key in raw and not isinstance(raw[key], bool):
+            r.fail(f"{where}.{key}", f"must be true or false, got {raw[key]!r}")
+    label = r.str(raw, "label", where, default="acts")
+    if label not in ("acts", "cell"):
+        r.fail(f"{where}.label", f"must be 'acts' or 'cell', got {label!r}")
+    if label == "cell" and not place:
+        r.fail(f"{where}.label", "only a place can be labelled by its cell")
+    return BoardTile(
+        requires=r.counts(raw["requires"], f"{where}.requires", inventory) if "requires" in raw else None,
+        reward=r.float(raw, "reward", where, 0.0) if "reward" in raw else None,
+        consumable=raw.get("consumable"),
+        ends_episode=raw.get("ends_episode", False),
+        label=label,
+    )
+
+
+def _places(r: _Reader, raw_places: dict, looks: _Looks, inventory: set[str]) -> tuple[Place, ...]:
     places = []
     for obj, table in raw_places.items():
         where = f"places.{obj}"
         table = r.table(table, where)
-        r.keys(table, {"count", "placement", "color", "symbol"}, where)
+        r.keys(table, {"count", "placement", "color", "symbol", "kinematic"}, where)
         placement = r.str(table, "placement", where, default="random")
         if placement not in ("random", "corner"):
             r.fail(f"{where}.placement", f"must be 'random' or 'corner', got {placement!r}")
@@ -518,7 +577,8 @@ def _places(r: _Reader, raw_places: dict, looks: _Looks) -> tuple[Place, ...]:
         if placement == "corner" and count != 1:
             r.fail(f"{where}.count", "a place with placement 'corner' must have count 1")
         color, symbol = looks(table, where, obj)
-        places.append(Place(name=obj, count=count, placement=placement, color=color, symbol=symbol))
+        places.append(Place(name=obj, count=count, placement=placement, color=color, symbol=symbol,
+                            kinematic=_board_tile(r, table, where, inventory, place=True)))
     corners = [p.name for p in places if p.placement == "corner"]
     if len(corners) > 1:
         r.fail("places", f"only one place can take the corner, got {corners}")
@@ -556,7 +616,7 @@ def _propositions(r: _Reader, data: dict, raw_places: dict, inventory: set[str])
             r.fail(where, "proposition names must be lower-case identifiers (e.g. 'tools3', 'gold_1')")
         table = r.table(table, where)
         if len(table) != 1:
-            r.fail(where, "needs exactly one of 'obtained', 'arrived', 'at_least', 'reached'")
+            r.fail(where, "needs exactly one of 'obtained', 'arrived', 'at_least', 'exactly', 'reached'")
         (kind, arg), = table.items()
         if kind == "obtained":
             if arg not in inventory:
@@ -566,14 +626,14 @@ def _propositions(r: _Reader, data: dict, raw_places: dict, inventory: set[str])
             if arg not in raw_places:
                 r.fail(f"{where}.arrived", f"unknown place {arg!r}; places: {sorted(raw_places)}")
             props.append(Proposition(prop, kind, arg))
-        elif kind in ("at_least", "reached"):
+        elif kind in COUNTED:
             counts = r.counts(arg, f"{where}.{kind}", inventory)
             if len(counts) != 1:
                 r.fail(f"{where}.{kind}", "must name exactly one inventory count, e.g. { tools = 3 }")
             (subject, value), = counts.items()
             props.append(Proposition(prop, kind, subject, value))
         else:
-            r.fail(where, f"unknown kind {kind!r}; use 'obtained', 'arrived', 'at_least' or 'reached'")
+            r.fail(where, f"unknown kind {kind!r}; use 'obtained', 'arrived', 'at_least', 'exactly' or 'reached'")
     return tuple(props)
 
 

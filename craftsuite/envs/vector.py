@@ -94,6 +94,10 @@ class CraftVectorEnv(VectorEnv):
         self._initial = int(automaton.initial)
         self._completion = float(self.task.completion_reward)
         self._step_reward = float(self.task.step_reward)
+        # whether acceptance and violation end an episode (with the completion reward), or
+        # only the world does (``_world_ended``, set by ``_move``: the kinematic board's tiles)
+        self._objective_ends = True
+        self._world_ended = np.zeros(num_envs, dtype=bool)
 
         # the single env's spaces, the product one built by the wrapper itself
         space = AutomatonObservation(template).observation_space if product else template.observation_space
@@ -187,8 +191,10 @@ class CraftVectorEnv(VectorEnv):
         w2 = np.where(active, self._delta[w, masks], w)
         success = self._accepting[w2] & active
         violation = self._rejecting[w2] & active
-        rewards += np.where(success, self._completion, 0.0)  # reward + bonus, as the single env adds them
-        terminated = success | violation
+        terminated = self._world_ended & active
+        if self._objective_ends:
+            rewards += np.where(success, self._completion, 0.0)  # reward + bonus, as the single env adds them
+            terminated |= success | violation
         self._elapsed += active
         truncated = active & (self._elapsed >= self.max_episode_steps) if self.max_episode_steps \
             else np.zeros(n, dtype=bool)
@@ -417,9 +423,12 @@ class PlanarVectorEnv(CraftVectorEnv):
 
 class KinematicVectorEnv(PlanarVectorEnv):
     """``num_envs`` episodes on the kinematic board (see ``KinematicWorldEnv``): positions
-    as (N, 2), object slots as (N, n_objects) arrays."""
+    as (N, 2), object slots as (N, n_objects) arrays. Motion, reach and observations are
+    numpy over all envs; the envs with an object in reach go through ``BoardRules`` in
+    Python, as the single world does."""
 
-    KEYWORDS = ("product", "render_mode", "width", "height", "status_panel", "max_episode_steps", "autoreset_mode")
+    KEYWORDS = ("product", "render_mode", "width", "height", "status_panel", "size", "observation",
+                "max_episode_steps", "autoreset_mode")
 
     def __init__(self, num_envs: int, task: str | TaskSpec = "BlindCraftsman", product: bool = False,
                  max_episode_steps: int | None = None,
@@ -429,25 +438,28 @@ class KinematicVectorEnv(PlanarVectorEnv):
         template = KinematicWorldEnv(task, **kwargs)
         super().__init__(template, num_envs, product, max_episode_steps, autoreset_mode)
         n_obj = len(template._kinds)
+        self.board = template.board
+        self._objective_ends = not self.board.ends_by_tile
         self._kinds = list(template._kinds)
-        self._is_item = template._is_item
+        self._by_cell = [self.board.tiles[k].by_cell for k in self._kinds]
+        self._cell_bits = template._cell_bits
         self._boxes = template._obstacles
         self.arena, self.half = template.arena, template.half
+        self._authors = template.observation == "authors"
         self._radius2 = template.radius ** 2
         self._step_size = template.step_size
         self._boundary_reward = template._boundary_reward
         self._inv_offset = template._inv_offset
+        self._scale = np.array(self.rules.scale)
         self._position = np.zeros((num_envs, 2))
         self._positions = np.zeros((num_envs, n_obj, 2))
         self._present = np.zeros((num_envs, n_obj), dtype=bool)
-        self._inside = np.zeros((num_envs, n_obj), dtype=bool)
 
     def _load(self, i: int) -> None:
         world = self.world
         self._position[i] = world._position
         self._positions[i] = world._positions
         self._present[i] = True
-        self._inside[i] = False
 
     def _move(self, actions, active):
         """``KinematicWorldEnv.step`` for the active envs, up to the automaton."""
@@ -457,24 +469,45 @@ class KinematicVectorEnv(PlanarVectorEnv):
             on &= ~within_boxes(target, self._boxes)
         rewards = np.full(self.num_envs, self._step_reward)
         masks = self._levels.copy()
+        ended = self._world_ended
+        ended[:] = False
         # the authors reject a move off the board: the agent stays and touches nothing
         rewards[active & ~on] += self._boundary_reward
         self._position[on] = target[on]
         offsets = self._positions - self._position[:, None, :]
         inside = self._present & (np.einsum("nij,nij->ni", offsets, offsets) < self._radius2)
         inside &= on[:, None]
+        board, labeller, kinds = self.board, self.labeller, self._kinds
         for i in np.flatnonzero(inside.any(axis=1)).tolist():
-            self._touch(i, inside[i], rewards, masks)
-        self._inside[on] = inside[on]
+            inv = self._inventories[i]
+            j, outcome = board.first_acting(inv, [(j, kinds[j]) for j in np.flatnonzero(inside[i]).tolist()])
+            if outcome is None:
+                continue
+            rewards[i] += outcome.reward
+            ended[i] = outcome.ends_episode
+            if outcome.consumed:
+                self._present[i, j] = False
+            self._levels[i] = labeller.levels(inv)
+            masks[i] = labeller(inv, outcome.gained, -1 if self._by_cell[j] else kinds[j])
+            off = self._inv_offset
+            self._obs[i, off:off + len(inv)] = inv if self._authors else np.asarray(inv) / self._scale
+        if self._cell_bits:
+            cell = np.floor(self._position)
+            for bit, j in self._cell_bits:
+                here = self._present[:, j] & (np.floor(self._positions[:, j]) == cell).all(axis=1)
+                masks[here] |= bit
         self._write_observation(offsets)
         return rewards, masks
 
     def _write_observation(self, offsets: np.ndarray) -> None:
         """``KinematicWorldEnv._write_observation`` for all envs (the inventory is written on
-        touches and resets, the only times it changes)."""
-        obs, n_obj = self._obs, len(self._kinds)
+        acts and resets, the only times it changes)."""
+        obs, n_obj, present = self._obs, len(self._kinds), self._present
+        if self._authors:
+            obs[:, 0:2] = self._position / self.arena
+            obs[:, 2:2 + n_obj] = np.where(present, np.sqrt((offsets ** 2).sum(axis=2)) / self.arena, 0.0)
+            return
         obs[:, 0:2] = self._position / self.half - 1.0
-        present = self._present
         obs[:, 2:2 + 3 * n_obj:3] = np.where(present, offsets[..., 0] / self.arena, 0.0)
         obs[:, 3:3 + 3 * n_obj:3] = np.where(present, offsets[..., 1] / self.arena, 0.0)
         obs[:, 4:4 + 3 * n_obj:3] = present

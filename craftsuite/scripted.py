@@ -228,6 +228,16 @@ class KinematicScriptedPolicy(ScriptedPolicy):
     end touches no object that would change the automaton state.
     """
 
+    def __call__(self, observation=None):
+        target = self.planner.next_kind_in(self.env)
+        if target is None and self.env.board.ends_by_tile:
+            # the objective may be met before the episode ends (the authors' at_home is a
+            # cell, their home a disc): go on to a tile that ends it
+            inv = self.env.inventory_counts
+            target = next((t.kind for t in self.env.board.tiles
+                           if t.ends_episode and self.env.board.act(list(inv), t.kind)), None)
+        return self.toward(target)
+
     def __init__(self, env):
         super().__init__(env)
         axis = np.linspace(-1.0, 1.0, 25)
@@ -253,13 +263,18 @@ class KinematicScriptedPolicy(ScriptedPolicy):
             aims = e._positions[goals]
             # objects on the board's edge (x or y = 0): aim 1e-4 inside, or the float32 action's
             # rounding (~1e-7 here) could end the jump just off the board, rejecting the move
-            aim = np.clip(aims[np.abs(aims - pos).max(axis=1).argmin()], 1e-4, e.arena - 1e-4)
+            # (and 1e-3 up and right of the object, so that it ends in the object's cell, not
+            # rounded down into the one below: a cell can be a label)
+            aim = np.clip(aims[np.abs(aims - pos).max(axis=1).argmin()] + 1e-3, 1e-4, e.arena - 1e-4)
             if np.abs(aim - pos).max() <= e.step_size:  # in reach: land on it
                 return ((aim - pos) / e.step_size).astype(np.float32)
         ends = pos + e.step_size * self._moves.astype(np.float64)
         ok = (ends >= 0).all(axis=1) & (ends < e.arena).all(axis=1) & ~e._in_obstacle(ends)
         if len(avoid):
             ok &= (np.linalg.norm(ends[:, None, :] - avoid[None, :, :], axis=2) >= e.radius + 0.05).all(axis=1)
+        for i in unsafe:  # a place labelled by its cell is arrived at anywhere in the cell
+            if e.board.tiles[kinds[i]].by_cell:
+                ok &= (np.floor(ends) != np.floor(e._positions[i])).any(axis=1)
         if not ok.any():
             return np.zeros(2, dtype=np.float32)
         if len(goals):

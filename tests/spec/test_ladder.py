@@ -22,7 +22,7 @@ BUILTIN_IDS = [i for i in craftsuite.registered_ids() if parse_id(i)[0] in BUILT
 def test_the_ladder_climbs_from_reach_to_the_paper_tasks():
     names = [s.name for s in ladder()]
     assert names[:3] == ["Reach", "FirstWood", "FirstTool"]
-    assert set(names[3:]) == {"BlindCraftsman", "BlindCraftsmanObstacles", "DungeonQuest", "DiamondMine"}
+    assert set(names[3:]) == {"BlindCraftsman", "BlindCraftsmanObstacles", "DungeonQuest", "DiamondMine", "GoldMine"}
     levels = [LEVELS.index(s.level) for s in ladder()]
     assert levels == sorted(levels)  # easiest first
     assert "calibration" in BUILTIN["Reach"].tags

@@ -96,7 +96,7 @@ def tasks_page(episodes: int = 100, progress: bool = True) -> str:
         "",
         "The task ladder, easiest rung first. Every task is a TOML spec in `tasks/` and is registered in",
         "every world: `CraftSuite/<Task>-Grid7-v0`, `-Grid10-v0` (the grids), `-Cont-v0` (MuJoCo) and",
-        "`-Kinematic-v0` (the authors' kinematic toy: jumps of 3 x the action, 1000-step episodes). Tags",
+        "`-Kinematic-v0` (the authors' kinematic toy and rules: jumps of 3 x the action, 1000-step episodes). Tags",
         "select rungs (`craftsuite tasks --tag easy`, a suite's `tags`): a difficulty (`easy`, `medium`,",
         "`hard`), `calibration` for the rung any algorithm should pass before its results above mean",
         "anything, `paper` for the paper's tasks.",

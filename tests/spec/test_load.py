@@ -39,8 +39,8 @@ def write(tmp_path, text, name="treasure.toml"):
 
 def test_builtin_specs():
     specs = builtin_specs()
-    assert set(specs) == {"Reach", "FirstWood", "FirstTool",
-                          "BlindCraftsman", "BlindCraftsmanObstacles", "DungeonQuest", "DiamondMine"}
+    assert set(specs) == {"Reach", "FirstWood", "FirstTool", "BlindCraftsman", "BlindCraftsmanObstacles",
+                          "DungeonQuest", "DiamondMine", "GoldMine"}
     bc = specs["BlindCraftsman"]
     assert bc.proposition_names == ("wood", "factory", "tools3", "home")
     assert bc.inventory == ("wood", "tools")
@@ -92,7 +92,30 @@ BAD = [
     (('name = "Treasure"', 'name = "Treasure"\ntags = ["easy", "easy"]'), "tags", "lists a tag twice"),
     (("[grid]", "[continuous]\ncontrol_period = 0\n[grid]"), "continuous.control_period", "must be > 0 seconds"),
     (("[grid]", "[continuous]\ncontrol_period = -0.25\n[grid]"), "continuous.control_period", "must be > 0"),
+    (("[places.trap]", "[places.trap]\nkinematic = { reward = \"lots\" }"), "places.trap.kinematic.reward",
+     "must be a number"),
+    (("[places.trap]", "[places.trap]\nkinematic = { label = \"near\" }"), "places.trap.kinematic.label",
+     "must be 'acts' or 'cell'"),
+    (("count = 2", "count = 2\nkinematic = { label = \"cell\" }"), "items.coin.kinematic.label",
+     "only a place can be labelled by its cell"),
+    (("[places.trap]", "[places.trap]\nkinematic = { ends = true }"), "places.trap.kinematic", "unknown key(s) ['ends']"),
+    (("[places.trap]", "[places.trap]\nkinematic = { requires = { gem = 1 } }"), "places.trap.kinematic.requires",
+     "unknown inventory name 'gem'"),
+    (('trap = { arrived = "trap" }', 'trap = { exactly = { coin = 0 } }'), "propositions.trap.exactly.coin",
+     "must be a positive integer"),
 ]
+
+
+def test_exactly_is_a_level_and_kinematic_tables_round_trip():
+    from craftsuite.labelling import Labeller
+
+    spec = builtin_specs()["GoldMine"]
+    labeller = Labeller(spec)
+    inv = [0, 0, 2, 0]  # gold, motherlode, silver, copper
+    assert labeller.names(labeller.levels(inv)) == ("s2",)  # true while holding exactly 2, not 1
+    home = spec.places[0].kinematic
+    assert home.requires == {"silver": 10} and home.ends_episode and home.label == "cell"
+    assert load_spec(spec.to_data()).digest() == spec.digest()
 
 
 @pytest.mark.parametrize("edit, field, problem", BAD, ids=[b[1] + ":" + b[2][:20] for b in BAD])

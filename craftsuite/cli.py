@@ -285,7 +285,7 @@ def _student(args) -> int:
 def _transfer(args) -> int:
     import dataclasses
 
-    from .ids import CONT, world_kind
+    from .ids import CONT, KINEMATIC, world_kind
     from .provenance import command_line
     from .suites import SUITES, transfer
 
@@ -309,6 +309,10 @@ def _transfer(args) -> int:
         changes["teacher_hyperparameters"] = {**suite.teacher_hyperparameters, **dqn}
     if args.env is not None:
         changes["cont_world_kwargs"] = _json_object(args.env, "--env")
+    if args.board_size is not None:
+        if KINEMATIC not in worlds:
+            raise ValueError(f"--board-size sets the kinematic board ({KINEMATIC}); these worlds have none: {worlds}")
+        changes["kinematic_world_kwargs"] = {} if args.board_size == 7 else {"size": args.board_size}
     if args.td3_hyper is not None:
         changes["td3_hyperparameters"] = {**suite.td3_hyperparameters, **_hyper(args.td3_hyper, "td3", "--td3-hyper")}
     if args.engine is not None:
@@ -498,6 +502,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--eval-every", type=_positive, help="override the evaluation interval")
     p.add_argument("--env", help="JSON gymnasium.make keywords of the MuJoCo students' world (replaces the suite's), "
                    "e.g. '{\"frame_skip\": 2, \"max_episode_steps\": 1000}'; the leaderboard names them")
+    p.add_argument("--board-size", type=int, choices=(7, 10), help="the kinematic board's side (default 7; the "
+                   "authors' distilled Blind Craftsman student ran on 10)")
     p.add_argument("--td3-hyper", help="JSON overrides of the TD3 students' settings, merged over the suite's, e.g. "
                    "'{\"action_noise\": {\"type\": \"persistent\", \"sigma\": 0.6, \"resample\": 0.1}}'")
     p.add_argument("--dqn-hyper", help="JSON overrides of the DQN settings of the grid students and the teachers, "

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .configs import StudentConfig, TeacherConfig
-from .ids import CONT, file_stem, world_kind
+from .ids import CONT, KINEMATIC, file_stem, world_kind
 from .methods import METHODS, check_methods, methods_for
 from .files import atomic_write
 from .spec import TaskSpec
@@ -72,6 +72,8 @@ class Suite:
     # gymnasium.make keywords of the MuJoCo students' world beyond the registered one; the
     # leaderboard names each in its world label
     cont_world_kwargs: dict = field(default_factory=dict)
+    # the same for the kinematic board (its ``size``)
+    kinematic_world_kwargs: dict = field(default_factory=dict)
     # what trains the students: "population" (the seeds of each cell in one process,
     # craftsuite.population) or "sb3" (one SB3 agent per run); teachers are SB3 agents
     engine: str = "population"
@@ -127,11 +129,14 @@ class Suite:
                             eval_every=self.eval_every or max(1, steps // 20), eval_episodes=self.eval_episodes,
                             hyperparameters=dict(self.td3_hyperparameters if cont else self.dqn_hyperparameters),
                             layout_seed=None if cont else self.grid_layout_seed,
-                            # the MuJoCo world's keywords (frame_skip, ...): not the kinematic board's
-                            world_kwargs=dict(self.cont_world_kwargs) if world == CONT else {},
+                            # each continuous world its own keywords (MuJoCo's frame_skip, the board's size)
+                            world_kwargs=dict(self.cont_world_kwargs if world == CONT else
+                                              self.kinematic_world_kwargs if world == KINEMATIC else {}),
                             n_envs=self.td3_n_envs if cont else self.dqn_n_envs,
+                            # hidden from distilled students where the suite says so, but for
+                            # those whose counterfactual replay relabels it (crm-edges)
                             automaton_state=None if self.students_see_automaton or not METHODS[method].distill
-                            else False, engine=self.engine))
+                            or METHODS[method].crm else False, engine=self.engine))
         if not out:
             raise ValueError(f"no method of {list(self.methods)} runs in the worlds {list(self.worlds)} "
                              f"({', '.join(f'{w}: {methods_for(w)}' for w in self.worlds)})")

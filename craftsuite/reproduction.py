@@ -15,7 +15,9 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
-from .files import atomic_write
+import numpy as np
+
+from .files import atomic_path, atomic_write
 from .ids import CONT, KINEMATIC
 
 MIN_SEEDS = 5  # what a panel needs before its verdict is a claim
@@ -48,6 +50,66 @@ FIGURE_5 = (
     Panel("f", "GoldMine", (KINEMATIC, CONT), "td3-dynamic", ("td3",), _CONT_CLAIM),
     Panel("g", "DungeonQuest", (KINEMATIC, CONT), "td3-dynamic", ("td3",), _CONT_CLAIM),
 )
+
+
+def authors_curves() -> dict[tuple[str, str], list[tuple[int, float]]]:
+    """The authors' published TD3 training curves (one seed per method, their logs binned
+    into 100 spans: ``assets/authors_td3_returns.csv``), by (task, method): (transitions,
+    mean episode return) pairs."""
+    import csv
+
+    from .paths import assets_dir
+
+    curves: dict[tuple[str, str], list[tuple[int, float]]] = {}
+    with (assets_dir() / "authors_td3_returns.csv").open(newline="") as f:
+        for row in csv.DictReader(f):
+            curves.setdefault((row["task"], row["method"]), []).append((int(row["transitions"]), float(row["return"])))
+    return curves
+
+
+def plot_against_authors(students_root, out, entries, task: str, world: str) -> Path | None:
+    """Return per training episode against transitions, ours (mean over seeds, the last 10%
+    of the budget before each point, as the leaderboard's curves) beside the authors'
+    published curves, on their axis (20M transitions) and on ours; None when they published
+    none for the task."""
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import EngFormatter
+
+    from .leaderboard import _smoothed
+    from .runs import read_csv
+
+    theirs = {m: c for (t, m), c in authors_curves().items() if t == task}
+    if not theirs or not entries:
+        return None
+    budget = max(e.budget for e in entries)
+    grid = np.linspace(budget / 50, budget, 50)
+    fig = Figure(figsize=(11, 3.6))
+    axes = fig.subplots(1, 2)
+    colors = {}
+    for e in entries:
+        series = np.array([_smoothed([(int(r["step"]), float(r["return"])) for r in
+                                      read_csv(Path(students_root) / name / "episodes.csv")], grid)
+                           for name in e.runs])
+        mean = np.nanmean(series, axis=0) if len(series) else np.full(len(grid), np.nan)
+        for ax in axes:
+            line, = ax.plot(grid, mean, "-", color=colors.get(e.method),
+                            label=f"{e.method}, CraftSuite ({len(e.runs)} seeds)")
+            colors[e.method] = line.get_color()
+    for method, curve in sorted(theirs.items()):
+        x, y = np.array(curve, dtype=float).T
+        for ax, keep in ((axes[0], x > 0), (axes[1], x <= budget * 1.05)):
+            ax.plot(x[keep], y[keep], ":", marker=".", color=colors.get(method), label=f"{method}, authors (1 seed)")
+    axes[0].set(title="on the authors' axis", xlabel="transitions", ylabel="return per episode")
+    axes[1].set(title="on this run's budget", xlabel="transitions")
+    axes[0].legend(fontsize=7)
+    for ax in axes:
+        ax.xaxis.set_major_formatter(EngFormatter(sep=""))
+    fig.suptitle(f"{task} ({world}): return per training episode")
+    fig.tight_layout()
+    path = Path(out) / f"returns-{task}-{world.replace(':', '').replace(' ', '').replace('=', '')}.png"
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110)
+    return path
 
 
 def verdict(distilled, baseline, metric: str = "auc") -> str:
@@ -132,6 +194,11 @@ def write_report(run_dir, path) -> Path:
             plot = curves.get(f"curves-{panel.task}-{world}")
             if plot is not None:
                 body += [f"![{panel.letter}: {panel.task}, {world}]({plot.relative_to(path.parent).as_posix()})", ""]
+            if world == KINEMATIC:  # the world the authors' continuous curves come from
+                returns = plot_against_authors(students, images, [entries[m] for m in ran], panel.task, world)
+                if returns is not None:
+                    body += [f"![{panel.letter}: returns beside the authors']"
+                             f"({returns.relative_to(path.parent).as_posix()})", ""]
     lines += ["## Panels", "", *summary, "",
               "AUC: the mean greedy success over a run's evaluations; return: the mean training-episode return "
               "over the last 10% of a run (the paper's figure plots reward per episode). *Ahead* / *behind*: the "

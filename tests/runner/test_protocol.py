@@ -172,6 +172,19 @@ def test_a_method_that_cannot_go_without_the_automaton_state_is_refused(tmp_path
                                 seeds=1)
     for c in suite.student_configs(tmp_path):
         assert c.product == (METHODS[c.method].product and not METHODS[c.method].distill)
+    # ... and the counterfactual distilled students theirs too: their replay relabels it
+    suite = dataclasses.replace(SUITES["transfer"], students_see_automaton=False, tasks=("BlindCraftsman",), seeds=1)
+    edges = [c for c in suite.student_configs(tmp_path) if c.method in ("crm-edges", "td3-crm-edges")]
+    assert edges and all(c.automaton_state is None for c in edges)
+
+
+def test_board_size_reaches_the_kinematic_students_only(tmp_path, capsys):
+    suite = dataclasses.replace(SUITES["paper"], tasks=("BlindCraftsman",), tags=(), seeds=1,
+                                worlds=("Cont", "Kinematic"), kinematic_world_kwargs={"size": 10})
+    worlds = {c.world: c.world_kwargs for c in suite.student_configs(tmp_path)}
+    assert worlds == {"Cont": {}, "Kinematic": {"size": 10}}
+    assert main(["transfer", "--suite", "quick", "--board-size", "10", "--out", str(tmp_path / "q")]) == 2
+    assert "--board-size sets the kinematic board" in capsys.readouterr().err and not (tmp_path / "q").exists()
 
 
 def test_the_paper_suite_runs_the_authors_protocol(tmp_path):

@@ -90,7 +90,9 @@ def plot_against_authors(students_root, out, entries, task: str, world: str) -> 
         series = np.array([_smoothed([(int(r["step"]), float(r["return"])) for r in
                                       read_csv(Path(students_root) / name / "episodes.csv")], grid)
                            for name in e.runs])
-        mean = np.nanmean(series, axis=0) if len(series) else np.full(len(grid), np.nan)
+        mean = np.full(len(grid), np.nan)
+        valid = ~np.isnan(series).all(axis=0)  # before a run's first episode: no value yet
+        mean[valid] = np.nanmean(series[:, valid], axis=0)
         for ax in axes:
             line, = ax.plot(grid, mean, "-", color=colors.get(e.method),
                             label=f"{e.method}, CraftSuite ({len(e.runs)} seeds)")

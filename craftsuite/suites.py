@@ -189,7 +189,7 @@ SUITES = {s.name: s for s in (
           tags=("calibration", "medium"), worlds=("Cont",), methods=("td3", "td3-dynamic-edges"), seeds=2,
           budgets={"Cont": {"easy": 200_000, "medium": 800_000}}, **TD3_REGIME),
     Suite("standard", "every rung x the paper's methods and baselines, 5 seeds (about 3 hours on 2 cores with "
-          "SB3 agents; its students' rates with populations project 1.1 h)",
+          "SB3 agents; its students' rates with populations project 1.2 h)",
           tags=("easy", "medium", "hard"), worlds=("Grid10", "Cont"), methods=PAPER_METHODS, seeds=5,
           budgets={"Cont": {"easy": 250_000, "medium": 800_000, "hard": 60_000},
                    "Grid": {"easy": 30_000, "medium": 60_000, "hard": 60_000}},

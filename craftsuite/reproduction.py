@@ -76,7 +76,7 @@ def plot_against_authors(students_root, out, entries, task: str, world: str) -> 
     from matplotlib.figure import Figure
     from matplotlib.ticker import EngFormatter
 
-    from .leaderboard import _smoothed
+    from .leaderboard import _file_part, _smoothed
     from .runs import read_csv
 
     theirs = {m: c for (t, m), c in authors_curves().items() if t == task}
@@ -109,7 +109,7 @@ def plot_against_authors(students_root, out, entries, task: str, world: str) -> 
         ax.xaxis.set_major_formatter(EngFormatter(sep=""))
     fig.suptitle(f"{task} ({world}): return per training episode")
     fig.tight_layout()
-    path = Path(out) / f"returns-{task}-{world.replace(':', '').replace(' ', '').replace('=', '')}.png"
+    path = Path(out) / f"returns-{task}-{_file_part(world)}.png"
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=110)
     return path

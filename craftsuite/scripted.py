@@ -186,11 +186,8 @@ class ContinuousScriptedPolicy(ScriptedPolicy):
                 return np.zeros(2, dtype=np.float32)
             away = pos - e._positions[near[0]]
             return self._steer(away / (np.linalg.norm(away) + 1e-9) * TOP_SPEED, vel)
-        # on the board an item touched at capacity is lost: full items are unsafe too
-        full = {k for k, obj in enumerate(e.task.objects[:e.rules.n_items])
-                if obj.capacity is not None and inv[e.rules.inventory_names.index(obj.name)] >= obj.capacity}
         unsafe = [i for i in np.flatnonzero(present)
-                  if (kinds[i] != target and not self.planner.harmless(w, inv, int(kinds[i]))) or kinds[i] in full]
+                  if kinds[i] != target and not self.planner.harmless(w, inv, int(kinds[i]))]
         blocked = self.static.copy()
         for i in unsafe:
             ox, oy = e._positions[i]
@@ -228,6 +225,12 @@ class KinematicScriptedPolicy(ScriptedPolicy):
     end touches no object that would change the automaton state.
     """
 
+    def __init__(self, env):
+        super().__init__(env)
+        axis = np.linspace(-1.0, 1.0, 25)
+        # float32, the actions' type: ends are checked where the world will put them
+        self._moves = np.array([(x, y) for x in axis for y in axis], dtype=np.float32)
+
     def __call__(self, observation=None):
         target = self.planner.next_kind_in(self.env)
         if target is None and self.env.board.ends_by_tile:
@@ -238,12 +241,6 @@ class KinematicScriptedPolicy(ScriptedPolicy):
                            if t.ends_episode and self.env.board.act(list(inv), t.kind)), None)
         return self.toward(target)
 
-    def __init__(self, env):
-        super().__init__(env)
-        axis = np.linspace(-1.0, 1.0, 25)
-        # float32, the actions' type: ends are checked where the world will put them
-        self._moves = np.array([(x, y) for x in axis for y in axis], dtype=np.float32)
-
     def toward(self, target: int | None) -> np.ndarray:
         e = self.env
         if target is None:
@@ -251,9 +248,9 @@ class KinematicScriptedPolicy(ScriptedPolicy):
         pos, w, inv = e.agent_position, e.automaton_state, tuple(e.inventory_counts)
         kinds = np.array(e._kinds)
         present = e._present
-        # on the board an item touched at capacity is lost: full items are unsafe too
-        full = {k for k, obj in enumerate(e.task.objects[:e.rules.n_items])
-                if obj.capacity is not None and inv[e.rules.inventory_names.index(obj.name)] >= obj.capacity}
+        # on the board an item touched at capacity is lost: full items are unsafe too (an
+        # item's inventory slot is its kind: spec.inventory lists the items first)
+        full = {k for k in range(e.rules.n_items) if e.board.capacity[k] is not None and inv[k] >= e.board.capacity[k]}
         unsafe = [i for i in np.flatnonzero(present)
                   if (kinds[i] != target and not self.planner.harmless(w, inv, int(kinds[i]))) or kinds[i] in full]
         # a place acts on entering: an instance we stand in counts once we have left it

@@ -48,6 +48,7 @@ class Act:
     gained: int
     consumed: bool
     ends_episode: bool
+    arrived: int  # the kind that acted, as ``Labeller`` reads ``arrived``; -1 for a place labelled by its cell
 
 
 class BoardRules:
@@ -114,7 +115,7 @@ class BoardRules:
                     gained |= 1 << s
                 if not repeat:
                     break
-        return Act(tile.reward, gained, tile.consumable, tile.ends_episode)
+        return Act(tile.reward, gained, tile.consumable, tile.ends_episode, -1 if tile.by_cell else kind)
 
     def first_acting(self, inv: list[int], inside) -> tuple[int, Act] | tuple[int, None]:
         """Slot and outcome of the first object within reach (``inside``: (slot, kind) pairs in

@@ -89,7 +89,7 @@ class KinematicWorldEnv(PlanarWorld):
     def __init__(self, task: str | TaskSpec = "BlindCraftsman", render_mode: str | None = None,
                  width: int = 240, height: int = 240, status_panel: bool = False, size: int = 7,
                  observation: str = "authors"):
-        if size not in SIZES or isinstance(size, bool):
+        if size not in SIZES:
             raise ValueError(f"size={size!r}: the kinematic board is {' or '.join(map(str, SIZES))} units a side")
         if observation not in OBSERVATIONS:
             raise ValueError(f"observation={observation!r}: use one of {', '.join(map(repr, OBSERVATIONS))}")
@@ -210,7 +210,7 @@ class KinematicWorldEnv(PlanarWorld):
         x, y = self.planar_action(action, "displacement")
         target = self._position + self.step_size * np.array([x, y])
         reward = self._step_reward
-        gained, acted, ended = 0, -1, False
+        mask, ended = self._level_mask, False
         if self.on_board(target):
             self._position = target
             offsets = self._positions - target
@@ -220,21 +220,18 @@ class KinematicWorldEnv(PlanarWorld):
                 j, outcome = self.board.first_acting(inv, [(j, self._kinds[j]) for j in np.flatnonzero(inside)])
                 if outcome is not None:
                     reward += outcome.reward
-                    gained, ended = outcome.gained, outcome.ends_episode
-                    acted = self._kinds[j] if not self.board.tiles[self._kinds[j]].by_cell else -1
+                    ended = outcome.ends_episode
                     if outcome.consumed:
                         self._consume(j)
                         inside[j] = False
                     self._level_mask = self.labeller.levels(inv)
+                    mask = self.labeller(inv, outcome.gained, outcome.arrived)
                     self._write_inventory()
             self._inside = inside
         else:  # the authors reject the whole move: the agent stays and touches nothing
             reward += self._boundary_reward
-        if gained or acted >= 0:
-            mask = self.labeller(self.inventory_counts, gained, acted)
-        else:
-            mask = self._level_mask
-        mask |= self.cell_mask()
+        if self._cell_bits:
+            mask |= self.cell_mask()
         self._write_observation()
         bonus, done, info = self.tracker.advance(mask)
         if self.board.ends_by_tile:  # the tiles pay and end the episode, as the authors' do

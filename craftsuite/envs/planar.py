@@ -1,8 +1,10 @@
 """What the two continuous worlds share: objects in the plane, touched within a radius.
 
 The MuJoCo world (``ContinuousWorldEnv``) and the kinematic board (``KinematicWorldEnv``)
-differ in how the agent moves; what it touches, and how the task's rules read a touch, is
-one piece of code here, so the worlds cannot drift apart in their labels or rewards.
+share their object slots, actions, obstacle geometry and views here. What a touch does
+differs: the MuJoCo world reads it through the task's ``Rules`` (``touch_slots``, shared
+with its vector env, as the grids read theirs); the kinematic board follows the authors'
+tiles (``envs/board.py``).
 """
 
 from __future__ import annotations
@@ -42,7 +44,7 @@ def touch_slots(rules, inv: list[int], kinds, is_item, inside: np.ndarray, was_i
     is consumed): items are touched while within reach, places act on entering their zone
     (not ``was_inside``). ``consume(j)`` removes slot j; ``inv`` changes in place. Returns
     (reward plus the touches', inventory bits gained, place kind entered or -1, whether any
-    rule acted). One piece of code for the continuous worlds and their vector envs."""
+    rule acted). One piece of code for the MuJoCo world and its vector env."""
     gained, arrived, touched = 0, -1, False
     for j in np.flatnonzero(inside).tolist():
         kind = kinds[j]

@@ -379,9 +379,11 @@ class GridVectorEnv(CraftVectorEnv):
 
 class PlanarVectorEnv(CraftVectorEnv):
     """What the kinematic board's and the MuJoCo world's vector envs share, as their single
-    worlds share ``PlanarWorld``: two numbers an action (``WHAT`` they are), and the rules'
-    reading of a touch. Subclasses keep (N, n_objects) ``_present``/``_inside`` arrays and
-    define ``_remove(i, j)``: what consuming slot j of env i changes besides ``_present``."""
+    worlds share ``PlanarWorld``: two numbers an action (``WHAT`` they are); and for the
+    MuJoCo world, the rules' reading of a touch (``_touch``; the board acts through its
+    ``BoardRules``). Subclasses keep (N, n_objects) ``_present`` arrays (and ``_inside``
+    where ``_touch`` is used) and define ``_remove(i, j)``: what consuming slot j of env i
+    changes besides ``_present``."""
 
     WHAT = "displacement"
 
@@ -441,7 +443,6 @@ class KinematicVectorEnv(PlanarVectorEnv):
         self.board = template.board
         self._objective_ends = not self.board.ends_by_tile
         self._kinds = list(template._kinds)
-        self._by_cell = [self.board.tiles[k].by_cell for k in self._kinds]
         self._cell_bits = template._cell_bits
         self._boxes = template._obstacles
         self.arena, self.half = template.arena, template.half
@@ -488,7 +489,7 @@ class KinematicVectorEnv(PlanarVectorEnv):
             if outcome.consumed:
                 self._present[i, j] = False
             self._levels[i] = labeller.levels(inv)
-            masks[i] = labeller(inv, outcome.gained, -1 if self._by_cell[j] else kinds[j])
+            masks[i] = labeller(inv, outcome.gained, outcome.arrived)
             off = self._inv_offset
             self._obs[i, off:off + len(inv)] = inv if self._authors else np.asarray(inv) / self._scale
         if self._cell_bits:

@@ -287,7 +287,8 @@ def _transfer(args) -> int:
 
     from .ids import CONT, KINEMATIC, world_kind
     from .provenance import command_line
-    from .suites import SUITES, transfer
+    from .suite_runner import transfer
+    from .suites import SUITES
 
     if args.suite not in SUITES:
         raise KeyError(f"unknown suite {args.suite!r}; suites: {sorted(SUITES)}")

@@ -1,36 +1,21 @@
-"""Benchmark suites and the transfer pipeline: teachers, distillation, students, leaderboard.
+"""Benchmark suites as data: which tasks, worlds, methods, seeds and budgets a suite runs.
 
-A ``Suite`` is data: rungs of the task ladder (by tag or name), student worlds, methods,
-seeds, a budget per rung level and each world's collection regime. ``transfer`` runs one
-end to end under an output directory::
-
-    <out>/teachers/teacher-<Task>-Grid7-s0-<key>/     teacher.zip, table.npz, evals.csv
-    <out>/students/student-<Task>-Cont-<method>-s<seed>-<key>/
-    <out>/leaderboard.md, leaderboard.csv, curves-<Task>-<world>[-<settings>].png, profile-<world>.png,
-          best-<...>.mp4
-
-Teachers and students share one pool of local processes (``workers`` at a time) or, with
-``ray``, a Ray cluster (``"local"`` starts one in-process; a real cluster needs ``out`` on
-a filesystem every node sees): students that need no teacher start at once, the others
-as soon as their rung's teacher is distilled. Runs that already finished are reused.
+A ``Suite`` row names rungs of the task ladder (by tag or name), student worlds, methods,
+seeds, a budget per rung level and each world's collection regime; ``SUITES`` is the table
+of the named ones. A row gives its teachers' and students' configs (``teachers``,
+``student_configs``); ``craftsuite.suite_runner.transfer`` runs them.
 """
 
 from __future__ import annotations
 
-import dataclasses
-import json
-import os
-import time
-from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from .configs import StudentConfig, TeacherConfig
-from .ids import CONT, KINEMATIC, file_stem, world_kind
+from .ids import CONT, KINEMATIC, world_kind
 from .methods import METHODS, check_methods, methods_for
-from .files import atomic_write
 from .spec import TaskSpec
-from .task_registry import carried, ladder, resolve_task
+from .task_registry import ladder, resolve_task
 
 
 @dataclass(frozen=True)
@@ -108,7 +93,7 @@ class Suite:
 
     def student_configs(self, teacher_root) -> list[StudentConfig]:
         """Every student run; a distilled student reads its rung's teacher's table from
-        under ``teacher_root`` (where ``transfer`` trains it first)."""
+        under ``teacher_root`` (where ``suite_runner.transfer`` trains it first)."""
         check_methods(self.methods)
         teachers = self.teachers()
         out = []
@@ -213,285 +198,3 @@ SUITES = {s.name: s for s in (
                                                                     "buffer_size": 200_000},
           **DQN_REGIME),
 )}
-
-
-def _population_job(configs: list[dict], root: str, task: str | dict | None = None, device: str = "cpu") -> list[str]:
-    """The seeds of one cell in a worker process, as one population (``craftsuite.population``)."""
-    _start_worker(task)
-    from .population import train_population
-
-    return [str(p) for p in train_population([StudentConfig(**c) for c in configs], root, progress=False,
-                                             device=device)]
-
-
-def cells(configs: list[StudentConfig]) -> list[list[StudentConfig]]:
-    """The population engine's jobs: configs equal but for the seed, together, in order;
-    each SB3 config alone."""
-    groups: dict[str, list[StudentConfig]] = {}
-    for c in {c.run_name(): c for c in configs}.values():  # a run asked for twice is one run
-        key = json.dumps(c.cell(), sort_keys=True) if c.engine == "population" else c.run_name()
-        groups.setdefault(key, []).append(c)
-    return list(groups.values())
-
-
-def _student_job(config: dict, root: str, task: str | dict | None = None) -> str:
-    """One student run in a worker process (one thread: the workers share the cores);
-    ``task``: its task as ``task_registry.carried`` gives it (a user task's data)."""
-    _start_worker(task)
-    from .training import train_student  # torch: only where runs train, not to list the suites
-
-    return str(train_student(StudentConfig(**config), root, progress=False))
-
-
-def _teacher_job(config: dict, root: str, task: str | dict | None = None) -> str:
-    """One teacher run (training, then distillation) in a worker process."""
-    _start_worker(task)
-    from .training import train_teacher
-
-    return str(train_teacher(TeacherConfig(**config), root, progress=False))
-
-
-def _start_worker(task: str | dict | None) -> None:
-    """One torch thread; the ids registered in this process, with the run's task if it is a
-    user task (a spec file the driver read: a worker, or a Ray node, may not see the file)."""
-    import torch
-
-    torch.set_num_threads(1)
-    import craftsuite  # (registers the built-in ids in this process)
-
-    if isinstance(task, dict):
-        craftsuite.register_task(task)
-
-
-def _carried(task: str) -> str | dict:
-    return carried(resolve_task(task))
-
-
-def _exit_with(driver: int, period: float = 0.5) -> None:
-    """Exit this worker soon after ``driver``, the process that started it, is gone.
-
-    Killing ``craftsuite transfer`` with SIGTERM or SIGKILL gives it no chance to stop its
-    workers; without this they would train on unseen. Their checkpoints let a rerun resume.
-    """
-    import threading
-
-    def watch():
-        while os.getppid() == driver:  # an orphan is re-parented: its parent pid changes
-            time.sleep(period)
-        os._exit(1)
-
-    threading.Thread(target=watch, name="craftsuite-driver-watch", daemon=True).start()
-
-
-class _Workers:
-    """Where jobs run: local worker processes, or a Ray cluster; ``submit`` gives a Future either way."""
-
-    def __init__(self, jobs: int, workers: int | None, ray: str | None):
-        self.ray, self.started, self.remote = None, False, {}
-        if ray is not None:
-            try:
-                import ray as ray_module
-            except ImportError:
-                raise RuntimeError("--ray needs Ray: pip install 'craftsuite[ray]'") from None
-            self.ray, self.started = ray_module, not ray_module.is_initialized()
-            if self.started:
-                ray_module.init(address=None if ray == "local" else ray, include_dashboard=False,
-                                log_to_driver=False, ignore_reinit_error=True)
-        else:
-            import multiprocessing as mp
-
-            self.pool = ProcessPoolExecutor(workers or max(1, min(jobs, os.cpu_count() or 1)),
-                                            mp_context=mp.get_context("spawn"), initializer=_exit_with,
-                                            initargs=(os.getpid(),))
-
-    def submit(self, job, *args) -> Future:
-        if self.ray is not None:
-            if job not in self.remote:
-                self.remote[job] = self.ray.remote(num_cpus=1)(job)
-            return self.remote[job].remote(*args).future()
-        return self.pool.submit(job, *args)
-
-    def close(self, abort: bool = False) -> None:
-        """Wait for the jobs; or, with ``abort`` (a job failed, or the driver was interrupted),
-        stop them now: every run resumes from its last checkpoint when asked for again."""
-        if self.ray is None:
-            processes = list((getattr(self.pool, "_processes", None) or {}).values())  # shutdown forgets them
-            self.pool.shutdown(wait=not abort, cancel_futures=True)
-            if abort:  # shutdown alone would still let each running job finish (hours, in a suite)
-                for process in processes:
-                    process.terminate()
-        elif self.started:
-            self.ray.shutdown()
-
-
-def run_students(configs: list[StudentConfig], root, workers: int | None = None, ray: str | None = None,
-                 progress: bool = True, teachers: dict[str, TeacherConfig] | None = None, teacher_root=None,
-                 log=print, device: str = "cpu") -> list[Path]:
-    """Run students in parallel (processes or Ray) with one progress bar over all their
-    transitions: one job per SB3 run, one per population (the seeds of a cell, ``cells``).
-    With ``teachers`` (by task, trained under ``teacher_root``), each teacher runs first in
-    the same pool and its task's distilled students start when it is done; the other
-    students start at once. ``device`` is the populations' torch device."""
-    from tqdm import tqdm
-
-    root = Path(root)
-    root.mkdir(parents=True, exist_ok=True)
-    teachers = teachers or {}
-    jobs = cells(configs)
-    waiting = {task: [job for job in jobs if job[0].task == task and METHODS[job[0].method].needs_table]
-               for task in teachers}
-    ready = [job for job in jobs if not (job[0].task in teachers and METHODS[job[0].method].needs_table)]
-    total = sum(c.steps for c in configs)
-    workers_ = _Workers(len(jobs) + len(teachers), workers, ray)
-    with tqdm(total=total, desc=f"{len(configs)} student runs", unit="step", disable=not progress,
-              dynamic_ncols=True) as bar:
-        runs = [(c, root / c.run_name()) for c in configs]  # named once: a name hashes the run's settings
-
-        def submit(job: list[StudentConfig]) -> Future:
-            if job[0].engine == "population":
-                return workers_.submit(_population_job, [dataclasses.asdict(c) for c in job], str(root),
-                                       _carried(job[0].task), device)
-            return workers_.submit(_student_job, dataclasses.asdict(job[0]), str(root), _carried(job[0].task))
-
-        def poll():
-            done = 0
-            for c, run in runs:
-                if (run / "result.json").exists():
-                    done += c.steps
-                elif (run / "progress.json").exists():
-                    try:
-                        done += json.loads((run / "progress.json").read_text())["step"]
-                    except (ValueError, KeyError, OSError):
-                        pass
-            bar.update(done - bar.n)
-
-        try:
-            pending = {workers_.submit(_teacher_job, dataclasses.asdict(t), str(teacher_root), _carried(t.task)): task
-                       for task, t in teachers.items()}
-            futures = {id(job): (job, submit(job)) for job in ready}
-            while pending or not all(f.done() for _, f in futures.values()):
-                time.sleep(0.5)
-                poll()
-                for future in [f for f in pending if f.done()]:
-                    task = pending.pop(future)
-                    path = Path(future.result())  # re-raises a teacher's error
-                    result = json.loads((path / "result.json").read_text())
-                    reached = "reached" if result["reached_target"] else "did NOT reach"
-                    (bar.write if progress else log)(
-                        f"teacher {task}: {result['steps']:,} steps, greedy success {result['success']:.2f} "
-                        f"({reached} {teachers[task].target_success:.0%}) -> {path}")
-                    for job in waiting.pop(task):
-                        futures[id(job)] = (job, submit(job))
-                for _, future in futures.values():
-                    if future.done() and future.exception() is not None:
-                        raise future.exception()  # a worker's error, at once rather than at the end
-            paths = {}
-            for job, future in futures.values():
-                result = future.result()
-                for c, path in zip(job, result if isinstance(result, list) else [result]):
-                    paths[c.run_name()] = path
-        except BaseException:
-            workers_.close(abort=True)
-            raise
-        workers_.close()
-        poll()
-    return [Path(paths[c.run_name()]) for c in configs]
-
-
-@dataclass(frozen=True)
-class TransferResult:
-    out: Path
-    teachers: dict
-    students: list
-    leaderboard: Path
-    plots: list
-    video: Path | None
-
-
-def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None = None, video: bool = True,
-             progress: bool = True, log=print, command: list[str] | None = None, device: str = "cpu") -> TransferResult:
-    """The suite end to end: teachers and distillation, students, leaderboard, plots, video.
-
-    ``device``: the torch device of the population engine's students (``cpu``, ``cuda``).
-    ``command``: how this run was asked for, as ``provenance.json`` records it (the CLI
-    passes its command line); by default, this Python call."""
-    from . import leaderboard
-    from .provenance import read, record_session, start_session
-
-    if command is None:
-        command = f"python: craftsuite.suites.transfer(suite {suite.name!r}, out {str(out)!r})"
-    session, clock = start_session(command), time.perf_counter()
-    out = Path(out)
-    configs = suite.student_configs(out / "teachers")
-    _check_students(configs, device)  # fail before any training
-    read(out)  # a damaged provenance record, too
-    out.mkdir(parents=True, exist_ok=True)
-    atomic_write(out / "suite.json", json.dumps(dataclasses.asdict(suite), indent=2) + "\n")
-    record_session(out, session, None)  # if this session is killed, its command and commit stay on record
-    teachers = suite.teachers()
-    students = run_students(configs, out / "students", workers=workers, ray=ray, progress=progress,
-                            teachers=teachers, teacher_root=out / "teachers", log=log, device=device)
-    board = leaderboard.build(out / "students")
-    board_md = leaderboard.write(board, out)
-    plots = leaderboard.plot_curves(out / "students", out, board)
-    log("")
-    log(board_md.read_text())
-    movie = None
-    if video:
-        movie = _best_student_video(students, out)
-    record_session(out, session, time.perf_counter() - clock)
-    return TransferResult(out, {task: out / "teachers" / t.run_name() for task, t in teachers.items()},
-                          students, board_md, plots, movie)
-
-
-def _check_students(configs: list[StudentConfig], device: str = "cpu") -> None:
-    """Build each kind of student once, untrained, from scratch (the teachers' tables do not
-    exist yet): a misspelt world setting or algorithm setting (``--env``, ``--td3-hyper``),
-    or a run the population engine cannot train, is named now, not in a worker after the
-    teachers have trained."""
-    import craftsuite  # noqa: F401  (registers the ids)
-
-    from .agents.methods import make_agent
-
-    if any(c.engine == "population" for c in configs):
-        from .population import check_supported
-        from .population.train import check_device
-
-        check_device(device)
-        for c in configs:
-            if c.engine == "population":
-                check_supported(c.method, c.effective()["hyperparameters"])
-
-    kinds = {(c.env_id, c.world, c.n_envs, json.dumps(c.env_kwargs, sort_keys=True),
-              json.dumps(c.hyperparameters, sort_keys=True)) for c in configs}
-    for env_id, world, n_envs, env_kwargs, hyper in kinds:
-        plain = next(m for m in methods_for(world) if not METHODS[m].needs_table)
-        agent = make_agent(plain, env_id, n_envs=n_envs, env_kwargs=json.loads(env_kwargs),
-                           **{**json.loads(hyper), "buffer_size": 16})
-        agent.get_env().close()
-
-
-def _best_student_video(students: list[Path], out: Path) -> Path | None:
-    """A rollout of the best of this suite's student runs (highest final success, then
-    the hardest rung, then return); runs of another config in the same directory are not
-    candidates."""
-    from .rollouts import record_video
-    from .runs import read_csv
-
-    runs = []
-    for run in students:
-        result = run / "result.json"
-        if result.exists():
-            r = json.loads(result.read_text())
-            evals = read_csv(run / "evals.csv")
-            last = evals[-1] if evals else {"success": 0, "return": float("-inf")}
-            level = resolve_task(r["task"]).rung[0]
-            runs.append(((float(last["success"]), level, float(last["return"])), run, r))
-    if not runs:
-        return None
-    _, run, r = max(runs, key=lambda x: x[0])
-    name = f"best-{file_stem(r['env_id'])}-{r['method']}-s{r['seed']}.mp4"
-    rec = record_video(r["env_id"], str(run / r["model"]), 1, str(out / name), seed=10**8,
-                       product=r["product"], progress=False,
-                       env_kwargs={"status_panel": True, **(r.get("env_kwargs") or {})})  # for people
-    return Path(rec.path)

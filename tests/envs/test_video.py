@@ -92,7 +92,7 @@ def test_videos_for_people_carry_the_status_panel(tmp_path, capsys):
 
     from craftsuite.agents.methods import make_agent
     from craftsuite.cli import main
-    from craftsuite.suites import _best_student_video
+    from craftsuite.suite_runner import _best_student_video
 
     env_id = "CraftSuite/DungeonQuest-Grid7-v0"
     plain = gym.make(env_id).unwrapped.frame_shape

@@ -174,7 +174,8 @@ def test_the_command_line_refuses_what_the_engine_cannot_run(argv, message, tmp_
 
 
 def test_suites_train_each_cell_as_one_population():
-    from craftsuite.suites import SUITES, cells
+    from craftsuite.suite_runner import cells
+    from craftsuite.suites import SUITES
 
     configs = SUITES["standard"].student_configs("teachers")
     jobs = cells(configs)

@@ -14,7 +14,8 @@ import pytest
 
 from craftsuite.cli import main
 from craftsuite.runs import read_csv
-from craftsuite.suites import SUITES, run_students
+from craftsuite.suite_runner import run_students
+from craftsuite.suites import SUITES
 from craftsuite.training import StudentConfig
 
 TINY = '{"learning_starts": 100, "buffer_size": 5000}'
@@ -97,7 +98,7 @@ def test_mujoco_keywords_reach_only_the_mujoco_students(tmp_path):
 
 
 def test_transfer_flags_reach_the_suite(tmp_path, monkeypatch):
-    import craftsuite.suites
+    import craftsuite.suite_runner
 
     seen = []
 
@@ -106,9 +107,9 @@ def test_transfer_flags_reach_the_suite(tmp_path, monkeypatch):
     def fake_transfer(suite, out, **_):
         seen.append(suite)
         outs.append(out)
-        return craftsuite.suites.TransferResult(Path(out), {}, [], Path(out) / "leaderboard.md", [], None)
+        return craftsuite.suite_runner.TransferResult(Path(out), {}, [], Path(out) / "leaderboard.md", [], None)
 
-    monkeypatch.setattr(craftsuite.suites, "transfer", fake_transfer)
+    monkeypatch.setattr(craftsuite.suite_runner, "transfer", fake_transfer)
     assert main(["transfer", "--out", str(tmp_path), "--env", '{"frame_skip": 2}',
                  "--td3-hyper", '{"learning_rate": 0.0005}', "--tags", "medium", "--tasks", "Reach"]) == 0
     [suite] = seen
@@ -186,9 +187,9 @@ def test_suite_selection_errors_name_the_problem(tmp_path):
 
 
 def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenance(tmp_path, monkeypatch):
-    from craftsuite import leaderboard, suites
+    from craftsuite import leaderboard, suite_runner
     from craftsuite.provenance import read
-    from craftsuite.suites import transfer
+    from craftsuite.suite_runner import transfer
 
     tiny = dataclasses.replace(SUITES["quick"], tags=("calibration",), seeds=1, student_steps=300, eval_every=150,
                                eval_episodes=1, teacher_max_steps=400, td3_n_envs=2,
@@ -204,7 +205,7 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
     board = result.leaderboard.read_text()
     assert "## Reach (Cont)" in board and "| 300 / " in board and "- `td3-dynamic-edges`:" in board
     [session] = read(tmp_path / "out")
-    assert session["command"] == f"python: craftsuite.suites.transfer(suite 'quick', out {str(tmp_path / 'out')!r})"
+    assert session["command"] == f"python: craftsuite.suite_runner.transfer(suite 'quick', out {str(tmp_path / 'out')!r})"
     assert session["machine"] and "torch" in session["versions"]
     page = leaderboard.write_page([tmp_path / "out"], tmp_path / "docs" / "results.md")
     text = page.read_text()
@@ -221,7 +222,7 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
 
     def killed(*args, **kwargs):
         raise KeyboardInterrupt
-    monkeypatch.setattr(suites, "run_students", killed)
+    monkeypatch.setattr(suite_runner, "run_students", killed)
     with pytest.raises(KeyboardInterrupt):
         transfer(tiny, tmp_path / "out", workers=2, video=False, progress=False, log=lambda *_: None)
     assert [s["seconds"] is None for s in read(tmp_path / "out")] == [False, False, True]
@@ -242,7 +243,7 @@ def test_students_on_a_local_ray_instance(tmp_path):
 
 _DRIVER = """
 import sys
-from craftsuite.suites import run_students
+from craftsuite.suite_runner import run_students
 from craftsuite.training import StudentConfig
 configs = [StudentConfig(method="dqn", world="Grid7", seed=s, steps=1_000_000, eval_every=100_000,
                          hyperparameters={"learning_starts": 100, "buffer_size": 1000}) for s in (0, 1)]

@@ -207,15 +207,15 @@ def test_the_paper_suite_runs_the_authors_protocol(tmp_path):
 
 
 def test_dqn_hyper_reaches_grid_students_and_teachers(tmp_path, monkeypatch):
-    import craftsuite.suites
+    import craftsuite.suite_runner
 
     seen = []
 
     def fake_transfer(suite, out, **_):
         seen.append(suite)
-        return craftsuite.suites.TransferResult(out, {}, [], out, [], None)
+        return craftsuite.suite_runner.TransferResult(out, {}, [], out, [], None)
 
-    monkeypatch.setattr(craftsuite.suites, "transfer", fake_transfer)
+    monkeypatch.setattr(craftsuite.suite_runner, "transfer", fake_transfer)
     assert main(["transfer", "--suite", "paper", "--dqn-hyper", '{"features_extractor": "flatten"}',
                  "--out", str(tmp_path)]) == 0
     [suite] = seen

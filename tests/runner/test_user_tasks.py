@@ -9,7 +9,7 @@ import pytest
 import craftsuite
 from craftsuite import task_registry
 from craftsuite.configs import StudentConfig
-from craftsuite.suites import run_students
+from craftsuite.suite_runner import run_students
 
 
 @pytest.fixture

@@ -94,7 +94,9 @@ class GridScriptedPolicy(ScriptedPolicy):
     def toward(self, target: int | None) -> int:
         """A step towards the nearest object of kind ``target``, through harmless cells."""
         env = self.env
-        size, cells, agent = env.size, env._cells, env._agent
+        size, cells = env.size, env.cells
+        x, y = env.agent_position
+        agent = y * size + x
         if target is None:
             return int(env.np_random.integers(4))
         w, inv = env.automaton_state, tuple(env.inventory_counts)
@@ -176,30 +178,30 @@ class ContinuousScriptedPolicy(ScriptedPolicy):
             return np.zeros(2, dtype=np.float32)
         pos, vel = e.data.qpos[:2].copy(), e.data.qvel[:2].copy()
         w, inv = e.automaton_state, tuple(e.inventory_counts)
-        kinds = np.array(e._kinds)
-        present = e._present
+        objects = e.objects
+        kinds, present, positions = objects.kinds, objects.present, objects.positions
         # a place acts on entering: instances we stand in do not count until we leave them
-        goal_objects = np.flatnonzero((kinds == target) & present & ~e._inside)
+        goal_objects = np.flatnonzero((kinds == target) & present & ~objects.inside)
         if len(goal_objects) == 0:
             near = np.flatnonzero((kinds == target) & present)
             if len(near) == 0:
                 return np.zeros(2, dtype=np.float32)
-            away = pos - e._positions[near[0]]
+            away = pos - positions[near[0]]
             return self._steer(away / (np.linalg.norm(away) + 1e-9) * TOP_SPEED, vel)
         unsafe = [i for i in np.flatnonzero(present)
                   if kinds[i] != target and not self.planner.harmless(w, inv, int(kinds[i]))]
         blocked = self.static.copy()
         for i in unsafe:
-            ox, oy = e._positions[i]
+            ox, oy = positions[i]
             blocked |= (self.cx - ox) ** 2 + (self.cy - oy) ** 2 < (e.radius + 0.3) ** 2
         goal = np.zeros_like(blocked)
         for i in goal_objects:
-            gx, gy = e._positions[i]
+            gx, gy = positions[i]
             goal |= (self.cx - gx) ** 2 + (self.cy - gy) ** 2 < (0.6 * e.radius) ** 2
         path = _grid_path(blocked, goal, self.cell_of(pos)) or _grid_path(self.static, goal, self.cell_of(pos))
         if path is None or len(path) <= self.LOOKAHEAD:
-            dists = np.linalg.norm(e._positions[goal_objects] - pos, axis=1)
-            aim = e._positions[goal_objects[dists.argmin()]]
+            dists = np.linalg.norm(positions[goal_objects] - pos, axis=1)
+            aim = positions[goal_objects[dists.argmin()]]
         else:
             iy, ix = path[self.LOOKAHEAD]
             aim = np.array([self.cx[iy, ix], self.cy[iy, ix]])
@@ -246,18 +248,18 @@ class KinematicScriptedPolicy(ScriptedPolicy):
         if target is None:
             return np.zeros(2, dtype=np.float32)
         pos, w, inv = e.agent_position, e.automaton_state, tuple(e.inventory_counts)
-        kinds = np.array(e._kinds)
-        present = e._present
+        objects = e.objects
+        kinds, present, positions, inside = objects.kinds, objects.present, objects.positions, objects.inside
         # on the board an item touched at capacity is lost: full items are unsafe too (an
         # item's inventory slot is its kind: spec.inventory lists the items first)
         full = {k for k in range(e.rules.n_items) if e.board.capacity[k] is not None and inv[k] >= e.board.capacity[k]}
         unsafe = [i for i in np.flatnonzero(present)
                   if (kinds[i] != target and not self.planner.harmless(w, inv, int(kinds[i]))) or kinds[i] in full]
         # a place acts on entering: an instance we stand in counts once we have left it
-        goals = np.flatnonzero((kinds == target) & present & ~e._inside)
-        avoid = e._positions[unsafe + np.flatnonzero((kinds == target) & e._inside).tolist()]
+        goals = np.flatnonzero((kinds == target) & present & ~inside)
+        avoid = positions[unsafe + np.flatnonzero((kinds == target) & inside).tolist()]
         if len(goals):
-            aims = e._positions[goals]
+            aims = positions[goals]
             # objects on the board's edge (x or y = 0): aim 1e-4 inside, or the float32 action's
             # rounding (~1e-7 here) could end the jump just off the board, rejecting the move
             # (and 1e-3 up and right of the object, so that it ends in the object's cell, not
@@ -266,12 +268,12 @@ class KinematicScriptedPolicy(ScriptedPolicy):
             if np.abs(aim - pos).max() <= e.step_size:  # in reach: land on it
                 return ((aim - pos) / e.step_size).astype(np.float32)
         ends = pos + e.step_size * self._moves.astype(np.float64)
-        ok = (ends >= 0).all(axis=1) & (ends < e.arena).all(axis=1) & ~e._in_obstacle(ends)
+        ok = (ends >= 0).all(axis=1) & (ends < e.arena).all(axis=1) & ~e.in_obstacle(ends)
         if len(avoid):
             ok &= (np.linalg.norm(ends[:, None, :] - avoid[None, :, :], axis=2) >= e.radius + 0.05).all(axis=1)
         for i in unsafe:  # a place labelled by its cell is arrived at anywhere in the cell
             if e.board.tiles[kinds[i]].by_cell:
-                ok &= (np.floor(ends) != np.floor(e._positions[i])).any(axis=1)
+                ok &= (np.floor(ends) != np.floor(positions[i])).any(axis=1)
         if not ok.any():
             return np.zeros(2, dtype=np.float32)
         if len(goals):

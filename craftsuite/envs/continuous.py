@@ -108,7 +108,8 @@ class ContinuousWorldEnv(PlanarWorld):
         self._rgba = self.model.geom_rgba[self._geom_ids].copy()
         self._lay_out(scene.object_kinds)
         n_obj = len(self._kinds)
-        self._wall_limit = self.half - AGENT_HALF - 0.02  # agent touching the boundary wall
+        # how far from the centre, on either axis, the agent touches the boundary wall
+        self.wall_limit = self.half - AGENT_HALF - 0.02
         self._any_inside = False
         self._radius2 = self.radius ** 2
         self._offset_scale = np.zeros((n_obj, 1))
@@ -227,7 +228,7 @@ class ContinuousWorldEnv(PlanarWorld):
 
         reward = self._step_reward
         px, py = data.qpos[0], data.qpos[1]
-        lim = self._wall_limit
+        lim = self.wall_limit
         if (abs(px) >= lim and x * px > 0) or (abs(py) >= lim and y * py > 0):
             reward += self._boundary_reward
 

@@ -62,7 +62,7 @@ class ContinuousVectorEnv(PlanarVectorEnv):
         self._is_item = template._is_item
         self.arena, self.half = template.arena, template.half
         self._radius2 = template._radius2
-        self._wall_limit = template._wall_limit
+        self._wall_limit = template.wall_limit
         self._boundary_reward = template._boundary_reward
         self._inv_offset = template._inv_offset
         self._n_obj = n_obj

@@ -136,6 +136,12 @@ class GridWorldEnv(CraftWorld):
         y, x = divmod(self._agent, self.size)
         return x, y
 
+    @property
+    def cells(self) -> tuple[int, ...]:
+        """What each cell holds now, row-major (cell ``y * size + x``): an object kind (an
+        index into ``task.objects``), ``envs.cells.EMPTY`` or ``envs.cells.WALL``."""
+        return tuple(self._cells)
+
     def remaining_counts(self) -> list[int]:
         """Objects of each kind still on the map (places are never used up)."""
         counts = [0] * len(self._objects)

@@ -121,7 +121,7 @@ class KinematicWorldEnv(PlanarWorld):
         # of obstacles by a pickup radius (so no object hides in a wall)
         axis = np.arange(self.size, dtype=float)
         sites = np.array([(x, y) for x in axis for y in axis if (x, y) != (0.0, 0.0)])
-        self._sites = sites[~self._in_obstacle(sites, self.radius)]
+        self._sites = sites[~self.in_obstacle(sites, self.radius)]
         if len(self._sites) < n_obj - int(self._fixed.sum()):
             raise ValueError(f"{spec.name}: {n_obj} objects do not fit the {self.size}x{self.size} kinematic "
                              f"board's {len(self._sites)} free integer points")
@@ -131,14 +131,15 @@ class KinematicWorldEnv(PlanarWorld):
         self._position = np.zeros(2)
         self._level_mask = 0
 
-    def _in_obstacle(self, points: np.ndarray, margin: float = 0.0) -> np.ndarray:
+    def in_obstacle(self, points: np.ndarray, margin: float = 0.0) -> np.ndarray:
+        """Which of the (n, 2) board points lie in an obstacle grown by ``margin``."""
         return within_boxes(points, self._obstacles, margin)
 
     def on_board(self, point) -> bool:
         """Whether the agent may stand at ``point``: on the half-open board (the authors'
         bounds, ``0 <= x < size``), outside obstacles."""
         x, y = float(point[0]), float(point[1])
-        return 0.0 <= x < self.arena and 0.0 <= y < self.arena and not self._in_obstacle(np.array([x, y]))[0]
+        return 0.0 <= x < self.arena and 0.0 <= y < self.arena and not self.in_obstacle(np.array([x, y]))[0]
 
     @property
     def observation_layout(self) -> dict:

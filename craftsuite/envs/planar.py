@@ -9,6 +9,8 @@ tiles (``envs/board.py``).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import gymnasium as gym
 import numpy as np
 
@@ -61,6 +63,22 @@ def touch_slots(rules, inv: list[int], kinds, is_item, inside: np.ndarray, was_i
             consume(j)
             inside[j] = False
     return reward, gained, arrived, touched
+
+
+@dataclass(frozen=True)
+class ObjectSlots:
+    """The object slots of a continuous world at one moment, one row per slot (read-only
+    copies: the world moves on without them)."""
+
+    kinds: np.ndarray  # (n,) int: the slot's object kind, an index into ``task.objects``
+    positions: np.ndarray  # (n, 2): where the slot's object is (meaningless once consumed)
+    present: np.ndarray  # (n,) bool: not consumed yet
+    inside: np.ndarray  # (n,) bool: the agent was within reach at the last step
+
+
+def _frozen(array: np.ndarray) -> np.ndarray:
+    array.flags.writeable = False
+    return array
 
 
 class PlanarWorld(CraftWorld):
@@ -133,6 +151,13 @@ class PlanarWorld(CraftWorld):
         for i, kind in enumerate(self._kinds):
             counts[kind] += bool(self._present[i])
         return counts
+
+    @property
+    def objects(self) -> ObjectSlots:
+        """The object slots now: kinds, positions, present, within reach. Built when asked
+        for, never on a step."""
+        return ObjectSlots(_frozen(np.array(self._kinds)), _frozen(self._positions.copy()),
+                           _frozen(self._present.copy()), _frozen(self._inside.copy()))
 
     def object_positions(self) -> dict[str, list[tuple[float, float]]]:
         """Positions of the objects still in the world, by object name."""

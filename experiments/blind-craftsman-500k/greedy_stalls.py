@@ -98,7 +98,7 @@ def stall_report(model, episode: dict) -> dict | None:
         actor = model.actor(th.as_tensor(episode["obs"][None]))[0].numpy()
     return {"nearest": nearest, "actor": actor, "critic_best": actions[int(q.argmax())],
             "q_spread": float(q.max() - q.min()), "inventory": tuple(int(c) for c in env.inventory_counts),
-            "at_wall": bool(np.abs(here).max() >= env._wall_limit - 0.01)}
+            "at_wall": bool(np.abs(here).max() >= env.wall_limit - 0.01)}
 
 
 def main(argv=None) -> None:

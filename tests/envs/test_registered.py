@@ -176,3 +176,41 @@ def test_observations_stay_in_the_space_through_whole_episodes(env_id):
                 obs, _, term, trunc, _ = env.step(policy(obs))
                 done = term or trunc
             assert env.observation_space.contains(obs)
+
+
+@pytest.mark.parametrize("world", ["Grid7", "Cont", "Kinematic"])
+def test_the_public_view_of_the_objects_agrees_with_the_world_and_is_a_snapshot(world):
+    """What the scripted policies read: the grid's ``cells``, the continuous worlds'
+    ``objects``; the world moves on without them and they cannot be written."""
+    from craftsuite.envs.cells import EMPTY, WALL
+    from craftsuite.scripted import scripted_policy
+
+    env = gym.make(f"CraftSuite/BlindCraftsman-{world}-v0").unwrapped
+    env.reset(seed=3)
+    names = [o.name for o in env.task.objects]
+    policy = scripted_policy(env)
+    if world == "Grid7":
+        before = env.cells
+        size = env.size
+        on_map = {n: sorted(divmod(c, size)[::-1] for c, k in enumerate(before) if k == i) for i, n in enumerate(names)}
+        assert on_map == {n: sorted(p) for n, p in env.object_positions().items()}
+        assert before[env.agent_position[1] * size + env.agent_position[0]] != WALL
+        for _ in range(100):  # until the agent picks something up
+            env.step(policy())
+            if sum(k >= 0 for k in env.cells) < sum(k >= 0 for k in before):
+                break
+        assert sum(k >= 0 for k in env.cells) == sum(k >= 0 for k in before) - 1
+        assert set(before) - set(range(len(names))) <= {EMPTY, WALL}
+        return
+    before = env.objects
+    for kind, (name, positions) in enumerate(env.object_positions().items()):
+        assert name == names[kind]
+        mine = before.positions[before.present & (before.kinds == kind)]
+        assert np.allclose(sorted(map(tuple, mine)), sorted(positions), atol=1e-4)
+    with pytest.raises(ValueError):
+        before.present[0] = False
+    for _ in range(300):
+        env.step(policy())
+        if env.objects.present.sum() < before.present.sum():
+            break
+    assert env.objects.present.sum() == before.present.sum() - 1 and before.present.all()

@@ -19,8 +19,9 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from craftsuite.leaderboard import _rung_order, run_metrics
+from craftsuite.leaderboard import run_metrics
 from craftsuite.methods import METHODS
+from craftsuite.task_registry import ladder
 
 
 def bootstrap_ci(values) -> tuple[float, float, float]:
@@ -51,7 +52,9 @@ def main(root):
         m = run_metrics(run)
         if m is not None:
             groups[m["task"], m["world"], m["method"]].append(m)
-    cells = sorted({(t, w) for t, w, _ in groups}, key=lambda k: (_rung_order(k[0]), k[1]))
+    rungs = [spec.name for spec in ladder()]  # easiest first, as the leaderboard's sections; unknown tasks last
+    cells = sorted({(t, w) for t, w, _ in groups},
+                   key=lambda k: (rungs.index(k[0]) if k[0] in rungs else len(rungs), k[0], k[1]))
     print(f"{sum(map(len, groups.values()))} finished runs in {root}")
     separated = {}  # (task, world) -> pairs apart by the t-interval of final success or of AUC
     for task, world in cells:

@@ -62,13 +62,24 @@ HORIZONS = {2: ("frame skip 2, 1,000 steps", {"frame_skip": 2, "max_episode_step
 NOISES = ("white", "persistent")
 
 
-def register_reach(scene: str) -> str:
-    """Register the scene's task (in this process) and return its name."""
+def register_reach(scene: str, entry_point: str | None = None) -> str:
+    """Register the scene's task (in this process) and return its name. ``entry_point``
+    ("module:function", taking the MuJoCo ids' keywords) makes its MuJoCo id's envs in
+    place of craftsuite's, e.g. to wrap the world."""
     import craftsuite
     from craftsuite.spec import load_spec
 
     spec = SCENES[scene]
     craftsuite.register_task(load_spec(spec, name_hint="td3_reach.py"))
+    if entry_point is not None:
+        import gymnasium as gym
+
+        env_id = f"CraftSuite/{spec['name']}-Cont-v0"
+        registered = gym.spec(env_id)
+        del gym.registry[env_id]
+        # no vector entry point: every env of the id goes through entry_point
+        gym.register(id=env_id, entry_point=entry_point, kwargs=registered.kwargs,
+                     max_episode_steps=registered.max_episode_steps)
     return spec["name"]
 
 
@@ -76,9 +87,10 @@ def noise_label(noise: str, resample: float) -> str:
     return "N(0, 0.3) per step" if noise == "white" else f"persistent N(0, 0.6), p {resample:g}"
 
 
-def run(setting: tuple[str, int, str, int], steps: int, resample: float, hyper: dict) -> list[dict]:
+def run(setting: tuple[str, int, str, int], steps: int, resample: float, hyper: dict,
+        entry_point: str | None = None) -> list[dict]:
     scene, skip, noise, seed = setting
-    task = register_reach(scene)  # here, in the worker that makes the envs (whatever the start method)
+    task = register_reach(scene, entry_point)  # here, in the worker that makes the envs (whatever the start method)
     kwargs = {"policy_kwargs": {"net_arch": [256, 256]}, **hyper}
     if noise == "persistent":
         kwargs["action_noise"] = {"type": "persistent", "sigma": 0.6, "resample": resample}
@@ -86,7 +98,8 @@ def run(setting: tuple[str, int, str, int], steps: int, resample: float, hyper: 
                               env_kwargs=HORIZONS[skip][1], **kwargs)
 
 
-def main(argv=None):
+def main(argv=None, entry_point: str | None = None):
+    """``entry_point``: what makes the MuJoCo envs instead of craftsuite (``register_reach``)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=30_000)
     parser.add_argument("--scenes", nargs="+", choices=list(SCENES), default=["one"],
@@ -104,7 +117,8 @@ def main(argv=None):
     settings = list(product(args.scenes, args.frame_skips, args.noises, args.seeds))
     n = len(settings)
     with ProcessPoolExecutor(args.workers) as pool:
-        results = list(pool.map(run, settings, [args.steps] * n, [args.resample] * n, [args.hyper] * n))
+        results = list(pool.map(run, settings, [args.steps] * n, [args.resample] * n, [args.hyper] * n,
+                                    [entry_point] * n))
     if args.hyper:
         print(f"\nmake_agent keywords: {json.dumps(args.hyper)}")
     print("\n| scene | control period, episode | exploration noise | seed | greedy success every 5,000 steps "

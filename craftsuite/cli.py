@@ -223,7 +223,7 @@ def _distill(args) -> int:
         table = static_distillation(spec.automaton, completion_reward=spec.completion_reward)
         automaton = spec.automaton
     else:
-        from .agents.methods import distill_from_replay, load_agent
+        from .agents.factory import distill_from_replay, load_agent
 
         source = Path(args.source)
         env_id, env_kwargs = args.env_id or _registered(args.task, "Grid7"), {}

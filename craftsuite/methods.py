@@ -1,7 +1,7 @@
 """The methods a benchmark compares, as data: one row per method, named for what it does.
 
 ``METHODS`` drives the suites (which methods run in which world), the command line's
-choices and the leaderboard's legend; ``craftsuite.agents.methods.make_agent`` builds a row
+choices and the leaderboard's legend; ``craftsuite.agents.factory.make_agent`` builds a row
 into an agent. This module imports no torch, so listing methods stays cheap.
 
 A row names its world kind (``Grid``: DQN on the grids, ``Cont``: TD3 in the MuJoCo

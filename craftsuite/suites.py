@@ -57,7 +57,7 @@ class Suite:
     eval_every: int | None = None  # None: 20 evaluations per run
     eval_episodes: int = 20
     # each world's collection regime: envs stepped side by side per agent step, and
-    # overrides of its algorithm's defaults (craftsuite.agents.methods): MuJoCo students
+    # overrides of its algorithm's defaults (craftsuite.agents.factory): MuJoCo students
     # are TD3, grid students DQN, so one network size never reaches the other
     td3_hyperparameters: dict = field(default_factory=dict)
     dqn_hyperparameters: dict = field(default_factory=dict)
@@ -451,7 +451,7 @@ def _check_students(configs: list[StudentConfig], device: str = "cpu") -> None:
     teachers have trained."""
     import craftsuite  # noqa: F401  (registers the ids)
 
-    from .agents.methods import make_agent
+    from .agents.factory import make_agent
 
     if any(c.engine == "population" for c in configs):
         from .population import check_supported

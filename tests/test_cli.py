@@ -52,7 +52,7 @@ def test_help_explains_commands(capsys):
 
 
 def test_video_loads_craftsuite_agents(tmp_path, capsys):
-    from craftsuite.agents.methods import make_agent
+    from craftsuite.agents.factory import make_agent
 
     agent = make_agent("product-dqn", "CraftSuite/DungeonQuest-Grid7-v0", learning_starts=10, buffer_size=500)
     agent.learn(50)

@@ -16,7 +16,7 @@ import craftsuite  # noqa: F401  (registers the ids)
 from craftsuite.agents import AutomatonQTable, DistillationError
 from craftsuite.agents.distillation import static_distillation
 from craftsuite.agents.dqn import AutomatonDQN
-from craftsuite.agents.methods import load_agent, make_agent, recorded_algorithm
+from craftsuite.agents.factory import load_agent, make_agent, recorded_algorithm
 from craftsuite.agents.td3 import AutomatonTD3
 from craftsuite.methods import HyperparameterError
 from craftsuite.registration import resolve_task
@@ -145,9 +145,9 @@ def test_models_that_record_no_algorithm_use_their_run_record_or_are_tried(tmp_p
 
 # -- hyperparameters are checked by make_agent too ------------------------------------------------
 def test_make_agent_names_a_bad_setting_before_it_makes_an_env(monkeypatch):
-    import craftsuite.agents.methods as methods
+    import craftsuite.agents.factory as factory
 
-    monkeypatch.setattr(methods, "make_vec_env", lambda *a, **k: pytest.fail("an env was made"))
+    monkeypatch.setattr(factory, "make_vec_env", lambda *a, **k: pytest.fail("an env was made"))
     with pytest.raises(HyperparameterError, match="batch_size must be an integer"):
         make_agent("dqn", GRID, batch_size="big")
     with pytest.raises(HyperparameterError, match="DQN has no setting 'policy_delay'"):

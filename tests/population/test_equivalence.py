@@ -6,7 +6,7 @@ import pytest
 import torch as th
 
 import craftsuite  # noqa: F401
-from craftsuite.agents.methods import make_agent
+from craftsuite.agents.factory import make_agent
 from craftsuite.population.dqn import PopulationDQN
 from craftsuite.population.replay import Batch, sparse_rows
 from craftsuite.population.targets import MemberTargets

@@ -40,11 +40,11 @@ def test_student_run_logs_every_episode(tmp_path):
 
 
 def test_grid_student_keeps_one_fixed_instance(tmp_path, monkeypatch):
-    import craftsuite.agents.methods as methods
+    import craftsuite.agents.factory as factory
     import craftsuite.training as training
 
     seen = []
-    real_make, real_evaluate = methods.make_agent, training.evaluate
+    real_make, real_evaluate = factory.make_agent, training.evaluate
 
     def make_agent(*args, env_kwargs=None, **kwargs):
         seen.append(("train", env_kwargs))
@@ -54,7 +54,7 @@ def test_grid_student_keeps_one_fixed_instance(tmp_path, monkeypatch):
         seen.append(("evaluate", env_kwargs))
         return real_evaluate(*args, env_kwargs=env_kwargs, **kwargs)
 
-    monkeypatch.setattr(methods, "make_agent", make_agent)
+    monkeypatch.setattr(factory, "make_agent", make_agent)
     monkeypatch.setattr(training, "evaluate", evaluate)
     config = StudentConfig(method="dqn", world="Grid7", steps=300, eval_every=300, eval_episodes=1,
                            hyperparameters={**TINY_DQN, "learning_starts": 200}, layout_seed=3)

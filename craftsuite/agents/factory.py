@@ -1,4 +1,5 @@
-"""Every method of ``craftsuite.methods.METHODS`` built into an agent: ``make_agent(method, env, ...)``.
+"""Agents built and loaded: every method of ``craftsuite.methods.METHODS`` built into an
+agent by ``make_agent(method, env, ...)``, a saved agent loaded by ``load_agent``.
 
 Grid methods are DQN (``AutomatonDQN``), MuJoCo methods TD3 (``AutomatonTD3``); the table
 says which sees the automaton state and how it uses the automaton. A teacher is
@@ -16,8 +17,7 @@ import gymnasium as gym
 from stable_baselines3.common.env_util import make_vec_env
 from stable_baselines3.common.vec_env import VecEnv
 
-from ..methods import (  # noqa: F401  (METHODS and the defaults re-exported)
-    ALGORITHMS, DQN_DEFAULTS, METHODS, TD3_DEFAULTS, Method, algorithm_settings, check_methods)
+from ..methods import ALGORITHMS, METHODS, Method, algorithm_settings, check_methods
 from ..envs.base import CraftWorld
 from ..envs.grid import GridWorldEnv
 from ..ids import parse_id, world_kind

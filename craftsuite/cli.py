@@ -195,7 +195,7 @@ def _json_object(text: str | None, flag: str = "--hyper") -> dict:
 
 def _hyper(text: str | None, algorithm: str, flag: str = "--hyper") -> dict:
     """``flag``'s JSON, checked by name and type against ``algorithm``'s settings before anything runs."""
-    from .methods import check_hyperparameters
+    from .hyperparameters import check_hyperparameters
 
     return check_hyperparameters(algorithm, _json_object(text, flag), source=flag)
 

@@ -17,7 +17,8 @@ import gymnasium as gym
 from stable_baselines3.common.env_util import make_vec_env
 from stable_baselines3.common.vec_env import VecEnv
 
-from ..methods import ALGORITHMS, METHODS, Method, algorithm_settings, check_methods
+from ..hyperparameters import algorithm_settings
+from ..methods import ALGORITHMS, METHODS, Method, check_methods
 from ..envs.base import CraftWorld
 from ..envs.grid import GridWorldEnv
 from ..ids import parse_id, world_kind
@@ -44,7 +45,7 @@ def make_agent(method: str, env, *, table: AutomatonQTable | None = None, seed: 
     method on a grid, a MuJoCo method in MuJoCo) and see the automaton state exactly when it
     is a product method (``product=True``). ``rho`` and ``self_loops`` go to the distilled
     target (``DistilledTarget``; None: the method's); ``overrides`` to the algorithm,
-    checked by name and type (``craftsuite.methods.check_hyperparameters``; TD3's
+    checked by name and type (``craftsuite.hyperparameters.check_hyperparameters``; TD3's
     ``action_noise`` may be a spec such as ``{"type": "persistent", "sigma": 0.6,
     "resample": 0.1}``: ``agents/noise.py``)."""
     check_methods([method])

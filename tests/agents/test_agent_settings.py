@@ -18,7 +18,7 @@ from craftsuite.agents.distillation import static_distillation
 from craftsuite.agents.dqn import AutomatonDQN
 from craftsuite.agents.factory import load_agent, make_agent, recorded_algorithm
 from craftsuite.agents.td3 import AutomatonTD3
-from craftsuite.methods import HyperparameterError
+from craftsuite.hyperparameters import HyperparameterError
 from craftsuite.registration import resolve_task
 
 GRID, CONT = "CraftSuite/DungeonQuest-Grid7-v0", "CraftSuite/DungeonQuest-Cont-v0"

@@ -1,4 +1,4 @@
-"""Hyperparameters checked by name and type (craftsuite.methods) before anything runs."""
+"""Hyperparameters checked by name and type (craftsuite.hyperparameters) before anything runs."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 
 import pytest
 
-from craftsuite.methods import (DQN_DEFAULTS, TD3_DEFAULTS, HyperparameterError, algorithm_settings,
-                                check_hyperparameters, hyperparameter_examples)
+from craftsuite.hyperparameters import (DQN_DEFAULTS, TD3_DEFAULTS, HyperparameterError, algorithm_settings,
+                                        check_hyperparameters, hyperparameter_examples)
 
 
 @pytest.mark.parametrize("overrides,message", [

@@ -92,7 +92,7 @@ def test_dqn_update_matches_automaton_dqn(loss, prioritized, sparse):
 
 
 def agent_settings(agent, algorithm, **overrides) -> dict:
-    from craftsuite.methods import algorithm_settings
+    from craftsuite.hyperparameters import algorithm_settings
 
     return algorithm_settings(algorithm, overrides)
 

@@ -119,29 +119,15 @@ def distill_from_replay(teacher: AutomatonDQN, chunk: int = 4096) -> AutomatonQT
 
 
 def recorded_algorithm(path) -> str | None:
-    """The algorithm (a key of ``CLASSES``) a saved agent records: the model's own metadata
-    (``algorithm``, saved since CraftSuite's agents carry it), else its run's record beside
-    it (``result.json``'s ``algorithm``, or ``config.json``'s effective method, which runs of
-    record format 2 carry); None when neither says (a plain SB3 checkpoint, an older run)."""
-    path = Path(path)
+    """The algorithm (a key of ``CLASSES``) a saved agent records in its model's metadata
+    (``algorithm``, which every CraftSuite agent saves); None where it records none (a plain
+    SB3 checkpoint) or cannot be read."""
     try:
         with zipfile.ZipFile(path) as z:
             data = json.loads(z.read("data"))
-        if isinstance(data.get("algorithm"), str):
-            return data["algorithm"]
     except (OSError, KeyError, ValueError, zipfile.BadZipFile):
-        pass  # damaged or foreign: the record beside, or loading, will say more
-    for run in (path.parent, path.parent.parent):  # run/model.zip, run/checkpoint/model.zip
-        for record, keys in (("result.json", ("algorithm",)), ("config.json", ("effective", "method", "algorithm"))):
-            try:
-                value = json.loads((run / record).read_text())
-                for key in keys:
-                    value = value[key]
-            except (OSError, ValueError, KeyError, TypeError):
-                continue
-            if isinstance(value, str):
-                return value
-    return None
+        return None  # damaged or foreign: loading will say more
+    return data["algorithm"] if isinstance(data.get("algorithm"), str) else None
 
 
 def load_agent(path, env=None):
@@ -166,8 +152,7 @@ def load_agent(path, env=None):
         except Exception as err:  # damaged inside: whatever SB3 raises
             raise ValueError(f"{path} could not be loaded as {CLASSES[algorithm].__name__}: "
                              f"{type(err).__name__}: {err}") from None
-    # Neither the model nor a run record names its algorithm: a plain SB3 checkpoint or an
-    # agent saved before CraftSuite recorded it. Only these are tried class by class.
+    # The model names no algorithm: a plain SB3 checkpoint, tried class by class.
     errors = []
     for cls in (AutomatonDQN, AutomatonTD3, sb3.DQN, sb3.TD3, sb3.SAC, sb3.PPO, sb3.A2C, sb3.DDPG):
         try:

@@ -69,14 +69,6 @@ def test_n_steps_is_sb3s_attribute_and_the_buffers(method, world, small, tmp_pat
         make_agent(method, world, replay_buffer_kwargs={"n_steps": 2}, **small)
 
 
-def test_a_checkpoint_that_predates_n_steps_in_sb3_reads_its_buffers(tmp_path):
-    agent = make_agent("product-dqn", GRID, n_steps=3, **SMALL_DQN)
-    agent.n_steps = 1  # as saved before: SB3's default beside the buffer's 3
-    agent.save(tmp_path / "old.zip")
-    back = load_agent(tmp_path / "old.zip")
-    assert back.n_steps == back.replay_buffer.n_steps == 3
-
-
 def _actor_updates(agent, gradient_steps: int) -> int:
     calls = []
     step = agent.actor.optimizer.step
@@ -129,18 +121,12 @@ def test_an_unknown_recorded_algorithm_is_named(tmp_path):
         load_agent(tmp_path / "a.zip")
 
 
-def test_models_that_record_no_algorithm_use_their_run_record_or_are_tried(tmp_path):
+def test_models_that_record_no_algorithm_are_tried_class_by_class(tmp_path):
     agent = make_agent("td3", CONT, **SMALL_TD3)
-    del agent.algorithm  # as saved before agents carried it
-    run = tmp_path / "run"
-    (run / "checkpoint").mkdir(parents=True)
-    agent.save(run / "checkpoint" / "model.zip")
-    assert recorded_algorithm(run / "checkpoint" / "model.zip") is None
-    assert type(load_agent(run / "checkpoint" / "model.zip")) is AutomatonTD3  # tried, class by class
-    (run / "config.json").write_text(json.dumps({"effective": {"method": {"algorithm": "td3"}}}))
-    assert recorded_algorithm(run / "checkpoint" / "model.zip") == "td3"
-    (run / "result.json").write_text(json.dumps({"algorithm": "dqn"}))
-    assert recorded_algorithm(run / "checkpoint" / "model.zip") == "dqn"  # the result is read first
+    del agent.algorithm  # as a plain SB3 checkpoint records none
+    agent.save(tmp_path / "model.zip")
+    assert recorded_algorithm(tmp_path / "model.zip") is None
+    assert type(load_agent(tmp_path / "model.zip")) is AutomatonTD3
 
 
 # -- hyperparameters are checked by make_agent too ------------------------------------------------

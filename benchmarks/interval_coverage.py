@@ -74,7 +74,7 @@ def main() -> None:
     report("|---|---|---|")
     for n in (2, 3, 5, 10):
         t_cov, boot_cov = coverage_of_the_mean(n, args.trials, rng)
-        t_text = f"{t_cov:.3f}" if n >= stats.MIN_SEEDS else "none (below its minimum of seeds)"
+        t_text = f"{t_cov:.3f}" if n >= stats.MIN_SEEDS_FOR_INTERVAL else "none (below its minimum of seeds)"
         report(f"| {n} | {t_text} | {boot_cov:.3f} |")
     report()
     report(f"Stratified-bootstrap IQM interval, 4 tasks x 5 seeds: coverage "

@@ -23,8 +23,8 @@ import argparse
 import time
 
 import craftsuite  # noqa: F401
-from craftsuite.agents.methods import make_agent
-from craftsuite.methods import algorithm_settings
+from craftsuite.agents.factory import make_agent
+from craftsuite.hyperparameters import algorithm_settings
 from craftsuite.suites import DQN_REGIME, TD3_REGIME
 from _page import Report, add_page_argument  # benchmarks/ is on sys.path as a script
 

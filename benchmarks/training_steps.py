@@ -30,8 +30,9 @@ from stable_baselines3.common.env_util import make_vec_env
 
 import craftsuite  # noqa: F401
 from craftsuite.agents import static_distillation
-from craftsuite.agents.methods import DQN_DEFAULTS, TD3_DEFAULTS, make_agent
+from craftsuite.agents.factory import make_agent
 from craftsuite.agents.noise import make_action_noise
+from craftsuite.hyperparameters import DQN_DEFAULTS, TD3_DEFAULTS
 from _page import Report, add_page_argument  # benchmarks/ is on sys.path as a script
 
 GRID, CONT = "CraftSuite/BlindCraftsman-Grid10-v0", "CraftSuite/BlindCraftsman-Cont-v0"

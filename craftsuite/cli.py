@@ -107,7 +107,7 @@ def _automaton(args) -> int:
     return 0
 
 
-def _demo(args) -> int:
+def _scripted(args) -> int:
     import cv2
     import gymnasium as gym
     import numpy as np
@@ -195,7 +195,7 @@ def _json_object(text: str | None, flag: str = "--hyper") -> dict:
 
 def _hyper(text: str | None, algorithm: str, flag: str = "--hyper") -> dict:
     """``flag``'s JSON, checked by name and type against ``algorithm``'s settings before anything runs."""
-    from .methods import check_hyperparameters
+    from .hyperparameters import check_hyperparameters
 
     return check_hyperparameters(algorithm, _json_object(text, flag), source=flag)
 
@@ -223,7 +223,7 @@ def _distill(args) -> int:
         table = static_distillation(spec.automaton, completion_reward=spec.completion_reward)
         automaton = spec.automaton
     else:
-        from .agents.methods import distill_from_replay, load_agent
+        from .agents.factory import distill_from_replay, load_agent
 
         source = Path(args.source)
         env_id, env_kwargs = args.env_id or _registered(args.task, "Grid7"), {}
@@ -428,12 +428,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--show-sink", action="store_true", help="also draw the rejecting sink")
     p.set_defaults(run=_automaton)
 
-    p = sub.add_parser("demo", help="roll out the scripted policy on every id; write pictures")
-    p.add_argument("--out", default="out/demo", help="output directory (default: out/demo)")
+    p = sub.add_parser("scripted", help="roll out the scripted policy on every id; write pictures")
+    p.add_argument("--out", default="out/scripted", help="output directory (default: out/scripted)")
     p.add_argument("--task", help=f"only this task (default: all): {task_help}")
     p.add_argument("--episodes", type=_positive, default=10, help="episodes per id (default: 10)")
     p.add_argument("--seed", type=int, default=0, help="first seed (default: 0)")
-    p.set_defaults(run=_demo)
+    p.set_defaults(run=_scripted)
 
     p = sub.add_parser("teacher", help="train a grid DQN teacher until 90%% greedy success; distil it")
     p.add_argument("task", help=task_help)

@@ -13,7 +13,8 @@ from pathlib import Path
 
 from . import ids
 from .envs.grid import layout_kwargs
-from .methods import METHODS, algorithm_settings, check_methods
+from .hyperparameters import algorithm_settings
+from .methods import METHODS, check_methods
 from .runs import config_key
 from .task_registry import resolve_task
 

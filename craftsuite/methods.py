@@ -1,7 +1,7 @@
 """The methods a benchmark compares, as data: one row per method, named for what it does.
 
 ``METHODS`` drives the suites (which methods run in which world), the command line's
-choices and the leaderboard's legend; ``craftsuite.agents.methods.make_agent`` builds a row
+choices and the leaderboard's legend; ``craftsuite.agents.factory.make_agent`` builds a row
 into an agent. This module imports no torch, so listing methods stays cheap.
 
 A row names its world kind (``Grid``: DQN on the grids, ``Cont``: TD3 in the MuJoCo
@@ -22,147 +22,9 @@ from .ids import WORLD_KINDS
 # the algorithm family of each world kind: DQN needs discrete moves, TD3 continuous thrust
 ALGORITHMS = MappingProxyType({"dqn": "Grid", "td3": "Cont"})
 DISTILLATIONS = (None, "static", "dynamic")
-TARGET_DEFAULTS = MappingProxyType({"rho": 0.999, "self_loops": True})  # the paper's
-
-
-# The algorithms' settings before a run's overrides. The authors' DQN, changed where a
-# small MLP on one env needs it (measured when the teachers were tuned): a hard target
-# update every 100 steps instead of 1,000, and epsilon annealed from 1.0 to 0.1 over the
-# first 10% instead of a constant 0.1; with the authors' two, the teacher did not learn
-# Blind Craftsman's fixed 7x7 instance in 100k steps, with these it did in 40k. A run
-# records these merged with its overrides (``algorithm_settings``) and hashes them into its
-# run key, so a change here makes new runs rather than reusing old ones.
-DQN_DEFAULTS = dict(learning_rate=5e-4, buffer_size=150_000, batch_size=64, learning_starts=1_000,
-                    gamma=0.99, train_freq=1, target_update_interval=100, exploration_fraction=0.1,
-                    exploration_initial_eps=1.0, exploration_final_eps=0.1,
-                    policy_kwargs=dict(net_arch=[64, 64]))
-TD3_DEFAULTS = dict(learning_rate=1e-4, buffer_size=1_000_000, batch_size=64, learning_starts=1_000,
-                    gamma=0.99, tau=0.005, target_policy_noise=0.2, target_noise_clip=0.5,
-                    action_noise={"type": "normal", "sigma": 0.3},  # a spec (agents/noise.py)
-                    policy_kwargs=dict(net_arch=[400, 300]))
-
-
-
-
-class OneOf(tuple):
-    """Examples of the forms a setting takes, e.g. ``train_freq``: 4 or [4, "step"]."""
-
-
-# The settings a run may also override, beyond its algorithm's defaults above, each with
-# an example (the library's default) whose type a value must have: SB3's keywords of DQN
-# and TD3 that are plain data, and CraftSuite's own (agents/dqn.py, agents/td3.py).
-# With the defaults, these are every name ``check_hyperparameters`` accepts.
-_OFF_POLICY = dict(tau=1.0, train_freq=OneOf((1, [1, "step"])), gradient_steps=1, n_steps=1,
-                   optimize_memory_usage=False, replay_buffer_kwargs={}, stats_window_size=100, device="auto",
-                   prioritized=True)
-# CraftSuite's DQN settings that take one of a few names, the first SB3's behaviour:
-# the loss, what target_update_interval counts, and how the observation reaches the MLP
-# (the grid planes as an image: agents/networks.py)
-DQN_CHOICES = MappingProxyType({"loss": ("huber", "mse"), "target_update_unit": ("transitions", "gradient_steps"),
-                                "features_extractor": ("flatten", "residual-cnn")})
-DQN_MORE = MappingProxyType(dict(_OFF_POLICY, max_grad_norm=10.0, double=True, dueling=True, loss="huber",
-                                 target_update_unit="transitions", features_extractor="flatten"))
-TD3_MORE = MappingProxyType(dict(_OFF_POLICY, tau=0.005, policy_delay=OneOf((2, None)),  # None: the schedule
-                                 delay_schedule=[[20_000, 4], [None, 2]]))
-
-
-class HyperparameterError(ValueError, TypeError):
-    """Hyperparameters that name no setting of their algorithm or hold a value of the wrong
-    type. A TypeError too: an unknown keyword was the algorithm constructor's TypeError before
-    settings were checked by name, and callers may still catch that."""
-
-
-def _forms(example) -> tuple[tuple[type, ...], str]:
-    """The types a value may have, by the example's, and their description."""
-    if isinstance(example, OneOf):
-        forms = [_forms(e) for e in example]
-        return tuple(t for types, _ in forms for t in types), " or ".join(text for _, text in forms)
-    if isinstance(example, bool):
-        return (bool,), "true or false"
-    if isinstance(example, int):
-        return (int,), "an integer"
-    if isinstance(example, float):
-        return (int, float), "a number"  # 1 stands for 1.0
-    if isinstance(example, str):
-        return (str,), "a string"
-    if isinstance(example, (list, tuple)):
-        return (list, tuple), "a list"
-    if isinstance(example, dict):
-        return (dict, type(None)), "an object (or null)"  # SB3 reads None as no keywords
-    if example is None:
-        return (type(None),), "null"
-    raise TypeError(f"no type rule for the example {example!r}")
-
-
-def hyperparameter_examples(algorithm: str) -> dict:
-    """Every setting ``algorithm`` takes from a run, with an example value of each: its
-    CraftSuite default, else the library's."""
-    if algorithm not in ALGORITHMS:
-        raise KeyError(f"unknown algorithm {algorithm!r}; algorithms: {list(ALGORITHMS)}")
-    return {**(TD3_MORE if algorithm == "td3" else DQN_MORE), **(TD3_DEFAULTS if algorithm == "td3" else DQN_DEFAULTS)}
-
-
-def check_hyperparameters(algorithm: str, overrides: Mapping | None, source: str = "hyperparameters") -> dict:
-    """``overrides`` of ``algorithm``'s settings, checked by name and by type before
-    anything runs; returned as given. ``source`` names where they came from in the message
-    (``--hyper`` on the command line).
-
-    Types follow each setting's example (``hyperparameter_examples``): an integer where it
-    is an integer (never true/false), a number (an integer too) where it is a float, true or
-    false strictly, a list, an object. Only data is checked (what JSON and run records
-    hold): a Python object given to ``make_agent`` (a learning-rate schedule, an
-    ``ActionNoise``) is the algorithm constructor's to judge.
-
-    Raises:
-        HyperparameterError: an unknown setting (the message lists the valid ones) or a
-            value of the wrong type (the message names the setting and what it takes).
-    """
-    examples = hyperparameter_examples(algorithm)
-    more = TD3_MORE if algorithm == "td3" else DQN_MORE
-    overrides = dict(overrides or {})
-    unknown = sorted(set(overrides) - set(examples))
-    if unknown:
-        raise HyperparameterError(f"{source}: {algorithm.upper()} has no setting {', '.join(map(repr, unknown))}; "
-                                  f"its settings: {', '.join(sorted(examples))}")
-    defaults = TD3_DEFAULTS if algorithm == "td3" else DQN_DEFAULTS
-    for name, value in overrides.items():
-        if not isinstance(value, _DATA):
-            continue
-        # a setting of several forms says so in its row of *_MORE, though its default has one
-        types, text = _forms(more[name] if isinstance(more.get(name), OneOf) else examples[name])
-        if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
-            example = examples[name][0] if isinstance(examples[name], OneOf) else examples[name]
-            # CraftSuite's defaults are what a run gets; the other settings' examples are the
-            # library's defaults, which CraftSuite may replace (TD3's policy_delay: its schedule)
-            shown = f"default {example!r}" if name in defaults else f"e.g. {example!r}"
-            raise HyperparameterError(f"{source}: {name} must be {text} ({shown}), got {value!r}")
-        choices = DQN_CHOICES.get(name) if algorithm == "dqn" else None
-        if choices and value not in choices:
-            raise HyperparameterError(f"{source}: {name} must be one of {list(choices)}, got {value!r}")
-    return overrides
-
-
-_DATA = (str, int, float, bool, list, tuple, dict, type(None))  # what JSON and a run's record hold
-
-
-def algorithm_settings(algorithm: str, overrides: Mapping | None = None) -> dict:
-    """The keywords ``algorithm`` (``"dqn"`` or ``"td3"``) is built with: its defaults,
-    then ``overrides`` (a key replaces the default's whole value), as plain JSON data: what
-    a run records as its effective hyperparameters and hashes into its run key.
-
-    Raises:
-        HyperparameterError: ``overrides`` name an unknown setting or hold a value of the
-            wrong type (``check_hyperparameters``).
-    """
-    import copy
-
-    overrides = check_hyperparameters(algorithm, overrides)
-    settings = copy.deepcopy({**(TD3_DEFAULTS if algorithm == "td3" else DQN_DEFAULTS), **(overrides or {})})
-    # fused Adam: one kernel per step instead of a Python loop over the parameters, about
-    # 25% more updates per second for these small nets on a CPU (benchmarks/student_throughput.py)
-    policy_kwargs = settings["policy_kwargs"] = dict(settings.get("policy_kwargs") or {})
-    policy_kwargs["optimizer_kwargs"] = {"fused": True, **policy_kwargs.get("optimizer_kwargs", {})}
-    return settings
+# the DistilledTarget's keywords unless a row or a run says otherwise: the paper's rho,
+# and the teacher's values on every label (self-loops included)
+TARGET_DEFAULTS = MappingProxyType({"rho": 0.999, "self_loops": True})
 
 
 class MethodError(ValueError):

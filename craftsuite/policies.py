@@ -26,7 +26,7 @@ def load_policy(name: str, env, seed: int = 0):
 
 
 def _load_checkpoint(path: Path, env):
-    from .agents.methods import load_agent
+    from .agents.factory import load_agent
 
     if not path.is_file():
         raise FileNotFoundError(

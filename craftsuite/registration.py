@@ -12,7 +12,7 @@ from pathlib import Path
 import gymnasium as gym
 
 from .ids import NAMESPACE, WORLD_KINDS, cont_id, grid_id, kinematic_id, parse_id, world_kind  # noqa: F401  (re-exported)
-from .spec import KINEMATIC, TaskSpec
+from .spec import KINEMATIC_CONFIG, TaskSpec
 from .task_registry import add_task, carried, ladder, resolve_task, tasks  # noqa: F401  (re-exported)
 
 
@@ -85,7 +85,7 @@ def _register(spec: TaskSpec) -> list[str]:
     worlds = [(grid_id(spec.name, size), "make_grid", _VECTOR["grid"], {"size": size}, spec.grid.max_steps)
               for size in spec.grid.sizes]
     worlds.append((cont_id(spec.name), "make_continuous", _VECTOR["continuous"], {}, spec.continuous.max_steps))
-    worlds.append((kinematic_id(spec.name), "make_kinematic", _VECTOR["kinematic"], {}, KINEMATIC.max_steps))
+    worlds.append((kinematic_id(spec.name), "make_kinematic", _VECTOR["kinematic"], {}, KINEMATIC_CONFIG.max_steps))
     for env_id, entry, vector_entry, kwargs, max_steps in worlds:
         if env_id in gym.registry:
             del gym.registry[env_id]  # re-registering a task replaces its ids

@@ -20,7 +20,7 @@ import numpy as np
 from .files import atomic_path, atomic_write
 from .ids import CONT, KINEMATIC
 
-MIN_SEEDS = 5  # what a panel needs before its verdict is a claim
+MIN_SEEDS_FOR_CLAIM = 5  # what a panel needs before its verdict is a claim
 
 
 @dataclass(frozen=True)
@@ -187,8 +187,8 @@ def write_report(run_dir, path) -> Path:
                                      for m in panel.baselines if m in entries) or "no baseline ran"
             else:
                 verdicts = f"{panel.distilled} did not run"
-            if seeds < MIN_SEEDS:
-                verdicts += f" (fewer than {MIN_SEEDS} seeds: not a claim)"
+            if seeds < MIN_SEEDS_FOR_CLAIM:
+                verdicts += f" (fewer than {MIN_SEEDS_FOR_CLAIM} seeds: not a claim)"
             summary.append(f"| {panel.letter} | {panel.task} | {world} | {seeds} | {budget} | {verdicts} |")
             body += [f"## {title}", "", f"The paper: *{panel.claim}*.", "",
                      f"Measured: {verdicts}." + (f" Did not run: {', '.join(missing)}."

@@ -20,7 +20,7 @@ A run directory holds
 * ``tb/``: TensorBoard logs (on resume, what the killed run logged after its checkpoint is
   purged, as from the CSV logs);
 * ``result.json``: written last; its presence means the run is finished and reusable. It
-  names the agent's ``algorithm`` (as the saved model does, for ``load_agent``).
+  names the agent's ``algorithm``, as the saved model does.
 
 Every whole-file write goes through ``craftsuite.files`` (a temporary file, then
 ``os.replace``), so a killed run never leaves a half-written file. An advisory lock (``flock`` on ``.lock``, which names its
@@ -39,18 +39,19 @@ import os
 import socket
 from pathlib import Path
 
-from .files import atomic_write  # also importable from here, where it lived before craftsuite.files
+from .files import atomic_write
 
 EPISODE_FIELDS = ("step", "return", "length", "success")
-EVAL_FIELDS = ("step", "success", "return", "episodes", "length")  # length: absent from runs before 0.2
+EVAL_FIELDS = ("step", "success", "return", "episodes", "length")
 
 
 class RunError(RuntimeError):
     """A run directory that cannot be used (locked by a live run, or holding another config)."""
 
 
-# config.json's layout: 1 (before 0.2: the dataclass fields alone) or 2 (with ``effective``
-# and ``provenance``). Readers take both; a run directory of layout 1 is never resumed.
+# config.json's layout: 2, the dataclass fields with ``effective`` and ``provenance``. A
+# record without ``format`` is read as layout 1, the fields alone: it loads, but it says
+# nothing of the effective settings, so a run directory holding one is never resumed.
 FORMAT = 2
 RECORD_KEYS = ("format", "provenance")  # in config.json, beside the settings: not hashed, not compared
 # fields that say where a file lives, not what the run computes from: recorded, but neither
@@ -173,8 +174,8 @@ class RunDir:
         if path.exists():
             saved = read_config(self.path)
             if "effective" not in saved and "effective" in mine:
-                raise RunError(f"{self.path} holds a run recorded by an older CraftSuite, without its effective "
-                               "settings, so it cannot be told to match this configuration; it is not resumed: "
+                raise RunError(f"{self.path} holds a run recorded without its effective settings (record format 1), "
+                               "so it cannot be told to match this configuration; it is not resumed: "
                                "choose another output directory")
             if run_settings(saved) != run_settings(mine):
                 raise RunError(f"{self.path} holds a run with another configuration ({path}); "
@@ -229,18 +230,11 @@ class RunDir:
         return self.path / "checkpoint" / "model.zip"
 
     @property
-    def replay(self) -> Path:
-        return self.path / "checkpoint" / "replay.pkl"
-
-    @property
     def result_path(self) -> Path:
         return self.path / "result.json"
 
     def finished(self) -> bool:
         return self.result_path.exists()
-
-    def result(self) -> dict:
-        return json.loads(self.result_path.read_text())
 
     def write_result(self, result: dict) -> None:
         atomic_write(self.result_path, json.dumps(result, indent=2) + "\n")

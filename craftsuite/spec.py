@@ -199,7 +199,7 @@ class KinematicConfig:
     max_steps: int = 1000
 
 
-KINEMATIC = KinematicConfig()
+KINEMATIC_CONFIG = KinematicConfig()
 
 
 @cache

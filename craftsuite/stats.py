@@ -4,9 +4,10 @@ Following Agarwal et al. (2021), "Deep reinforcement learning at the edge of the
 statistical precipice" (the ``rliable`` library):
 
 * per task and method, the seeds' values and a Student t-interval of their mean
-  (``t_interval``). Below ``MIN_SEEDS`` there is no interval, only the seeds. A percentile
-  bootstrap over 5 seeds covers the true mean in about 85% of normal cases, not the 95%
-  it is labelled with; the t-interval keeps its level (``benchmarks/interval_coverage.py``);
+  (``t_interval``). Below ``MIN_SEEDS_FOR_INTERVAL`` there is no interval, only the
+  seeds. A percentile bootstrap over 5 seeds covers the true mean in about 85% of normal
+  cases, not the 95% it is labelled with; the t-interval keeps its level
+  (``benchmarks/interval_coverage.py``);
 * across tasks, each method's interquartile mean (``aggregate_iqm``), the probability
   that it improves on a baseline (``probability_of_improvement``) and its performance
   profile (``performance_profile``), with stratified-bootstrap intervals.
@@ -31,7 +32,7 @@ from statistics import median
 import numpy as np
 
 LEVEL = 0.95
-MIN_SEEDS = 3  # fewer seeds: the values, and no interval
+MIN_SEEDS_FOR_INTERVAL = 3  # fewer seeds: the values, and no interval
 RESAMPLES = 2_000
 SEED = 0
 
@@ -52,14 +53,14 @@ class Estimate:
 def t_interval(values, level: float = LEVEL, bounds: tuple[float, float] = (-math.inf, math.inf)) -> Estimate:
     """The mean of ``values`` (one per seed) and its Student t-interval, clipped to
     ``bounds`` (a success rate's [0, 1]: the true mean lies inside them, so clipping loses
-    no coverage). Fewer than ``MIN_SEEDS`` values: the mean alone."""
+    no coverage). Fewer than ``MIN_SEEDS_FOR_INTERVAL`` values: the mean alone."""
     from scipy import stats
 
     x = np.asarray(values, dtype=float)
     if len(x) == 0 or not np.isfinite(x).all():  # a seed without a value: no estimate to make
         return Estimate(math.nan)
     mean = float(x.mean())
-    if len(x) < MIN_SEEDS:
+    if len(x) < MIN_SEEDS_FOR_INTERVAL:
         return Estimate(mean)
     half = float(stats.t.ppf(0.5 + level / 2, len(x) - 1) * x.std(ddof=1) / math.sqrt(len(x)))
     return Estimate(mean, max(bounds[0], mean - half), min(bounds[1], mean + half))

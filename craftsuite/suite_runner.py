@@ -211,7 +211,7 @@ def _check_students(configs: list[StudentConfig], device: str = "cpu") -> None:
     teachers have trained."""
     import craftsuite  # noqa: F401  (registers the ids)
 
-    from .agents.methods import make_agent
+    from .agents.factory import make_agent
 
     if any(c.engine == "population" for c in configs):
         from .population import check_supported

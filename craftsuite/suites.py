@@ -42,7 +42,7 @@ class Suite:
     eval_every: int | None = None  # None: 20 evaluations per run
     eval_episodes: int = 20
     # each world's collection regime: envs stepped side by side per agent step, and
-    # overrides of its algorithm's defaults (craftsuite.agents.methods): MuJoCo students
+    # overrides of its algorithm's defaults (craftsuite.hyperparameters): MuJoCo students
     # are TD3, grid students DQN, so one network size never reaches the other
     td3_hyperparameters: dict = field(default_factory=dict)
     dqn_hyperparameters: dict = field(default_factory=dict)

@@ -291,7 +291,7 @@ def _stopped(run: RunDir, stop_at) -> bool:
 
 def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
     """A teacher run under ``root``; returns its directory (with teacher.zip and table.npz)."""
-    from .agents.methods import distill_from_replay, make_agent
+    from .agents.factory import distill_from_replay, make_agent
 
     name = config.run_name()  # checks the hyperparameters before a run directory exists
     with RunDir(Path(root) / name, config) as run:
@@ -337,7 +337,8 @@ def student_result(config: StudentConfig, algorithm: str, steps: int, updates: i
 def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
     """A student (or baseline) run under ``root``; returns its directory."""
     from .agents import AutomatonQTable
-    from .agents.methods import METHODS, make_agent
+    from .agents.factory import make_agent
+    from .methods import METHODS
 
     if config.method not in METHODS:
         raise KeyError(f"unknown method {config.method!r}; methods: {sorted(METHODS)}")

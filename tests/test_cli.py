@@ -29,8 +29,8 @@ def test_unknown_task_is_a_clear_error(capsys):
     assert "unknown task 'Nope'" in err and "Traceback" not in err
 
 
-def test_demo_writes_pictures(tmp_path, capsys):
-    assert main(["demo", "--task", "DungeonQuest", "--episodes", "2", "--out", str(tmp_path)]) == 0
+def test_scripted_writes_pictures(tmp_path, capsys):
+    assert main(["scripted", "--task", "DungeonQuest", "--episodes", "2", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "| CraftSuite/DungeonQuest-Grid7-v0 | 2/2 |" in out
     assert (tmp_path / "DungeonQuest-Grid10-v0.png").read_bytes().startswith(b"\x89PNG")
@@ -47,12 +47,12 @@ def test_help_explains_commands(capsys):
     with pytest.raises(SystemExit):
         main(["--help"])
     out = capsys.readouterr().out
-    for command in ("tasks", "automaton", "demo"):
+    for command in ("tasks", "automaton", "scripted"):
         assert command in out
 
 
 def test_video_loads_craftsuite_agents(tmp_path, capsys):
-    from craftsuite.agents.methods import make_agent
+    from craftsuite.agents.factory import make_agent
 
     agent = make_agent("product-dqn", "CraftSuite/DungeonQuest-Grid7-v0", learning_starts=10, buffer_size=500)
     agent.learn(50)
@@ -76,7 +76,7 @@ def test_an_output_path_that_cannot_be_written_is_one_line(tmp_path, capsys):
 
 def test_zero_episodes_is_a_clear_error(capsys):
     with pytest.raises(SystemExit):
-        main(["demo", "--episodes", "0"])
+        main(["scripted", "--episodes", "0"])
     assert "must be at least 1" in capsys.readouterr().err
 
 
@@ -139,7 +139,7 @@ def test_debug_shows_the_traceback(capsys):
             main(argv)
 
 
-@pytest.mark.parametrize("command", [["student", "Nope"], ["teacher", "Nope"], ["demo", "--task", "Nope"],
+@pytest.mark.parametrize("command", [["student", "Nope"], ["teacher", "Nope"], ["scripted", "--task", "Nope"],
                                      ["student", "Reach", "--world", "Grid5"], ["teacher", "Reach", "--size", "5"]])
 def test_a_bad_task_or_world_is_named_and_nothing_is_written(tmp_path, capsys, command):
     out = tmp_path / "runs"

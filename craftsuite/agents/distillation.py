@@ -26,6 +26,7 @@ import torch as th
 
 from ..automata import Automaton
 from ..files import atomic_path
+from ..methods import TARGET_DEFAULTS
 
 FORMAT_VERSION = 1
 
@@ -194,8 +195,8 @@ class DistilledTarget:
     (``experiments/self-loops``).
     """
 
-    def __init__(self, table: AutomatonQTable, automaton: Automaton, rho: float = 0.999,
-                 self_loops: bool = True):
+    def __init__(self, table: AutomatonQTable, automaton: Automaton, rho: float = TARGET_DEFAULTS["rho"],
+                 self_loops: bool = TARGET_DEFAULTS["self_loops"]):
         table.check(automaton)
         if not 0.0 <= rho <= 1.0:
             raise ValueError(f"rho must lie in [0, 1], got {rho}")

@@ -24,7 +24,7 @@ from stable_baselines3.common.utils import polyak_update
 from stable_baselines3.dqn.policies import DQNPolicy, QNetwork
 from torch import nn
 
-from ..methods import DQN_CHOICES
+from ..hyperparameters import DQN_CHOICES
 from .distillation import DistilledTarget
 from .networks import features_policy_kwargs
 from .replay import AutomatonReplayBuffer, AutomatonSamples, NStepOwner, automaton_buffer_kwargs

@@ -14,7 +14,7 @@ import torch as th
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 
-from ..methods import DQN_CHOICES
+from ..hyperparameters import DQN_CHOICES
 
 FEATURES_EXTRACTORS = DQN_CHOICES["features_extractor"]
 

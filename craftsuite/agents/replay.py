@@ -223,9 +223,6 @@ class NStepOwner:
     from its keywords (``replay_buffer_kwargs``)."""
 
     def _setup_model(self) -> None:
-        # checkpoints saved before n_steps reached SB3 recorded SB3's default 1 beside the
-        # buffer's own: the buffer's is the one they trained with
-        self.n_steps = self.replay_buffer_kwargs.get("n_steps", self.n_steps)
         with warnings.catch_warnings():
             if isinstance(self.replay_buffer_class, type) and issubclass(self.replay_buffer_class,
                                                                           AutomatonReplayBuffer):

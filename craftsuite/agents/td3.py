@@ -1,5 +1,5 @@
-"""TD3 students for the MuJoCo worlds: SB3's TD3 with prioritized replay, the paper's actor
-delay schedule and, for distilled students, the distilled target.
+"""TD3 students for the MuJoCo worlds: SB3's TD3 with prioritized replay, an actor delay
+schedule and, for distilled students, the distilled target.
 
 Where this differs from SB3's TD3, and nowhere else:
 * ``AutomatonTD3._td_target``: the one seam for the target (clipped double-Q with target
@@ -7,7 +7,7 @@ Where this differs from SB3's TD3, and nowhere else:
   when a ``DistilledTarget`` is given).
 * ``AutomatonTD3.train``: SB3's loop, with the critic loss weighted by importance weights,
   priorities updated from the first critic's TD errors, and the actor delayed by
-  ``policy_delay_at(num_timesteps)`` (4 for the first 20,000 steps, 2 afterwards), which it
+  ``policy_delay_at(num_timesteps)`` (by default ``hyperparameters.TD3_DELAY_SCHEDULE``), which it
   sets as SB3's ``policy_delay`` for each call, so that attribute says the delay in force.
 """
 
@@ -19,6 +19,7 @@ import torch.nn.functional as F
 from stable_baselines3 import TD3
 from stable_baselines3.common.utils import polyak_update
 
+from ..hyperparameters import TD3_DELAY_SCHEDULE
 from .distillation import DistilledTarget
 from .replay import AutomatonReplayBuffer, AutomatonSamples, NStepOwner, automaton_buffer_kwargs
 
@@ -30,7 +31,7 @@ class AutomatonTD3(NStepOwner, TD3):
         prioritized: prioritized replay (``AutomatonReplayBuffer``), else uniform.
         distill: a ``DistilledTarget``; None for TD3 from scratch and product TD3.
         delay_schedule: ``((until_step, delay), ..., (None, delay))``: the actor's delay
-            by step (default: 4 until step 20,000, then 2).
+            by step (default: ``hyperparameters.TD3_DELAY_SCHEDULE``).
         policy_delay: a constant delay, as in SB3's TD3: the schedule ``((None, policy_delay),)``
             (give this or ``delay_schedule``). ``model.policy_delay`` is always the delay in
             force: the schedule's at the last training call.
@@ -124,7 +125,7 @@ def _delay_schedule(schedule, policy_delay) -> tuple:
     if policy_delay is not None:
         schedule = ((None, policy_delay),)
     elif schedule is None:
-        schedule = ((20_000, 4), (None, 2))  # the paper's authors' schedule
+        schedule = TD3_DELAY_SCHEDULE
     schedule = tuple(tuple(row) for row in schedule)
     for i, row in enumerate(schedule):
         last = i == len(schedule) - 1

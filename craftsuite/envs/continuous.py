@@ -32,7 +32,7 @@ class ContinuousWorldEnv(PlanarWorld):
     steps of 0.025 s); full thrust reaches the top speed of 2 m/s (0.5 m per decision)
     with a 0.2 s time constant, so crossing the arena takes about 14 decisions, as a 7x7
     grid teacher crosses its grid in 6 moves, and the scripted policy completes Blind
-    Craftsman in about 40. The fine-control world of earlier releases is
+    Craftsman in about 40. A fine-control world is
     ``gymnasium.make(id, frame_skip=2, max_episode_steps=1000)`` (0.05 s, the same 50 s
     of simulated time); no TD3 student has learned a task there.
 

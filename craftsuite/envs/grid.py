@@ -76,8 +76,8 @@ class GridWorldEnv(CraftWorld):
 
     ## Registered Configurations
     ``CraftSuite/<Task>-Grid<size>-v0`` for every spec in ``tasks/`` and each of its grid
-    sizes: BlindCraftsman, DungeonQuest, DiamondMine (7 and 10), BlindCraftsmanObstacles
-    (10). ``craftsuite tasks`` lists them.
+    sizes (every built-in task, BlindCraftsmanObstacles included: 7 and 10).
+    ``craftsuite tasks`` lists them.
     """
 
     metadata = {"render_modes": ["rgb_array", "ansi"], "render_fps": 8}

@@ -19,13 +19,13 @@ import numpy as np
 
 from ..rendering.frames import frame_side
 from ..rendering.panel import add_status_panel, hex_to_rgb
-from ..spec import KINEMATIC, TaskSpec
+from ..spec import KINEMATIC_CONFIG, TaskSpec
 from .board import BoardRules
 from .planar import PlanarWorld, obstacle_boxes, within_boxes
 
 # The authors' values (``spec.KinematicConfig``); the pickup radius and off-board penalty
 # are the spec's ``[continuous]`` values, which equal theirs (0.4, -0.1).
-STEP = KINEMATIC.step
+STEP = KINEMATIC_CONFIG.step
 SIZES = (7, 10)  # the board sides the authors ran: 7 (their teachers, TD3) and 10 (their
 # distilled Blind Craftsman student)
 OBSERVATIONS = ("authors", "craftsuite")

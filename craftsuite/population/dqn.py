@@ -17,7 +17,7 @@ from .targets import MemberTargets
 
 class PopulationDQN:
     """K DQN learners. ``settings`` are a run's effective DQN settings
-    (``methods.algorithm_settings("dqn", ...)``); ``targets`` the members' distilled targets."""
+    (``hyperparameters.algorithm_settings("dqn", ...)``); ``targets`` the members' distilled targets."""
 
     algorithm = "dqn"
 

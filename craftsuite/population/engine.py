@@ -4,7 +4,7 @@
 replay and exploration, and steps the K x n envs of one vector env: member k acts in its
 own n envs, stores in its own replay slice and takes its own gradient steps, in lockstep
 with the others. What a member does per transition is what an SB3 agent of its run does
-(``agents.methods.make_agent``): the same warm-up of random actions, exploration noise or
+(``agents.factory.make_agent``): the same warm-up of random actions, exploration noise or
 epsilon schedule, collection regime (``train_freq``, ``gradient_steps``), target-update
 interval, TD3 delay schedule and ``_td_target`` rule. Two differences, both deliberate:
 DQN explores with a coin per env (SB3's ``predict`` tosses one for all envs of a step), and

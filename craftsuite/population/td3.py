@@ -27,7 +27,7 @@ def net_arch(policy_kwargs: dict, default) -> tuple[list[int], list[int]]:
 
 class PopulationTD3:
     """K TD3 learners. ``settings`` are a run's effective TD3 settings
-    (``methods.algorithm_settings("td3", ...)``); ``targets`` the members' distilled targets
+    (``hyperparameters.algorithm_settings("td3", ...)``); ``targets`` the members' distilled targets
     (None from scratch)."""
 
     algorithm = "td3"

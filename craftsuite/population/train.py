@@ -272,7 +272,7 @@ def _resume(pop: Population, runs) -> None:
 
 def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, seconds: float, device: str) -> None:
     """Member ``k``'s model as an SB3 agent (``model.zip``), its result, its checkpoints gone."""
-    from ..agents.methods import make_agent
+    from ..agents.factory import make_agent
     from ..training import student_result
 
     agent = make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=1,

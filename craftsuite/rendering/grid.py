@@ -1,7 +1,6 @@
 """Drawing a grid world: RGB frames and ANSI text.
 
-The cell codes (``EMPTY``, ``WALL``) belong to the world (``craftsuite.envs.cells``); they
-are imported here, and stay importable from here for older code.
+The cell codes (``EMPTY``, ``WALL``) belong to the world (``craftsuite.envs.cells``).
 """
 
 from __future__ import annotations

@@ -34,7 +34,7 @@ def main(argv=None) -> None:
     import torch
 
     torch.set_num_threads(1)
-    from craftsuite.agents.methods import load_agent
+    from craftsuite.agents.factory import load_agent
     from craftsuite.training import evaluate
 
     model = load_agent(args.checkpoint / "model.zip")

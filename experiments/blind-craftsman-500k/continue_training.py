@@ -27,7 +27,7 @@ def job(run: Path, sigma: float) -> str:
     from stable_baselines3.common.callbacks import BaseCallback
 
     from craftsuite.agents import AutomatonQTable
-    from craftsuite.agents.methods import make_agent
+    from craftsuite.agents.factory import make_agent
     from craftsuite.agents.noise import make_action_noise
     from craftsuite.runs import load_config
     from craftsuite.training import StudentConfig, evaluate

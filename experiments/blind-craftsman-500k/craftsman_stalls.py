@@ -47,7 +47,7 @@ def main(argv=None) -> None:
     import torch
 
     torch.set_num_threads(1)
-    from craftsuite.agents.methods import make_agent
+    from craftsuite.agents.factory import make_agent
     from greedy_stalls import critic_greedy
     from td3_reach import HORIZONS, register_reach
 

@@ -24,7 +24,7 @@ import numpy as np
 
 def _load(run: Path):
     """A run's config, its last checkpoint's model, and whether it sees the automaton state."""
-    from craftsuite.agents.methods import load_agent
+    from craftsuite.agents.factory import load_agent
     from craftsuite.runs import RunDir, load_config
     from craftsuite.training import StudentConfig, checkpoint_dir
 

@@ -18,12 +18,12 @@ import _tools  # noqa: F401  (td3_reach and _students live with the calibration 
 
 
 def run(n: int, seed: int):
-    import craftsuite.agents.methods as methods
+    import craftsuite.agents.factory as factory
     from _students import train_with_reports
     from stable_baselines3 import TD3
     from td3_reach import HORIZONS, register_reach
 
-    real = methods.make_agent
+    real = factory.make_agent
 
     def make_agent(method, env_id, **kw):
         a = real(method, env_id, **kw)  # builds the env and the persistent noise as the package does
@@ -31,7 +31,7 @@ def run(n: int, seed: int):
                    gamma=0.99, tau=0.005, target_policy_noise=0.2, target_noise_clip=0.5, action_noise=a.action_noise,
                    policy_kwargs={"net_arch": [256, 256]}, n_steps=n, seed=seed)
 
-    methods.make_agent = make_agent  # _students builds its agent through this name
+    factory.make_agent = make_agent  # _students builds its agent through this name
     task = register_reach("tool")
     rows = train_with_reports("td3", None, task=task, seed=seed, steps=40_000, every=5_000, env_kwargs=HORIZONS[10][1],
                               action_noise={"type": "persistent", "sigma": 0.6, "resample": 0.1})

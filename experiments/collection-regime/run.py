@@ -61,7 +61,7 @@ def run(task: str, name: str, seed: int, seconds: float, every: float, transitio
     import craftsuite  # noqa: F401
     from stable_baselines3.common.callbacks import BaseCallback
 
-    from craftsuite.agents.methods import make_agent
+    from craftsuite.agents.factory import make_agent
     from craftsuite.training import evaluate
 
     regime = dict(REGIMES[name])

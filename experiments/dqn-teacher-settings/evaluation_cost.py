@@ -21,7 +21,8 @@ def main(argv=None) -> None:
     parser.add_argument("--episodes", type=int, default=50)
     args = parser.parse_args(argv)
     import craftsuite  # noqa: F401
-    from craftsuite.agents.methods import METHODS, make_agent
+    from craftsuite.agents.factory import make_agent
+    from craftsuite.methods import METHODS
     from craftsuite.training import evaluate
 
     for env_id, method in CASES:

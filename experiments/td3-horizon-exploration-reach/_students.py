@@ -27,7 +27,8 @@ def train_with_reports(method: str, table: str | None, *, task: str, seed: int, 
     from stable_baselines3.common.callbacks import BaseCallback
 
     from craftsuite.agents import AutomatonQTable
-    from craftsuite.agents.methods import METHODS, make_agent
+    from craftsuite.agents.factory import make_agent
+    from craftsuite.methods import METHODS
     from craftsuite.training import evaluate
 
     env_id = f"CraftSuite/{task}-Cont-v0"

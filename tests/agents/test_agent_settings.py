@@ -16,9 +16,9 @@ import craftsuite  # noqa: F401  (registers the ids)
 from craftsuite.agents import AutomatonQTable, DistillationError
 from craftsuite.agents.distillation import static_distillation
 from craftsuite.agents.dqn import AutomatonDQN
-from craftsuite.agents.methods import load_agent, make_agent, recorded_algorithm
+from craftsuite.agents.factory import load_agent, make_agent, recorded_algorithm
 from craftsuite.agents.td3 import AutomatonTD3
-from craftsuite.methods import HyperparameterError
+from craftsuite.hyperparameters import HyperparameterError
 from craftsuite.registration import resolve_task
 
 GRID, CONT = "CraftSuite/DungeonQuest-Grid7-v0", "CraftSuite/DungeonQuest-Cont-v0"
@@ -67,14 +67,6 @@ def test_n_steps_is_sb3s_attribute_and_the_buffers(method, world, small, tmp_pat
     assert back.n_steps == back.replay_buffer.n_steps == 3
     with pytest.raises(ValueError, match="n_steps is the algorithm's setting"):
         make_agent(method, world, replay_buffer_kwargs={"n_steps": 2}, **small)
-
-
-def test_a_checkpoint_that_predates_n_steps_in_sb3_reads_its_buffers(tmp_path):
-    agent = make_agent("product-dqn", GRID, n_steps=3, **SMALL_DQN)
-    agent.n_steps = 1  # as saved before: SB3's default beside the buffer's 3
-    agent.save(tmp_path / "old.zip")
-    back = load_agent(tmp_path / "old.zip")
-    assert back.n_steps == back.replay_buffer.n_steps == 3
 
 
 def _actor_updates(agent, gradient_steps: int) -> int:
@@ -129,25 +121,19 @@ def test_an_unknown_recorded_algorithm_is_named(tmp_path):
         load_agent(tmp_path / "a.zip")
 
 
-def test_models_that_record_no_algorithm_use_their_run_record_or_are_tried(tmp_path):
+def test_models_that_record_no_algorithm_are_tried_class_by_class(tmp_path):
     agent = make_agent("td3", CONT, **SMALL_TD3)
-    del agent.algorithm  # as saved before agents carried it
-    run = tmp_path / "run"
-    (run / "checkpoint").mkdir(parents=True)
-    agent.save(run / "checkpoint" / "model.zip")
-    assert recorded_algorithm(run / "checkpoint" / "model.zip") is None
-    assert type(load_agent(run / "checkpoint" / "model.zip")) is AutomatonTD3  # tried, class by class
-    (run / "config.json").write_text(json.dumps({"effective": {"method": {"algorithm": "td3"}}}))
-    assert recorded_algorithm(run / "checkpoint" / "model.zip") == "td3"
-    (run / "result.json").write_text(json.dumps({"algorithm": "dqn"}))
-    assert recorded_algorithm(run / "checkpoint" / "model.zip") == "dqn"  # the result is read first
+    del agent.algorithm  # as a plain SB3 checkpoint records none
+    agent.save(tmp_path / "model.zip")
+    assert recorded_algorithm(tmp_path / "model.zip") is None
+    assert type(load_agent(tmp_path / "model.zip")) is AutomatonTD3
 
 
 # -- hyperparameters are checked by make_agent too ------------------------------------------------
 def test_make_agent_names_a_bad_setting_before_it_makes_an_env(monkeypatch):
-    import craftsuite.agents.methods as methods
+    import craftsuite.agents.factory as factory
 
-    monkeypatch.setattr(methods, "make_vec_env", lambda *a, **k: pytest.fail("an env was made"))
+    monkeypatch.setattr(factory, "make_vec_env", lambda *a, **k: pytest.fail("an env was made"))
     with pytest.raises(HyperparameterError, match="batch_size must be an integer"):
         make_agent("dqn", GRID, batch_size="big")
     with pytest.raises(HyperparameterError, match="DQN has no setting 'policy_delay'"):

@@ -1,4 +1,4 @@
-"""Hyperparameters checked by name and type (craftsuite.methods) before anything runs."""
+"""Hyperparameters checked by name and type (craftsuite.hyperparameters) before anything runs."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 
 import pytest
 
-from craftsuite.methods import (DQN_DEFAULTS, TD3_DEFAULTS, HyperparameterError, algorithm_settings,
-                                check_hyperparameters, hyperparameter_examples)
+from craftsuite.hyperparameters import (DQN_DEFAULTS, TD3_DEFAULTS, HyperparameterError, algorithm_settings,
+                                        check_hyperparameters, hyperparameter_examples)
 
 
 @pytest.mark.parametrize("overrides,message", [
@@ -47,7 +47,7 @@ def test_values_of_the_right_type_pass_unchanged():
 
 @pytest.mark.parametrize("algorithm", ["dqn", "td3"])
 def test_every_setting_is_a_keyword_of_the_agent_and_every_data_keyword_a_setting(algorithm):
-    from craftsuite.agents.methods import CLASSES
+    from craftsuite.agents.factory import CLASSES
 
     cls = CLASSES[algorithm]
     sb3 = cls.__bases__[-1]  # SB3's DQN or TD3
@@ -71,7 +71,7 @@ def test_python_objects_are_the_constructors_to_judge_and_nulls_mean_the_default
     check, and a null setting (policy_delay: the schedule; replay_buffer_kwargs: none)."""
     from stable_baselines3.common.noise import NormalActionNoise
 
-    from craftsuite.agents.methods import make_agent
+    from craftsuite.agents.factory import make_agent
 
     noise = NormalActionNoise(np.zeros(2), np.full(2, 0.1))
     agent = make_agent("td3", "CraftSuite/Reach-Cont-v0", learning_rate=lambda progress: 1e-4 * progress,

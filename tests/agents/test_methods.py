@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from craftsuite.agents import AutomatonQTable
-from craftsuite.agents.methods import METHODS, distill_from_replay, load_agent, make_agent
-from craftsuite.methods import Method, MethodError, methods_for
+from craftsuite.agents.factory import distill_from_replay, load_agent, make_agent
+from craftsuite.methods import METHODS, Method, MethodError, methods_for
 
 GRID, CONT = "CraftSuite/DungeonQuest-Grid7-v0", "CraftSuite/DungeonQuest-Cont-v0"
 SMALL_DQN = dict(learning_starts=50, buffer_size=2_000, target_update_interval=100)

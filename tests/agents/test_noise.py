@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from stable_baselines3.common.noise import NormalActionNoise, OrnsteinUhlenbeckActionNoise
 
-from craftsuite.agents.methods import make_agent
+from craftsuite.agents.factory import make_agent
 from craftsuite.agents.noise import PersistentActionNoise, make_action_noise
 
 CONT = "CraftSuite/BlindCraftsman-Cont-v0"

@@ -303,7 +303,7 @@ def test_the_scripted_policy_completes_blind_craftsman():
 
 
 def test_a_td3_agent_learns_a_few_steps():
-    from craftsuite.agents.methods import make_agent
+    from craftsuite.agents.factory import make_agent
 
     agent = make_agent("td3", "CraftSuite/Reach-Kinematic-v0", learning_starts=50, seed=0)
     agent.learn(120)

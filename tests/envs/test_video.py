@@ -90,7 +90,7 @@ def test_videos_for_people_carry_the_status_panel(tmp_path, capsys):
 
     import gymnasium as gym
 
-    from craftsuite.agents.methods import make_agent
+    from craftsuite.agents.factory import make_agent
     from craftsuite.cli import main
     from craftsuite.suite_runner import _best_student_video
 

@@ -6,7 +6,7 @@ import pytest
 import torch as th
 
 import craftsuite  # noqa: F401
-from craftsuite.agents.methods import make_agent
+from craftsuite.agents.factory import make_agent
 from craftsuite.population.dqn import PopulationDQN
 from craftsuite.population.replay import Batch, sparse_rows
 from craftsuite.population.targets import MemberTargets
@@ -92,7 +92,7 @@ def test_dqn_update_matches_automaton_dqn(loss, prioritized, sparse):
 
 
 def agent_settings(agent, algorithm, **overrides) -> dict:
-    from craftsuite.methods import algorithm_settings
+    from craftsuite.hyperparameters import algorithm_settings
 
     return algorithm_settings(algorithm, overrides)
 

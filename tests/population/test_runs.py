@@ -9,7 +9,7 @@ import pytest
 import torch as th
 
 import craftsuite  # noqa: F401
-from craftsuite.agents.methods import load_agent
+from craftsuite.agents.factory import load_agent
 from craftsuite.configs import StudentConfig
 from craftsuite.population import EngineError, train_population
 from craftsuite.population import train as population_train

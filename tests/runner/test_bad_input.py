@@ -8,7 +8,7 @@ import warnings
 import pytest
 
 from craftsuite.cli import main
-from craftsuite.methods import HyperparameterError
+from craftsuite.hyperparameters import HyperparameterError
 from craftsuite.runs import RunDir, read_csv
 from craftsuite.training import CheckpointError, StudentConfig, TeacherConfig, train_student, train_teacher
 

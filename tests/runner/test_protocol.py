@@ -13,7 +13,7 @@ import pytest
 import torch as th
 
 import craftsuite  # noqa: F401  (registers the ids)
-from craftsuite.agents.methods import make_agent
+from craftsuite.agents.factory import make_agent
 from craftsuite.cli import main
 from craftsuite.configs import StudentConfig, TeacherConfig
 from craftsuite.methods import METHODS, MethodError
@@ -144,7 +144,7 @@ def test_students_without_the_automaton_state(tmp_path, method):
     result = json.loads((run / "result.json").read_text())
     assert result["product"] is False
     base = gym.make(config.env_id).observation_space.shape
-    from craftsuite.agents.methods import load_agent
+    from craftsuite.agents.factory import load_agent
 
     agent = load_agent(run / "model.zip")
     assert agent.observation_space.shape == base  # no automaton one-hot

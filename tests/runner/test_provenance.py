@@ -47,7 +47,7 @@ def test_a_session_is_on_record_from_its_start_and_updated_when_it_ends(tmp_path
 
 
 def test_a_run_records_its_effective_settings_and_the_code_that_trained_it(tmp_path, monkeypatch):
-    from craftsuite.methods import TD3_DEFAULTS
+    from craftsuite.hyperparameters import TD3_DEFAULTS
     from craftsuite.runs import FORMAT, RunDir, load_config, read_config, run_settings, settings
     from craftsuite.training import StudentConfig
 
@@ -83,14 +83,14 @@ def craftsuite_task_digest(task: str) -> str:
 def test_a_change_of_a_default_or_of_the_rules_gives_a_new_run_key(monkeypatch):
     import dataclasses
 
-    from craftsuite import methods, task_registry
+    from craftsuite import hyperparameters, task_registry
     from craftsuite.training import StudentConfig, TeacherConfig
 
     student, teacher = StudentConfig(method="td3"), TeacherConfig()
     keys = student.run_name(), teacher.run_name()
-    monkeypatch.setitem(methods.TD3_DEFAULTS, "learning_rate", 3e-4)
+    monkeypatch.setitem(hyperparameters.TD3_DEFAULTS, "learning_rate", 3e-4)
     assert student.run_name() != keys[0] and teacher.run_name() == keys[1]  # DQN's defaults did not change
-    monkeypatch.setitem(methods.DQN_DEFAULTS, "target_update_interval", 1_000)
+    monkeypatch.setitem(hyperparameters.DQN_DEFAULTS, "target_update_interval", 1_000)
     assert teacher.run_name() != keys[1]
     monkeypatch.undo()
     assert (student.run_name(), teacher.run_name()) == keys

@@ -7,7 +7,8 @@ import sys
 
 import pytest
 
-from craftsuite.runs import EPISODE_FIELDS, RunDir, RunError, atomic_write, read_csv
+from craftsuite.files import atomic_write
+from craftsuite.runs import EPISODE_FIELDS, RunDir, RunError, read_csv
 from craftsuite.training import StudentConfig
 
 

@@ -40,11 +40,11 @@ def test_student_run_logs_every_episode(tmp_path):
 
 
 def test_grid_student_keeps_one_fixed_instance(tmp_path, monkeypatch):
-    import craftsuite.agents.methods as methods
+    import craftsuite.agents.factory as factory
     import craftsuite.training as training
 
     seen = []
-    real_make, real_evaluate = methods.make_agent, training.evaluate
+    real_make, real_evaluate = factory.make_agent, training.evaluate
 
     def make_agent(*args, env_kwargs=None, **kwargs):
         seen.append(("train", env_kwargs))
@@ -54,7 +54,7 @@ def test_grid_student_keeps_one_fixed_instance(tmp_path, monkeypatch):
         seen.append(("evaluate", env_kwargs))
         return real_evaluate(*args, env_kwargs=env_kwargs, **kwargs)
 
-    monkeypatch.setattr(methods, "make_agent", make_agent)
+    monkeypatch.setattr(factory, "make_agent", make_agent)
     monkeypatch.setattr(training, "evaluate", evaluate)
     config = StudentConfig(method="dqn", world="Grid7", steps=300, eval_every=300, eval_episodes=1,
                            hyperparameters={**TINY_DQN, "learning_starts": 200}, layout_seed=3)
@@ -216,13 +216,13 @@ def test_a_field_at_its_default_is_left_out_of_the_key_and_old_records_load_but_
     plain, skipped = StudentConfig(), StudentConfig(world_kwargs={"frame_skip": 10})
     assert plain.run_name() != skipped.run_name() != StudentConfig(n_envs=4).run_name()
     assert not {"world_kwargs", "n_envs"} & set(settings(plain))  # fields added later, at their default
-    # a record as CraftSuite wrote it before runs recorded their effective settings
+    # a record of format 1: the config's fields alone, without the effective settings
     saved = {k: v for k, v in dataclasses.asdict(plain).items() if k not in ("world_kwargs", "n_envs")}
     old = tmp_path / plain.run_name()
     old.mkdir()
     (old / "config.json").write_text(json.dumps(saved))
     assert load_config(StudentConfig, old) == plain  # it loads
-    with pytest.raises(RunError, match="recorded by an older CraftSuite, without its effective settings"):
+    with pytest.raises(RunError, match=r"recorded without its effective settings \(record format 1\)"):
         with RunDir(old, plain):  # but is not taken for a run of these settings
             pass
     assert json.loads((old / "config.json").read_text()) == saved  # and is left as it was

@@ -1,4 +1,5 @@
-"""Every method of ``craftsuite.methods.METHODS`` built into an agent: ``make_agent(method, env, ...)``.
+"""Agents built and loaded: every method of ``craftsuite.methods.METHODS`` built into an
+agent by ``make_agent(method, env, ...)``, a saved agent loaded by ``load_agent``.
 
 Grid methods are DQN (``AutomatonDQN``), MuJoCo methods TD3 (``AutomatonTD3``); the table
 says which sees the automaton state and how it uses the automaton. A teacher is
@@ -16,8 +17,8 @@ import gymnasium as gym
 from stable_baselines3.common.env_util import make_vec_env
 from stable_baselines3.common.vec_env import VecEnv
 
-from ..methods import (  # noqa: F401  (METHODS and the defaults re-exported)
-    ALGORITHMS, DQN_DEFAULTS, METHODS, TD3_DEFAULTS, Method, algorithm_settings, check_methods)
+from ..hyperparameters import algorithm_settings
+from ..methods import ALGORITHMS, METHODS, Method, check_methods
 from ..envs.base import CraftWorld
 from ..envs.grid import GridWorldEnv
 from ..ids import parse_id, world_kind
@@ -44,7 +45,7 @@ def make_agent(method: str, env, *, table: AutomatonQTable | None = None, seed: 
     method on a grid, a MuJoCo method in MuJoCo) and see the automaton state exactly when it
     is a product method (``product=True``). ``rho`` and ``self_loops`` go to the distilled
     target (``DistilledTarget``; None: the method's); ``overrides`` to the algorithm,
-    checked by name and type (``craftsuite.methods.check_hyperparameters``; TD3's
+    checked by name and type (``craftsuite.hyperparameters.check_hyperparameters``; TD3's
     ``action_noise`` may be a spec such as ``{"type": "persistent", "sigma": 0.6,
     "resample": 0.1}``: ``agents/noise.py``)."""
     check_methods([method])
@@ -118,29 +119,15 @@ def distill_from_replay(teacher: AutomatonDQN, chunk: int = 4096) -> AutomatonQT
 
 
 def recorded_algorithm(path) -> str | None:
-    """The algorithm (a key of ``CLASSES``) a saved agent records: the model's own metadata
-    (``algorithm``, saved since CraftSuite's agents carry it), else its run's record beside
-    it (``result.json``'s ``algorithm``, or ``config.json``'s effective method, which runs of
-    record format 2 carry); None when neither says (a plain SB3 checkpoint, an older run)."""
-    path = Path(path)
+    """The algorithm (a key of ``CLASSES``) a saved agent records in its model's metadata
+    (``algorithm``, which every CraftSuite agent saves); None where it records none (a plain
+    SB3 checkpoint) or cannot be read."""
     try:
         with zipfile.ZipFile(path) as z:
             data = json.loads(z.read("data"))
-        if isinstance(data.get("algorithm"), str):
-            return data["algorithm"]
     except (OSError, KeyError, ValueError, zipfile.BadZipFile):
-        pass  # damaged or foreign: the record beside, or loading, will say more
-    for run in (path.parent, path.parent.parent):  # run/model.zip, run/checkpoint/model.zip
-        for record, keys in (("result.json", ("algorithm",)), ("config.json", ("effective", "method", "algorithm"))):
-            try:
-                value = json.loads((run / record).read_text())
-                for key in keys:
-                    value = value[key]
-            except (OSError, ValueError, KeyError, TypeError):
-                continue
-            if isinstance(value, str):
-                return value
-    return None
+        return None  # damaged or foreign: loading will say more
+    return data["algorithm"] if isinstance(data.get("algorithm"), str) else None
 
 
 def load_agent(path, env=None):
@@ -165,8 +152,7 @@ def load_agent(path, env=None):
         except Exception as err:  # damaged inside: whatever SB3 raises
             raise ValueError(f"{path} could not be loaded as {CLASSES[algorithm].__name__}: "
                              f"{type(err).__name__}: {err}") from None
-    # Neither the model nor a run record names its algorithm: a plain SB3 checkpoint or an
-    # agent saved before CraftSuite recorded it. Only these are tried class by class.
+    # The model names no algorithm: a plain SB3 checkpoint, tried class by class.
     errors = []
     for cls in (AutomatonDQN, AutomatonTD3, sb3.DQN, sb3.TD3, sb3.SAC, sb3.PPO, sb3.A2C, sb3.DDPG):
         try:

@@ -5,11 +5,11 @@ import json
 
 import pytest
 
-from craftsuite import leaderboard
 from craftsuite.cli import main
-from craftsuite.reproduction import FIGURE_5, verdict, write_report
+from craftsuite.reporting.pages import PAPER_REFERENCE
+from craftsuite.reproduction import FIGURE_5, write_report
 
-from .test_leaderboard import fake_run
+from ..reporting.fakes import fake_run
 
 
 def _seeds(root, method, success, world="Kinematic", task="BlindCraftsman", seeds=5, ret=0.0):
@@ -37,19 +37,6 @@ def transfer_dir(tmp_path):
     (teacher / "result.json").write_text(json.dumps({"steps": 100_000, "updates": 9_900, "success": 0.3,
                                                      "reached_target": False}))
     return out
-
-
-def test_verdicts_follow_the_intervals(transfer_dir):
-    board = {(e.task, e.world, e.method): e for e in leaderboard.build(transfer_dir / "students")}
-    ahead = board["BlindCraftsman", "Kinematic", "td3-dynamic"]
-    assert verdict(ahead, board["BlindCraftsman", "Kinematic", "td3"]) == "ahead"
-    assert verdict(board["BlindCraftsman", "Kinematic", "td3"], ahead) == "behind"
-    assert verdict(ahead, board["BlindCraftsman", "Kinematic", "td3"], "return") == "ahead"
-    dq = {m: board["DungeonQuest", "Grid10", m] for m in ("dynamic", "crm", "product-dqn")}
-    assert verdict(dq["dynamic"], dq["product-dqn"]) == "behind"
-    assert verdict(dq["dynamic"], dq["crm"]) == "no difference measured"
-    nothing = board["BlindCraftsman", "Cont", "td3-dynamic"], board["BlindCraftsman", "Cont", "td3"]
-    assert verdict(*nothing) == "neither learned"
 
 
 def test_the_report_names_every_panel_what_ran_and_what_did_not(transfer_dir, tmp_path):
@@ -88,7 +75,7 @@ def test_the_authors_curves_are_their_six_runs_on_their_axis():
         assert steps == sorted(steps) and 19_000_000 < steps[-1] <= 20_000_000  # 2M steps of 10 envs
     # their reference rows (the last 5% of each run) agree with the binned curves' end
     last = {m: curves["GoldMine", m][-5:] for m in ("td3", "td3-dynamic")}
-    assert sum(r for _, r in last["td3-dynamic"]) / 5 == pytest.approx(leaderboard.PAPER_REFERENCE["GoldMine"]["td3-dynamic"], abs=2.5)
+    assert sum(r for _, r in last["td3-dynamic"]) / 5 == pytest.approx(PAPER_REFERENCE["GoldMine"]["td3-dynamic"], abs=2.5)
 
 
 def test_bad_input_is_named(tmp_path, capsys):

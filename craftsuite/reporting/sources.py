@@ -38,7 +38,8 @@ def read_runs(path, *, transfer: bool = False) -> RunsDirectory:
     board = build(students)
     if not board.entries:
         raise ValueError(f"no finished student runs under {students}"
-                         + (f" ({len(board.unfinished)} unfinished)" if board.unfinished else ""))
+                         + (f" ({len(board.unfinished)} unfinished)" if board.unfinished else "")
+                         + "".join(f"; not read: {reason}" for reason in board.unreadable))
     suite = {}
     if (path / "suite.json").exists():
         try:

@@ -215,3 +215,25 @@ def test_interval_verdicts_follow_the_intervals(tmp_path):
     assert verdict(*nothing, "return") == "too few seeds"  # two seeds each: no interval
     # the transfer target on the same entries: 80% at 500 against never
     assert verdict(ahead, td3, "steps_to_80") == "met: scratch never got there (500 against never in 1,000)"
+
+
+@pytest.mark.parametrize("name, text, problem", [
+    ("result.json", "{torn", "is not valid JSON"),
+    ("result.json", json.dumps({"steps": 1000}), "holds no student's or teacher's result"),
+    ("result.json", json.dumps({"kind": "student"}), "holds no transitions"),
+    ("evals.csv", "step,success,return,episodes\nlate,1.0,0.0,10\n", "does not read as a run's log"),
+    ("episodes.csv", "step,return,length,success\n995,high,10,1\n", "does not read as a run's log"),
+    ("config.json", json.dumps({"world": "Cont"}), "holds no run configuration"),
+    ("config.json", None, "is missing beside its result.json"),
+])
+def test_a_damaged_record_is_named_by_its_file_and_never_pooled(runs, name, text, problem):
+    damaged = fake_run(runs, "td3", 8, [(1000, 1.0)], [(995, 1.0)])
+    if text is None:
+        (damaged / name).unlink()
+    else:
+        (damaged / name).write_text(text)
+    board = build(runs)
+    assert {e.method: e.seeds for e in board} == {"td3": [0, 1], "td3-dynamic": [0, 1]}
+    [reason] = board.unreadable
+    assert reason.startswith(str(damaged / name)) and problem in reason
+    assert not board.unfinished

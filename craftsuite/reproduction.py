@@ -126,7 +126,7 @@ def write_report(run_dir, path) -> Path:
     """
     from .reporting.board import Board, verdict
     from .reporting.pages import task_table
-    from .reporting.plots import plot_curves
+    from .reporting.plots import file_part, plot_curves
     from .reporting.sources import read_runs
 
     runs, path = read_runs(run_dir, transfer=True), Path(path)
@@ -170,7 +170,7 @@ def write_report(run_dir, path) -> Path:
                      f"Measured: {verdicts}." + (f" Did not run: {', '.join(missing)}."
                                                  if [m for m in missing if m != panel.distilled] else ""), ""]
             body += [*task_table([entries[m] for m in ran]), ""]
-            plot = curves.get(f"curves-{panel.task}-{world}")
+            plot = curves.get(f"curves-{panel.task}-{file_part(world)}")
             if plot is not None:
                 body += [f"![{panel.letter}: {panel.task}, {world}]({plot.relative_to(path.parent).as_posix()})", ""]
             if entries[ran[0]].world == KINEMATIC:  # the world the authors' continuous curves come from

@@ -12,10 +12,11 @@ from craftsuite.reproduction import FIGURE_5, write_report
 from ..reporting.fakes import fake_run
 
 
-def _seeds(root, method, success, world="Kinematic", task="BlindCraftsman", seeds=5, ret=0.0):
+def _seeds(root, method, success, world="Kinematic", task="BlindCraftsman", seeds=5, ret=0.0, **config):
     for seed in range(seeds):
         value = success + 0.01 * seed if success else 0.0
-        fake_run(root, method, seed, [(500, value), (1000, value)], [(950, ret + seed)], task=task, world=world)
+        fake_run(root, method, seed, [(500, value), (1000, value)], [(950, ret + seed)], task=task, world=world,
+                 **config)
 
 
 @pytest.fixture
@@ -24,6 +25,7 @@ def transfer_dir(tmp_path):
     students = out / "students"
     _seeds(students, "td3-dynamic", 0.8, ret=50.0)  # (e), kinematic: ahead of scratch
     _seeds(students, "td3", 0.1)
+    _seeds(students, "td3-dynamic", 0.8, world_kwargs={"size": 10})  # (e), on the authors' 10x10 board
     _seeds(students, "td3-dynamic", 0.0, world="Cont", seeds=2)  # (e), MuJoCo: two seeds, nothing learned
     _seeds(students, "td3", 0.0, world="Cont", seeds=2)
     _seeds(students, "dynamic", 0.1, world="Grid10", task="DungeonQuest")  # (a): behind product DQN; static missing
@@ -60,6 +62,9 @@ def test_the_report_names_every_panel_what_ran_and_what_did_not(transfer_dir, tm
     assert "1,000 transitions" in text
     images = tmp_path / "docs" / "images" / "reproduction"
     assert (images / "curves-BlindCraftsman-Kinematic.png").exists()
+    # every panel's curves are linked, a world with settings too
+    for name in ("curves-BlindCraftsman-Kinematic.png", "curves-BlindCraftsman-Kinematic-size-10.png"):
+        assert (images / name).exists() and f"](images/reproduction/{name})" in text
     # the kinematic panels' returns beside the authors' published curves; none in MuJoCo
     assert (images / "returns-BlindCraftsman-Kinematic.png").exists() and "returns beside the authors'" in text
     assert not (images / "returns-BlindCraftsman-Cont.png").exists()

@@ -8,7 +8,6 @@ import pytest
 
 from craftsuite.reporting.board import Board, aggregates, build, run_metrics, verdict
 from craftsuite.reporting.pages import leaderboard_markdown, write_leaderboard
-from craftsuite.reporting.plots import plot_curves, plot_profiles
 
 from .fakes import fake_run
 

@@ -159,7 +159,8 @@ def write_report(run_dir, path) -> Path:
             budget = entries[ran[0]].budget_text
             if panel.distilled in entries:
                 d = entries[panel.distilled]
-                verdicts = "; ".join(f"{m}: AUC {verdict(d, entries[m], 'auc')}, return {verdict(d, entries[m], 'return')}"
+                verdicts = "; ".join(f"{m}: AUC {verdict(d, entries[m], 'auc')}, "
+                                     f"return {verdict(d, entries[m], 'return')}"
                                      for m in panel.baselines if m in entries) or "no baseline ran"
             else:
                 verdicts = f"{panel.distilled} did not run"

@@ -27,7 +27,7 @@ import numpy as np
 from scipy.stats import mannwhitneyu
 
 from craftsuite import stats
-from craftsuite.leaderboard import run_metrics
+from craftsuite.reporting.board import run_metrics
 from _page import Report, add_page_argument
 
 ENGINES = ("population", "sb3")

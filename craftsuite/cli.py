@@ -332,7 +332,9 @@ def _transfer(args) -> int:
 
 
 def _leaderboard(args) -> int:
-    from . import leaderboard
+    from .reporting.pages import write_leaderboard, write_results_page
+    from .reporting.plots import plot_curves
+    from .reporting.sources import read_runs
 
     if args.reproduction:
         if args.page or args.out or len(args.runs) > 1:
@@ -346,22 +348,15 @@ def _leaderboard(args) -> int:
         if args.out:
             raise ValueError("--page writes the page and its images beside PATH; --out is for one directory's "
                              "leaderboard: use one or the other")
-        path = leaderboard.write_page(args.runs, args.page)
+        path = write_results_page(args.runs, args.page)
         print(f"wrote {path}")
         return 0
     if len(args.runs) > 1:
         raise ValueError("several run directories make one results page: add --page PATH")
-    root = Path(args.runs[0])
-    students = root / "students" if (root / "students").is_dir() else root
-    if not students.is_dir():
-        raise FileNotFoundError(f"no run directory at {root}")
-    board = leaderboard.build(students)
-    if not board.entries:
-        raise ValueError(f"no finished student runs under {students}"
-                         + (f" ({len(board.unfinished)} unfinished)" if board.unfinished else ""))
-    out = Path(args.out or root)
-    path = leaderboard.write(board, out)
-    plots = leaderboard.plot_curves(students, out, board)
+    runs = read_runs(args.runs[0])
+    out = Path(args.out or runs.path)
+    path = write_leaderboard(runs.board, out)
+    plots = plot_curves(runs.board, out)
     print(path.read_text())
     print(f"wrote {path}, {out / 'leaderboard.csv'}" + "".join(f", {p}" for p in plots))
     return 0

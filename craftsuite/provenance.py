@@ -3,7 +3,7 @@
 ``transfer`` takes a session when it starts (``start_session``), records it in
 ``<out>/provenance.json`` at once without a duration, and records its duration when it
 ends: a session that is killed still leaves its command and commit, marked unfinished.
-The results page (``leaderboard.write_page``) prints the sessions beside the leaderboard.
+The results page (``reporting.pages.write_results_page``) prints the sessions beside the leaderboard.
 """
 
 from __future__ import annotations

@@ -19,6 +19,7 @@ import numpy as np
 
 from .files import atomic_path, atomic_write
 from .ids import CONT, KINEMATIC
+from .reporting.board import world_label
 
 MIN_SEEDS_FOR_CLAIM = 5  # what a panel needs before its verdict is a claim
 
@@ -27,7 +28,7 @@ MIN_SEEDS_FOR_CLAIM = 5  # what a panel needs before its verdict is a claim
 class Panel:
     letter: str
     task: str
-    worlds: tuple[str, ...]  # student worlds; a continuous panel is read in both continuous worlds
+    worlds: tuple[str, ...]  # student worlds (``world_label``); a continuous panel is read in both continuous worlds
     distilled: str  # the paper's method
     baselines: tuple[str, ...]
     claim: str  # the paper's words
@@ -46,7 +47,8 @@ FIGURE_5 = (
     Panel("d", "BlindCraftsmanObstacles", ("Grid10",), "dynamic", _GRID_BASELINES,
           "a faster convergence in the student grid world with obstacles the teacher never saw"),
     # the authors' distilled Blind Craftsman student ran on a 10x10 board (their scratch TD3 on 7x7)
-    Panel("e", "BlindCraftsman", (KINEMATIC, f"{KINEMATIC}: size=10", CONT), "td3-dynamic", ("td3",), _CONT_CLAIM),
+    Panel("e", "BlindCraftsman", (KINEMATIC, world_label(KINEMATIC, {"size": 10}), CONT), "td3-dynamic", ("td3",),
+          _CONT_CLAIM),
     # the paper's caption says Diamond Mine; the authors' TD3 runs behind it are their Gold Mine
     Panel("f", "GoldMine", (KINEMATIC, CONT), "td3-dynamic", ("td3",), _CONT_CLAIM),
     Panel("g", "DungeonQuest", (KINEMATIC, CONT), "td3-dynamic", ("td3",), _CONT_CLAIM),
@@ -68,7 +70,7 @@ def authors_curves() -> dict[tuple[str, str], list[tuple[int, float]]]:
     return curves
 
 
-def plot_against_authors(students_root, out, entries, task: str, world: str) -> Path | None:
+def plot_against_authors(out, entries, task: str, world: str) -> Path | None:
     """Return per training episode against transitions, ours (mean over seeds, the last 10%
     of the budget before each point, as the leaderboard's curves) beside the authors'
     published curves, on their axis (20M transitions) and on ours; None when they published
@@ -76,7 +78,7 @@ def plot_against_authors(students_root, out, entries, task: str, world: str) -> 
     from matplotlib.figure import Figure
     from matplotlib.ticker import EngFormatter
 
-    from .leaderboard import _file_part, _smoothed
+    from .reporting.plots import file_part, smoothed
     from .runs import read_csv
 
     theirs = {m: c for (t, m), c in authors_curves().items() if t == task}
@@ -88,9 +90,9 @@ def plot_against_authors(students_root, out, entries, task: str, world: str) -> 
     axes = fig.subplots(1, 2)
     colors = {}
     for e in entries:
-        series = np.array([_smoothed([(int(r["step"]), float(r["return"])) for r in
-                                      read_csv(Path(students_root) / name / "episodes.csv")], grid)
-                           for name in e.runs])
+        series = np.array([smoothed([(int(r["step"]), float(r["return"])) for r in read_csv(run / "episodes.csv")],
+                                    grid)
+                           for run in e.runs])
         mean = np.full(len(grid), np.nan)
         valid = ~np.isnan(series).all(axis=0)  # before a run's first episode: no value yet
         mean[valid] = np.nanmean(series[:, valid], axis=0)
@@ -109,31 +111,10 @@ def plot_against_authors(students_root, out, entries, task: str, world: str) -> 
         ax.xaxis.set_major_formatter(EngFormatter(sep=""))
     fig.suptitle(f"{task} ({world}): return per training episode")
     fig.tight_layout()
-    path = Path(out) / f"returns-{task}-{_file_part(world)}.png"
+    path = Path(out) / f"returns-{task}-{file_part(world)}.png"
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=110)
     return path
-
-
-def verdict(distilled, baseline, metric: str = "auc") -> str:
-    """How the distilled student's ``metric`` (a leaderboard metric: ``auc``, ``return``)
-    compares with a baseline's: ``ahead``, ``behind``, ``no difference measured`` (the
-    intervals overlap), ``neither learned`` (success 0 at every evaluation of both, for the
-    success metrics), or ``too few seeds`` (no interval)."""
-    import math
-
-    a, b = distilled.stats[metric], baseline.stats[metric]
-    if math.isnan(a.value) or math.isnan(b.value):
-        return "not measured"
-    if metric in ("auc", "success") and a.value == 0 and b.value == 0:
-        return "neither learned"
-    if not (a.has_interval and b.has_interval):
-        return "too few seeds"
-    if a.low > b.high:
-        return "ahead"
-    if a.high < b.low:
-        return "behind"
-    return "no difference measured"
 
 
 def write_report(run_dir, path) -> Path:
@@ -143,34 +124,29 @@ def write_report(run_dir, path) -> Path:
     Raises:
         FileNotFoundError, ValueError: no such directory, or no finished student run in it.
     """
-    from .leaderboard import Board, build, plot_curves, to_markdown
-    from .provenance import read
+    from .reporting.board import Board, verdict
+    from .reporting.pages import task_table
+    from .reporting.plots import file_part, plot_curves
+    from .reporting.sources import read_runs
 
-    run_dir, path = Path(run_dir), Path(path)
-    students = run_dir / "students"
-    if not students.is_dir():
-        raise FileNotFoundError(f"{run_dir} is not a transfer output directory (no students/)")
-    board = build(students)
-    if not board.entries:
-        raise ValueError(f"no finished student runs under {students}")
+    runs, path = read_runs(run_dir, transfer=True), Path(path)
+    run_dir, board = runs.path, runs.board
     images = path.parent / "images" / "reproduction"
     shutil.rmtree(images, ignore_errors=True)
     images.mkdir(parents=True)
     panels = {(p.task, w) for p in FIGURE_5 for w in p.worlds}  # not a task or world of no panel
-    curves = {p.stem: p for p in plot_curves(students, images,
-                                             Board([e for e in board if (e.task, e.world) in panels]))}
-    suite = json.loads((run_dir / "suite.json").read_text()) if (run_dir / "suite.json").exists() else {}
+    curves = {p.stem: p for p in plot_curves(Board([e for e in board if (e.task, e.world_label) in panels]), images)}
     lines = ["# Reproducing the paper's Figure 5", "",
              f"<!-- generated by `craftsuite leaderboard {run_dir.as_posix()} --reproduction {path.as_posix()}`;"
              " do not edit -->", ""]
-    lines += _what_ran(run_dir, board, suite, read(run_dir))
+    lines += _what_ran(runs)
     summary = ["| panel | task | world | seeds per method | budget per run (transitions / updates) | "
                "the distilled student against each baseline |", "|---|---|---|---|---|---|"]
     body = []
     for panel in FIGURE_5:
         for world in panel.worlds:
             # a method's runs of several settings: the one with the most runs (variant "a")
-            entries = {e.method: e for e in board if e.task == panel.task and e.world == world
+            entries = {e.method: e for e in board if e.task == panel.task and e.world_label == world
                        and e.method in panel.methods() and e.variant in ("", "a")}
             ran = [m for m in panel.methods() if m in entries]
             missing = [m for m in panel.methods() if m not in entries]
@@ -183,7 +159,8 @@ def write_report(run_dir, path) -> Path:
             budget = entries[ran[0]].budget_text
             if panel.distilled in entries:
                 d = entries[panel.distilled]
-                verdicts = "; ".join(f"{m}: AUC {verdict(d, entries[m])}, return {verdict(d, entries[m], 'return')}"
+                verdicts = "; ".join(f"{m}: AUC {verdict(d, entries[m], 'auc')}, "
+                                     f"return {verdict(d, entries[m], 'return')}"
                                      for m in panel.baselines if m in entries) or "no baseline ran"
             else:
                 verdicts = f"{panel.distilled} did not run"
@@ -193,12 +170,12 @@ def write_report(run_dir, path) -> Path:
             body += [f"## {title}", "", f"The paper: *{panel.claim}*.", "",
                      f"Measured: {verdicts}." + (f" Did not run: {', '.join(missing)}."
                                                  if [m for m in missing if m != panel.distilled] else ""), ""]
-            body += [_table(to_markdown([entries[m] for m in ran], title=None)), ""]
-            plot = curves.get(f"curves-{panel.task}-{world}")
+            body += [*task_table([entries[m] for m in ran]), ""]
+            plot = curves.get(f"curves-{panel.task}-{file_part(world)}")
             if plot is not None:
                 body += [f"![{panel.letter}: {panel.task}, {world}]({plot.relative_to(path.parent).as_posix()})", ""]
-            if world.startswith(KINEMATIC):  # the world the authors' continuous curves come from
-                returns = plot_against_authors(students, images, [entries[m] for m in ran], panel.task, world)
+            if entries[ran[0]].world == KINEMATIC:  # the world the authors' continuous curves come from
+                returns = plot_against_authors(images, [entries[m] for m in ran], panel.task, world)
                 if returns is not None:
                     body += [f"![{panel.letter}: returns beside the authors']"
                              f"({returns.relative_to(path.parent).as_posix()})", ""]
@@ -211,22 +188,13 @@ def write_report(run_dir, path) -> Path:
     return path
 
 
-def _table(markdown: str) -> str:
-    """The first table of a leaderboard's Markdown (one panel's rows, with the authors'
-    reference rows in the continuous worlds), without its legend and methods list."""
-    lines = markdown.splitlines()
-    start = next(i for i, line in enumerate(lines) if line.startswith("| method"))
-    end = next((i for i in range(start, len(lines)) if not lines[i].startswith("|")), len(lines))
-    return "\n".join(lines[start:end])
+def _what_ran(runs) -> list[str]:
+    """The protocol, the sessions and the budgets as run (``runs``: a ``RunsDirectory``),
+    and what the paper ran instead."""
+    from .reporting.sources import session_line
 
-
-def _what_ran(run_dir: Path, board, suite: dict, sessions: list[dict]) -> list[str]:
-    """The protocol, the sessions and the budgets as run, and what the paper ran instead."""
-    lines = ["## What ran", ""]
-    for s in sessions:
-        took = "did not finish" if s.get("seconds") is None else f"{s['seconds'] / 60:.0f} min"
-        lines.append(f"- `{s['command']}`: {s['started'][:10]}, commit {s.get('commit') or 'unknown'}, {took} "
-                     f"on {s['machine']}")
+    run_dir, board, suite = runs.path, runs.board, runs.suite
+    lines = ["## What ran", "", *(session_line(s, to_the_minute=False) for s in runs.sessions)]
     if suite:
         def layout(key, fixed):  # a suite.json from before a field existed holds the default's meaning
             return "new every episode" if suite.get(key, fixed) is None else "fixed"

@@ -175,8 +175,10 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     ``device``: the torch device of the population engine's students (``cpu``, ``cuda``).
     ``command``: how this run was asked for, as ``provenance.json`` records it (the CLI
     passes its command line); by default, this Python call."""
-    from . import leaderboard
     from .provenance import read, record_session, start_session
+    from .reporting.board import build
+    from .reporting.pages import write_leaderboard
+    from .reporting.plots import plot_curves
 
     if command is None:
         command = f"python: craftsuite.suite_runner.transfer(suite {suite.name!r}, out {str(out)!r})"
@@ -191,9 +193,9 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     teachers = suite.teachers()
     students = run_students(configs, out / "students", workers=workers, ray=ray, progress=progress,
                             teachers=teachers, teacher_root=out / "teachers", log=log, device=device)
-    board = leaderboard.build(out / "students")
-    board_md = leaderboard.write(board, out)
-    plots = leaderboard.plot_curves(out / "students", out, board)
+    board = build(out / "students")
+    board_md = write_leaderboard(board, out)
+    plots = plot_curves(board, out)
     log("")
     log(board_md.read_text())
     movie = None

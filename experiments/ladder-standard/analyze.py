@@ -19,9 +19,8 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from craftsuite.leaderboard import run_metrics
+from craftsuite.reporting.board import rung_order, run_metrics, world_label
 from craftsuite.methods import METHODS
-from craftsuite.task_registry import ladder
 
 
 def bootstrap_ci(values) -> tuple[float, float, float]:
@@ -51,10 +50,8 @@ def main(root):
     for run in sorted(students.iterdir()):
         m = run_metrics(run)
         if m is not None:
-            groups[m["task"], m["world"], m["method"]].append(m)
-    rungs = [spec.name for spec in ladder()]  # easiest first, as the leaderboard's sections; unknown tasks last
-    cells = sorted({(t, w) for t, w, _ in groups},
-                   key=lambda k: (rungs.index(k[0]) if k[0] in rungs else len(rungs), k[0], k[1]))
+            groups[m["task"], world_label(m["world"], m["world_kwargs"]), m["method"]].append(m)
+    cells = sorted({(t, w) for t, w, _ in groups}, key=lambda k: (rung_order(k[0]), k[1]))
     print(f"{sum(map(len, groups.values()))} finished runs in {root}")
     separated = {}  # (task, world) -> pairs apart by the t-interval of final success or of AUC
     for task, world in cells:

@@ -187,8 +187,9 @@ def test_suite_selection_errors_name_the_problem(tmp_path):
 
 
 def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenance(tmp_path, monkeypatch):
-    from craftsuite import leaderboard, suite_runner
+    from craftsuite import suite_runner
     from craftsuite.provenance import read
+    from craftsuite.reporting.pages import write_results_page
     from craftsuite.suite_runner import transfer
 
     tiny = dataclasses.replace(SUITES["quick"], tags=("calibration",), seeds=1, student_steps=300, eval_every=150,
@@ -207,7 +208,7 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
     [session] = read(tmp_path / "out")
     assert session["command"] == f"python: craftsuite.suite_runner.transfer(suite 'quick', out {str(tmp_path / 'out')!r})"
     assert session["machine"] and "torch" in session["versions"]
-    page = leaderboard.write_page([tmp_path / "out"], tmp_path / "docs" / "results.md")
+    page = write_results_page([tmp_path / "out"], tmp_path / "docs" / "results.md")
     text = page.read_text()
     assert "## quick:" in text and "### Reach (Cont)" in text and session["command"] in text
     assert "As last run: rungs tagged calibration; worlds Cont; methods td3, td3-dynamic-edges; 1 seed." in text
@@ -226,7 +227,7 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
     with pytest.raises(KeyboardInterrupt):
         transfer(tiny, tmp_path / "out", workers=2, video=False, progress=False, log=lambda *_: None)
     assert [s["seconds"] is None for s in read(tmp_path / "out")] == [False, False, True]
-    text = leaderboard.write_page([tmp_path / "out"], tmp_path / "docs" / "results.md").read_text()
+    text = write_results_page([tmp_path / "out"], tmp_path / "docs" / "results.md").read_text()
     assert text.count("min on ") == 2 and text.count("did not finish on ") == 1
 
 

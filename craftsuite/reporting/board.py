@@ -1,0 +1,386 @@
+"""A directory's student runs as a leaderboard: entries, their metrics, aggregates, verdicts.
+
+Per run (``run_metrics``):
+
+* ``success``: greedy success rate at the last evaluation;
+* ``return``: mean training-episode return over the last 10% of the run's steps;
+* ``train_success``: the share of training episodes won over the same window, with the
+  exploration noise on (what SB3 logs as ``rollout/success_rate``); a policy can win
+  there and still stall when evaluated greedily, so both are shown;
+* ``auc``: area under the evaluation success curve, as a fraction of the budget (the mean
+  of the evaluations, every ``eval_every`` steps and at the end): 1.0 means solved from the
+  first one;
+* ``steps_to_80``: transitions at the first evaluation with success >= 0.8 (None: never);
+* ``budget`` and ``updates``: the run's transitions and gradient updates.
+
+Per task, world and method (``build``): every seed's value, the mean and its Student
+t-interval (``craftsuite.stats``; below 3 seeds, the seeds alone), and steps to 80% as
+"k of n reached; the median of those that did". The world is its name and the settings
+that change it (``Entry.world``, ``Entry.world_kwargs``): runs in a fixed grid instance or
+at another frame skip are another benchmark, so they get a row of their own. Runs of one
+method whose settings differ in more than the seed are not pooled: each setting is a row
+of its own, flagged.
+
+Across tasks, per world (``aggregates``): each method's IQM of final success and of AUC
+with stratified-bootstrap intervals, and the probability that it improves on the same
+algorithm from scratch.
+
+Two entries are compared by ``verdict``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import string
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import stats
+from ..runs import RunError, flatten, read_config, read_csv, run_settings
+
+# metrics with a mean and an interval per task and method; a rate lies in [0, 1]
+METRICS = {"success": (0.0, 1.0), "return": (-math.inf, math.inf), "train_success": (0.0, 1.0),
+           "auc": (0.0, 1.0)}
+THRESHOLD = 0.8  # greedy success at which a run counts as having learned the task
+AGGREGATED = ("success", "auc")  # the metrics aggregated across tasks (rates: comparable across tasks)
+
+
+def world_of(config: dict) -> tuple[str, dict]:
+    """A student's world as its ``config.json`` records it: the world's name and the
+    keywords that change it (a fixed grid instance, a frame skip, a board size)."""
+    from ..configs import StudentConfig  # the owner of a student's world settings
+    from ..runs import config_from
+
+    return config["world"], config_from(StudentConfig, config).env_kwargs
+
+
+def world_label(world: str, kwargs: dict) -> str:
+    """A world as a leaderboard shows it: ``Cont``, ``Grid10``, or with the settings that
+    change it, e.g. ``Cont: frame_skip=2, max_episode_steps=1000``."""
+    if not kwargs:
+        return world
+    return f"{world}: " + ", ".join(f"{k}={json.dumps(v)}" for k, v in sorted(kwargs.items()))
+
+
+def _log(path: Path, row) -> list[tuple]:
+    """A run's CSV log, each row as ``row`` reads it.
+
+    Raises:
+        RunError: a row that does not read as the log's, naming the file.
+    """
+    try:
+        return [row(r) for r in read_csv(path)]
+    except (KeyError, ValueError) as err:
+        raise RunError(f"{path} does not read as a run's log ({type(err).__name__}: {err}): "
+                       "the run's record is damaged") from None
+
+
+def _result(run: Path) -> dict:
+    """A run's ``result.json``.
+
+    Raises:
+        RunError: not JSON, or not a run's result, naming the file.
+    """
+    path = run / "result.json"
+    try:
+        result = json.loads(path.read_text())
+    except ValueError as err:
+        raise RunError(f"{path} is not valid JSON ({err}): the run's result is damaged") from None
+    if not isinstance(result, dict) or result.get("kind") not in ("student", "teacher"):
+        raise RunError(f"{path} holds no student's or teacher's result (no kind): the run's result is damaged")
+    if result["kind"] == "student" and not isinstance(result.get("steps"), int):
+        raise RunError(f"{path} holds no transitions (steps): the run's result is damaged")
+    return result
+
+
+def run_metrics(run: Path) -> dict | None:
+    """The metrics of one finished student run directory (None: a teacher's, or not finished).
+
+    Raises:
+        RunError: a damaged or unreadable record, named.
+    """
+    run = Path(run)
+    if not (run / "result.json").exists():
+        return None
+    config = read_config(run)
+    result = _result(run)
+    if result["kind"] != "student":
+        return None  # a teacher run
+    budget = int(config["steps"])
+    # (step, return, won) per training episode; (step, greedy success) per evaluation
+    episodes = _log(run / "episodes.csv", lambda e: (int(e["step"]), float(e["return"]), int(e["success"])))
+    evals = _log(run / "evals.csv", lambda e: (int(e["step"]), float(e["success"])))
+    tail = [e for e in episodes if e[0] > 0.9 * budget]
+    if not tail and episodes:  # fewer episodes than the window: the last one
+        tail = episodes[-1:]
+    success = [s for _, s in evals]
+    reached = next((step for step, s in evals if s >= THRESHOLD), None)
+    world, world_kwargs = world_of(config)
+    return {
+        "task": config["task"], "world": world, "world_kwargs": world_kwargs, "method": config["method"],
+        "seed": config["seed"], "budget": budget, "steps": result["steps"], "updates": result.get("updates"),
+        "success": success[-1] if success else float("nan"),
+        "return": float(np.mean([r for _, r, _ in tail])) if tail else float("nan"),
+        "train_success": float(np.mean([won for _, _, won in tail])) if tail else float("nan"),
+        "auc": float(np.mean(success)) if success else float("nan"),
+        "steps_to_80": reached,
+    }
+
+
+@dataclass
+class Entry:
+    """One row: a method's runs of one setting on one task in one world."""
+
+    task: str
+    world: str  # the world's name: Cont, Kinematic, Grid10
+    method: str
+    seeds: list[int]
+    values: dict[str, list[float]]  # metric -> one value per seed, in seed order
+    reached: stats.Reached  # seeds that reached 80% greedy success, and their median transitions
+    budget: int = 0  # transitions per run
+    updates: int | None = None  # mean gradient updates per run (None: runs from before they were recorded)
+    variant: str = ""  # "a", "b", ...: the method's runs here differ in more than the seed, and this is one setting
+    differs: dict = field(default_factory=dict)  # with a variant: the settings that tell it apart, and its values
+    runs: list[Path] = field(default_factory=list)  # the run directories, in seed order
+    world_kwargs: dict = field(default_factory=dict)  # the settings that change the world, beyond its name
+
+    @property
+    def label(self) -> str:
+        return f"{self.method} ({self.variant})" if self.variant else self.method
+
+    @property
+    def world_label(self) -> str:
+        return world_label(self.world, self.world_kwargs)
+
+    @property
+    def stats(self) -> dict[str, stats.Estimate]:
+        return {m: stats.t_interval(self.values[m], bounds=METRICS[m]) for m in METRICS}
+
+    @property
+    def budget_text(self) -> str:
+        """The budget in transitions and gradient updates, e.g. ``60,000 / 15,000``."""
+        return f"{self.budget:,} / " + (f"{self.updates:,}" if self.updates is not None else "?")
+
+
+@dataclass
+class Unfinished:
+    """A student run that has no result yet: not on the board, but named beside it."""
+
+    task: str
+    world: str
+    world_kwargs: dict
+    method: str
+    seed: int
+    run: str  # the run directory's name
+
+    @property
+    def world_label(self) -> str:
+        return world_label(self.world, self.world_kwargs)
+
+
+@dataclass
+class Board:
+    """A directory's leaderboard: its entries, and the runs that are not on it."""
+
+    entries: list[Entry]
+    unfinished: list[Unfinished] = field(default_factory=list)
+    unreadable: list[str] = field(default_factory=list)  # runs whose record is damaged: the file and the reason
+
+    def __iter__(self):
+        return iter(self.entries)
+
+    def __len__(self) -> int:
+        return len(self.entries)
+
+
+def build(students_root) -> Board:
+    """The leaderboard of the runs under ``students_root``: one entry per task, world,
+    method and setting (runs that differ in more than the seed are never pooled). A run
+    whose record is damaged is left out and named in ``Board.unreadable``."""
+    root = Path(students_root)
+    groups: dict[tuple, list[tuple[dict, dict]]] = {}
+    board = Board([])
+    for run in sorted(root.iterdir()) if root.is_dir() else []:
+        if not (run / "config.json").exists():
+            if (run / "result.json").exists():  # a result of no known run
+                board.unreadable.append(f"{run / 'config.json'} is missing beside its result.json: "
+                                        "the run's record is damaged")
+            continue
+        try:
+            m = run_metrics(run)
+            config = read_config(run)
+            if m is None:
+                if not (run / "result.json").exists() and run.name.startswith("student-"):
+                    board.unfinished.append(Unfinished(config["task"], *world_of(config), config["method"],
+                                                       config["seed"], run.name))
+                continue
+        except RunError as err:
+            board.unreadable.append(str(err))
+            continue
+        except (ValueError, KeyError, TypeError) as err:  # a record that does not read as a run's
+            board.unreadable.append(f"{run / 'config.json'}: {type(err).__name__}: {err}")
+            continue
+        setting = {k: v for k, v in run_settings(config).items() if k != "seed"}
+        key = (m["task"], world_label(m["world"], m["world_kwargs"]), m["method"], json.dumps(setting, sort_keys=True))
+        groups.setdefault(key, []).append(({**m, "run": run}, setting))
+    by_method: dict[tuple, list[tuple]] = {}
+    for key in groups:
+        by_method.setdefault(key[:3], []).append(key)
+    for (task, _, method), keys in sorted(by_method.items()):
+        settings = [flatten(groups[k][0][1]) for k in keys]
+        differing = sorted({name for s in settings for name in s
+                            if len({json.dumps(t.get(name), sort_keys=True) for t in settings}) > 1})
+        for i, key in enumerate(sorted(keys, key=lambda k: (-len(groups[k]), k[3]))):  # most runs first
+            runs = sorted((m for m, _ in groups[key]), key=lambda m: m["seed"])
+            setting = flatten(groups[key][0][1])
+            updates = [r["updates"] for r in runs]
+            board.entries.append(Entry(
+                task, runs[0]["world"], method, [r["seed"] for r in runs], {m: [r[m] for r in runs] for m in METRICS},
+                stats.reached([r["steps_to_80"] for r in runs]), budget=max(r["budget"] for r in runs),
+                updates=None if None in updates else round(float(np.mean(updates))),
+                variant=(string.ascii_lowercase[i] if i < 26 else str(i + 1)) if len(keys) > 1 else "",
+                differs={name: setting.get(name, "(not recorded)") for name in differing},
+                runs=[r["run"] for r in runs], world_kwargs=runs[0]["world_kwargs"]))
+    return board
+
+
+def rung_order(task: str) -> tuple:
+    """Tasks follow the task ladder, easiest rung first (unknown tasks last, by name)."""
+    from ..task_registry import tasks
+
+    spec = tasks().get(task)
+    return spec.rung if spec is not None else (99, True, task)
+
+
+def verdict(entry: Entry, baseline: Entry, metric: str) -> str:
+    """How ``entry`` compares with ``baseline`` (same task and world) on ``metric``.
+
+    ``steps_to_80``, the transfer target: whether ``entry`` reaches 80% greedy success in
+    at most half the transitions of ``baseline``, read on the medians over all seeds
+    (``stats.Reached.overall``), with the figures that say so: ``met (...)`` or ``not met
+    (...)``. Where the baseline's median is never within a budget at least ``entry``'s,
+    reaching 80% at all meets the target, and the text says that the baseline never got
+    there (all that is known of its time is that it exceeds its budget).
+
+    A metric with an interval (``METRICS``: ``auc``, ``return``, ...): ``ahead``,
+    ``behind``, ``no difference measured`` (the intervals overlap), ``neither learned``
+    (success 0 at every evaluation of both, for the success metrics), ``too few seeds``
+    (no interval) or ``not measured``.
+    """
+    if metric == "steps_to_80":
+        return _transfer_target(entry, baseline)
+    a, b = entry.stats[metric], baseline.stats[metric]
+    if math.isnan(a.value) or math.isnan(b.value):
+        return "not measured"
+    if metric in ("auc", "success") and a.value == 0 and b.value == 0:
+        return "neither learned"
+    if not (a.has_interval and b.has_interval):
+        return "too few seeds"
+    if a.low > b.high:
+        return "ahead"
+    if a.high < b.low:
+        return "behind"
+    return "no difference measured"
+
+
+def _transfer_target(entry: Entry, baseline: Entry) -> str:
+    mine, theirs = entry.reached.overall, baseline.reached.overall
+
+    def text(steps: float, e: Entry) -> str:
+        return f"{steps:,.0f}" if math.isfinite(steps) else f"never in {e.budget:,}"
+
+    figures = f"{text(mine, entry)} against {text(theirs, baseline)}"
+    if not math.isfinite(mine):
+        return f"not met ({figures})"
+    if math.isfinite(theirs) and mine <= theirs / 2:
+        return f"met ({figures})"
+    if not math.isfinite(theirs) and baseline.budget >= entry.budget:
+        return f"met: scratch never got there ({figures})"
+    return f"not met ({figures})"
+
+
+def distilled_against_scratch(rows: list[Entry]) -> list[tuple[Entry, Entry]]:
+    """For one task and world: each distilled student (a method with a distilled target)
+    beside its algorithm from scratch; none where scratch did not run or ran in variants."""
+    from ..methods import METHODS, scratch
+
+    base = [e for e in rows if e.method == scratch(e.world)]
+    if len(base) != 1:
+        return []
+    return [(e, base[0]) for e in rows if e.method in METHODS and METHODS[e.method].distill]
+
+
+@dataclass
+class Aggregate:
+    """One world's methods across its tasks."""
+
+    world: str  # the world's name
+    world_kwargs: dict  # and its settings: runs in another setting are another aggregate
+    tasks: list[str]  # the tasks every aggregated method ran
+    baseline: str | None  # the world's algorithm from scratch, if it ran
+    iqm: dict[str, dict[str, stats.Estimate]]  # method -> metric -> IQM
+    improvement: dict[str, dict[str, stats.Estimate]]  # method -> metric -> P(method > baseline)
+    scores: dict[str, list[np.ndarray]]  # method -> final success per task (for profiles)
+    runs: dict[str, int]  # method -> runs aggregated
+    left_out: list[str]  # what was not aggregated, and why
+
+    @property
+    def world_label(self) -> str:
+        return world_label(self.world, self.world_kwargs)
+
+
+def aggregates(entries) -> list[Aggregate]:
+    """Per world, the methods compared across the tasks all of them ran, each with 2 runs
+    or more per task that have a final success, and one setting (variants are not
+    aggregated). A world with nothing to aggregate still says why (an empty aggregate)."""
+    from ..methods import scratch
+
+    def finite(entry, metric):
+        x = np.asarray(entry.values[metric], dtype=float)
+        return x[np.isfinite(x)]
+
+    out = []
+    for label in sorted({e.world_label for e in entries}):
+        mine = [e for e in entries if e.world_label == label]
+        world, world_kwargs = mine[0].world, mine[0].world_kwargs
+        left_out = []
+        variants = sorted({e.method for e in mine if e.variant})
+        if variants:
+            left_out.append(f"{', '.join(variants)}: runs of more than one setting")
+        methods = sorted({e.method for e in mine} - set(variants))
+        cells = {(e.task, e.method): e for e in mine if e.method in methods}
+        tasks = sorted({e.task for e in mine}, key=rung_order)
+        blank = sum(len(e.seeds) - len(finite(e, m)) for e in cells.values() for m in AGGREGATED[:1])
+        if blank:
+            left_out.append(f"{blank} run{'s' if blank > 1 else ''} without an evaluation")
+        # a method short of runs on a task every method ran is left out; the others keep the task
+        common = [t for t in tasks if all((t, m) in cells for m in methods)]
+        few = sorted(m for m in methods if any(min(len(finite(cells[(t, m)], metric)) for metric in AGGREGATED) < 2
+                                               for t in common))
+        if few:
+            left_out.append(f"{', '.join(few)}: fewer than 2 runs on some task")
+        methods = [m for m in methods if m not in few]
+        common = [t for t in tasks if methods and all((t, m) in cells for m in methods)]
+        for t in tasks:
+            if t not in common:
+                ran = sorted(m for m in methods if (t, m) in cells)
+                left_out.append(f"task {t}: run by {', '.join(ran) or 'no aggregated method'} only")
+        if not common:
+            methods = []
+        scratch_method = scratch(world)
+        baseline = scratch_method if scratch_method in methods else None
+        if scratch_method and not baseline and any(e.method == scratch_method for e in mine):
+            left_out.append(f"the baseline {scratch_method} is not aggregated: no probability of improvement")
+        per_task = {m: {metric: [finite(cells[(t, m)], metric) for t in common] for metric in AGGREGATED}
+                    for m in methods}
+        out.append(Aggregate(
+            world=world, world_kwargs=world_kwargs, tasks=common, baseline=baseline,
+            iqm={m: {metric: stats.aggregate_iqm(per_task[m][metric]) for metric in AGGREGATED} for m in methods},
+            improvement={m: {metric: stats.probability_of_improvement(per_task[m][metric], per_task[baseline][metric])
+                             for metric in AGGREGATED} for m in methods if baseline and m != baseline},
+            scores={m: per_task[m]["success"] for m in methods},
+            runs={m: sum(len(x) for x in per_task[m]["success"]) for m in methods}, left_out=left_out))
+    return out

@@ -1,0 +1,144 @@
+"""Learning curves and performance profiles, drawn from a leaderboard's entries."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .. import stats
+from ..files import atomic_path
+from ..runs import read_csv
+from .board import THRESHOLD, Aggregate, Board, aggregates
+
+
+def file_part(label: str) -> str:
+    """``label`` as part of a file name: ``Cont: frame_skip=2`` -> ``Cont-frame_skip-2``."""
+    return re.sub(r"[^\w.]+", "-", label).strip("-")
+
+
+def _curve(values_at, grid):
+    """Step function of (step, value) pairs sampled on ``grid`` (NaN before the first)."""
+    steps = np.array([s for s, _ in values_at], dtype=float)
+    vals = np.array([v for _, v in values_at], dtype=float)
+    idx = np.searchsorted(steps, grid, side="right") - 1
+    return np.where(idx >= 0, vals[np.maximum(idx, 0)], np.nan)
+
+
+def plot_curves(board: Board, out) -> list[Path]:
+    """Figure-5-style learning curves per task and world, one line per row of the board:
+    training return, greedy and training success (mean over seeds, with the t-interval band
+    from 3 seeds), and the share of seeds that have reached 80% greedy success."""
+    from matplotlib.figure import Figure  # not pyplot: no global backend switch in the caller's session
+    from matplotlib.ticker import EngFormatter
+
+    runs: dict[tuple, list[tuple[str, list, list, int]]] = {}
+    for e in board:
+        for run in e.runs:
+            runs.setdefault((e.task, e.world_label), []).append(
+                (e.label, read_csv(run / "episodes.csv"), read_csv(run / "evals.csv"), e.budget))
+    paths = []
+    for (task, world), group in sorted(runs.items()):
+        budget = max(g[3] for g in group)
+        grid = np.linspace(budget / 50, budget, 50)
+        fig = Figure(figsize=(14, 3.6))
+        axes = fig.subplots(1, 3)
+        for method in sorted({g[0] for g in group}):
+            mine = [g for g in group if g[0] == method]
+            color = None
+            for ax, style, series in (
+                (axes[0], "-", [smoothed([(int(e["step"]), float(e["return"])) for e in g[1]], grid) for g in mine]),
+                (axes[1], "-", [_curve([(int(e["step"]), float(e["success"])) for e in g[2]], grid) for g in mine]),
+                (axes[1], "--", [smoothed([(int(e["step"]), int(e["success"])) for e in g[1]], grid) for g in mine]),
+            ):
+                data = np.array(series)
+                if data.size == 0:
+                    continue
+                valid = ~np.isnan(data).all(axis=0)  # before a run's first episode: no value yet
+                mean = np.full(len(grid), np.nan)
+                mean[valid] = np.nanmean(data[:, valid], axis=0)
+                line, = ax.plot(grid, mean, style, color=color,
+                                label=f"{method} ({len(mine)} seeds)" if style == "-" else None)
+                color = line.get_color()  # one colour per method across panels and styles
+                if style == "-":  # the dashed training success goes without a band, for legibility
+                    bounds = (0.0, 1.0) if ax is axes[1] else (-math.inf, math.inf)
+                    band = [stats.t_interval(col[~np.isnan(col)], bounds=bounds) for col in data.T]
+                    lo, hi = np.array([(b.low, b.high) for b in band]).T  # NaN below 3 seeds: no band
+                    ax.fill_between(grid, lo, hi, color=color, alpha=0.2)
+            # the share of seeds that have reached 80% greedy success by each point: censored runs
+            # (never reached) stay in the denominator, as in a survival curve
+            firsts = [next((int(e["step"]) for e in g[2] if float(e["success"]) >= THRESHOLD), None) for g in mine]
+            share = [np.mean([f is not None and f <= x for f in firsts]) for x in grid]
+            axes[2].step(grid, share, where="post", color=color, label=f"{method} ({len(mine)} seeds)")
+        fig.suptitle(f"{task} ({world})")  # a world with settings is too long for a panel's title
+        axes[0].set(title="training episode return", xlabel="transitions", ylabel="return")
+        axes[1].set(xlabel="transitions", ylabel="success rate", ylim=(-0.02, 1.02))
+        axes[1].set_title("success: greedy evaluation (solid), training episodes (dashed)", fontsize=9)
+        axes[1].legend(loc="upper left", fontsize=8)
+        axes[2].set(title=f"seeds that reached {THRESHOLD:.0%} greedy success", xlabel="transitions",
+                    ylabel="share of seeds", ylim=(-0.02, 1.02))
+        for ax in axes:  # 800k, not 800000 run into its neighbours
+            ax.xaxis.set_major_formatter(EngFormatter(sep=""))
+        fig.tight_layout()
+        name = f"curves-{task}-{file_part(world)}"
+        if any(p.stem == name for p in paths):  # two settings that read alike once in a file name
+            name += "-" + hashlib.sha256(world.encode()).hexdigest()[:6]
+        path = Path(out) / f"{name}.png"
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110)
+        paths.append(path)
+    return paths
+
+
+def smoothed(values_at, grid, window: float = 0.1):
+    """Mean return of the episodes that ended in the last ``window`` of the budget before each grid point."""
+    if not values_at:
+        return np.full(len(grid), np.nan)
+    steps = np.array([s for s, _ in values_at], dtype=float)
+    vals = np.array([v for _, v in values_at], dtype=float)
+    width = window * grid[-1]
+    out = np.full(len(grid), np.nan)
+    for i, g in enumerate(grid):
+        sel = (steps <= g) & (steps > g - width)
+        if sel.any():
+            out[i] = vals[sel].mean()
+    return out
+
+
+@dataclass
+class Profile:
+    world_label: str  # the aggregate's world, as its page names it
+    path: Path
+
+
+def plot_profiles(board: Board, out, aggs: list[Aggregate] | None = None) -> list[Profile]:
+    """Per world with an aggregate, the performance profile of final greedy success: the
+    share of runs (averaged over tasks) above each threshold, with its stratified-bootstrap
+    band (Agarwal et al. 2021, Figure 5); ``profile-<world>.png`` in ``out``."""
+    from matplotlib.figure import Figure
+
+    taus = np.linspace(0, 1, 51)
+    out_paths = []
+    for agg in aggregates(list(board)) if aggs is None else aggs:
+        if not agg.scores:
+            continue
+        fig = Figure(figsize=(6, 3.8))
+        ax = fig.subplots()
+        for method in sorted(agg.scores, key=lambda m: -agg.iqm[m]["auc"].value):
+            value, low, high = stats.performance_profile(agg.scores[method], taus - 1e-9)  # >= tau: a rate of tau counts
+            line, = ax.plot(taus, value, label=f"{method} ({agg.runs[method]} runs)")
+            ax.fill_between(taus, low, high, color=line.get_color(), alpha=0.2)
+        ax.set(title=f"{agg.world_label}: {len(agg.tasks)} task{'s' if len(agg.tasks) > 1 else ''}", xlabel="final greedy success \u03c4",
+               ylabel="share of runs with success \u2265 \u03c4", ylim=(-0.02, 1.02))
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        path = Path(out) / f"profile-{file_part(agg.world_label)}.png"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110)
+        out_paths.append(Profile(agg.world_label, path))
+    return out_paths

@@ -1,0 +1,76 @@
+"""Leaderboards and results pages rendered from synthetic run directories."""
+
+import csv
+import json
+
+import pytest
+
+from craftsuite.reporting.board import Board, build
+from craftsuite.reporting.pages import leaderboard_markdown, write_leaderboard, write_results_page
+from .fakes import fake_run
+
+
+def test_a_single_seed_reads_as_its_value_and_never_as_an_interval(tmp_path):
+    root = tmp_path / "students"
+    fake_run(root, "td3", 0, [(500, 0.3), (1000, 0.5)], [(995, 22.2)])
+    board = build(root)
+    md = leaderboard_markdown(board)
+    assert "| td3 | 1 | 0.50 | 0.50 | 0.40 | 22.2 |" in md and "[22.2, 22.2]" not in md
+    assert "| 0 of 1 |" in md
+
+
+def test_markdown_csv_and_profile(runs, tmp_path):
+    board = build(runs)
+    md = write_leaderboard(board, tmp_path).read_text()
+    assert "## BlindCraftsman (Cont)" in md
+    assert md.index("| td3-dynamic |") < md.index("| td3 |")  # ranked by AUC
+    assert "| 1.00 0.60 |" in md  # every seed's final success
+    assert "| 2 of 2; median 500 |" in md and "| 1 of 2; median 1,000 |" in md
+    assert "reference: authors' td3-dynamic" in md and "19.95" in md
+    with open(tmp_path / "leaderboard.csv") as f:
+        rows = {r["method"]: r for r in csv.DictReader(f)}
+    assert float(rows["td3-dynamic"]["success"]) == pytest.approx(0.8) and rows["td3-dynamic"]["success_lo"] == ""
+    assert float(rows["td3-dynamic"]["train_success"]) == pytest.approx(0.375)
+    assert rows["td3"]["reached_80"] == "1" and float(rows["td3"]["reached_80_median"]) == 1000
+    assert rows["td3-dynamic"]["success_per_seed"] == "1.0 0.6"
+    assert (tmp_path / "profile-Cont.png").exists() and "](profile-Cont.png)" in md
+
+
+def test_budget_reads_in_transitions_and_gradient_updates_and_methods_are_explained(runs):
+    for seed, updates in ((5, 240), (6, 260)):
+        run = fake_run(runs, "td3-dynamic-edges", seed, [(1000, 0.5)], [(995, 1.0)])
+        (run / "result.json").write_text(json.dumps({"kind": "student", "steps": 1000, "updates": updates}))
+    entries = {e.method: e for e in build(runs)}
+    assert entries["td3-dynamic-edges"].budget_text == "1,000 / 250"
+    assert entries["td3"].budget_text == "1,000 / ?"  # runs from before updates were recorded
+    md = leaderboard_markdown(Board(list(entries.values())))
+    assert "| 1,000 / 250 |" in md
+    assert "- `td3-dynamic-edges`: td3-dynamic with the teacher's values on the automaton's edges only" in md
+    assert md.index("- `td3`:") < md.index("- `td3-dynamic`:")  # the legend follows the methods table
+
+
+def test_results_page_names_the_missing_and_the_empty(tmp_path):
+    with pytest.raises(FileNotFoundError, match="no run directory"):
+        write_results_page([tmp_path / "nope"], tmp_path / "results.md")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError, match="no finished student runs"):
+        write_results_page([tmp_path / "empty"], tmp_path / "results.md")
+    assert not (tmp_path / "results.md").exists()
+
+
+def test_a_directory_of_unfinished_runs_only_is_named_as_such(tmp_path):
+    run = tmp_path / "students" / "student-Reach-Cont-td3-s0"
+    run.mkdir(parents=True)
+    (run / "config.json").write_text(json.dumps({"task": "Reach", "world": "Cont", "method": "td3", "seed": 0,
+                                                 "steps": 1000}))
+    with pytest.raises(ValueError, match=r"no finished student runs under .*students \(1 unfinished\)"):
+        write_results_page([tmp_path], tmp_path / "results.md")
+    assert not (tmp_path / "results.md").exists() and (run / "config.json").exists()
+
+
+def test_a_world_with_nothing_to_aggregate_says_why(tmp_path):
+    root = tmp_path / "students"
+    fake_run(root, "td3", 0, [(1000, 1.0)], [(995, 1.0)])
+    fake_run(root, "td3-dynamic", 0, [(1000, 1.0)], [(995, 1.0)])
+    md = leaderboard_markdown(build(root))
+    assert "### Cont\n\nNothing to aggregate: td3, td3-dynamic: fewer than 2 runs on some task" in md

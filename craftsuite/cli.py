@@ -116,6 +116,7 @@ def _demo(args) -> int:
     from .automata import write_image
     from .ids import CONT, file_stem, parse_id
     from .registration import registered_ids
+    from .rollouts import rollout
     from .scripted import scripted_policy
     from .task_registry import tasks
 
@@ -126,20 +127,12 @@ def _demo(args) -> int:
     for env_id in tqdm(ids, desc="scripted rollouts", unit="env"):
         env = gym.make(env_id, render_mode="rgb_array", status_panel=True)  # pictures for people: inventory shown
         policy = scripted_policy(env)
-        successes, lengths = 0, []
-        for episode in range(args.episodes):
-            env.reset(seed=args.seed + episode)
-            if episode == 0:
-                first = env.render()
-            steps, done = 0, False
-            while not done:
-                _, _, term, trunc, info = env.step(policy(None))
-                steps += 1
-                done = term or trunc
-            if episode == 0:
-                last = env.render()
-            successes += bool(info["is_success"])
-            lengths.append(steps)
+        frames = []  # the first episode's start and end
+        played = rollout(env, policy, 1, args.seed, on_reset=lambda _: frames.append(env.render()))
+        frames.append(env.render())
+        played += rollout(env, policy, args.episodes - 1, args.seed + 1)
+        first, last = frames
+        successes, lengths = sum(e.success for e in played), [e.length for e in played]
         gap = np.full((first.shape[0], 8, 3), 255, np.uint8)
         picture = out / f"{file_stem(env_id)}.png"
         cv2.imwrite(str(picture), cv2.cvtColor(np.concatenate([first, gap, last], 1), cv2.COLOR_RGB2BGR))

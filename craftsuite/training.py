@@ -38,24 +38,18 @@ def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kw
     batch per step (an untrained policy that never finishes costs one batched call per
     decision of the episode limit, not ``episodes`` times as many). ``on_step(episode,
     reward, info)``, if given, sees every step (for measures beyond an ``Evaluation``'s)."""
+    from .rollouts import rollout
+
     envs = [gym.make(env_id, product=product, **(env_kwargs or {})) for _ in range(episodes)]
-    obs = np.stack([env.reset(seed=seed + i)[0] for i, env in enumerate(envs)])
-    returns, lengths, wins = np.zeros(episodes), np.zeros(episodes), np.zeros(episodes, dtype=bool)
-    active = np.ones(episodes, dtype=bool)
-    while active.any():
-        live = np.flatnonzero(active)
-        actions, _ = agent.predict(obs[live], deterministic=True)
-        for i, action in zip(live, actions):
-            obs[i], reward, term, trunc, info = envs[i].step(action)
-            returns[i] += float(reward)
-            lengths[i] += 1
-            if on_step is not None:
-                on_step(i, float(reward), info)
-            if term or trunc:
-                active[i] = False
-                wins[i] = bool(info["is_success"])
-    for env in envs:
-        env.close()
+    try:
+        played = rollout(envs, lambda obs: agent.predict(obs, deterministic=True)[0], episodes, seed,
+                         on_step=on_step)
+    finally:
+        for env in envs:
+            env.close()
+    returns = np.array([e.total_reward for e in played])
+    lengths = np.array([e.length for e in played], dtype=float)
+    wins = np.array([e.success for e in played])
     return Evaluation(float(wins.mean()), float(returns.mean()), float(lengths.mean()))
 
 

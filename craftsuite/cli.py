@@ -221,14 +221,14 @@ def _distill(args) -> int:
         source = Path(args.source)
         env_id, env_kwargs = args.env_id or _registered(args.task, "Grid7"), {}
         if source.is_dir():  # a teacher run directory: its config names the env, its checkpoint the replay
-            from .training import TeacherConfig, checkpoint_dir
+            from .training import TeacherConfig
             from .runs import RunDir, load_config
 
             if not (source / "config.json").is_file():
                 raise FileNotFoundError(f"{source} is not a teacher run directory (no config.json)")
             config = load_config(TeacherConfig, source)
             env_id, env_kwargs = config.env_id, config.env_kwargs
-            saved = checkpoint_dir(RunDir(source, config))
+            saved = RunDir(source, config).last_checkpoint()
             if saved is None:
                 raise FileNotFoundError(f"{source} has no checkpoint (model and replay buffer) yet")
             model, replay = saved / "model.zip", saved / "replay.pkl"

@@ -526,7 +526,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--episodes", type=_positive, default=1, help="episodes to record (default: 1)")
     p.add_argument("--out", default="rollout.mp4", help="output .mp4 (default: rollout.mp4)")
     p.add_argument("--seed", type=int, default=0, help="seed of the first episode (default: 0)")
-    p.add_argument("--fps", type=float, help="frames per second (default: the env's render_fps)")
+    p.add_argument("--fps", type=float, help="frames per second (default: the world's pace, the env's "
+                   "render_fps decisions a second; continuous worlds' motion is drawn between decisions)")
     p.add_argument("--product", action="store_true",
                    help="make the env with product=True (for checkpoints trained on the product MDP)")
     p.add_argument("--env", help="JSON gymnasium.make keywords, e.g. '{\"frame_skip\": 2}' "

@@ -78,7 +78,7 @@ def rollout(env, policy, episodes: int = 1, seed: int | None = 0, *, max_steps: 
     return records
 
 
-SMOOTH_FPS = 20  # frames per second a video of a continuous world plays at, at least (its motion drawn between decisions)
+SMOOTH_FPS = 20  # the least frames per second of a continuous world's video (motion drawn between decisions)
 
 
 @dataclass(frozen=True)
@@ -100,7 +100,7 @@ def record_video(env_id: str, policy: str = "scripted", episodes: int = 1, out: 
     A grid video shows one frame per decision at the env's ``render_fps``; a continuous
     world's draws each decision's motion too (``set_frames_per_decision``), so that it plays
     at ``SMOOTH_FPS`` or more at the world's pace. ``fps``, if given, sets the playback rate."""
-    from .policies import load_policy  # which imports the scripted policies, which play through ``rollout``
+    from .policies import load_policy  # here: the loop's other users (training's evaluation) need no policies
 
     env = gym.make(env_id, render_mode="rgb_array", product=product, **(env_kwargs or {}))
     world = env.unwrapped

@@ -64,7 +64,8 @@ class ContinuousWorldEnv(PlanarWorld):
     ``status_panel=True`` (for videos people watch) a 40-row strip with the inventory and
     the automaton state is added below, ``(height + 40, width, 3)``; it is off by default
     because a frame showing the automaton state would hand it to an agent that learns from
-    pixels.
+    pixels. For videos, ``set_frames_per_decision(n)`` has ``step`` draw the arena during
+    its physics steps too, and ``motion_frames()`` gives the decision's ``n`` pictures.
 
     ## Registered Configurations
     ``CraftSuite/<Task>-Cont-v0`` for every task spec in ``tasks/``, the rungs of the

@@ -79,6 +79,8 @@ class KinematicWorldEnv(PlanarWorld):
     ## Rendering
     ``rgb_array``: a top-down drawing of the board, ``(height, width, 3)`` uint8 (240 by
     default, each up to ``MAX_FRAME_SIDE``); ``status_panel=True`` adds the 40-row strip.
+    For videos, ``set_frames_per_decision(n)`` has ``step`` draw the agent gliding to where
+    it jumps, and ``motion_frames()`` gives the decision's ``n`` pictures.
 
     ## Registered Configurations
     ``CraftSuite/<Task>-Kinematic-v0`` for every task; keywords ``size``, ``observation``.

@@ -52,12 +52,12 @@ def measure_sb3(method, env_id, n_envs, settings, seconds: float) -> tuple[float
     agent = make_agent(method, env_id, n_envs=n_envs, buffer_size=200_000, **settings)
     agent.learn(2_000)
     steps, total = 1_000 * n_envs, 0.0
-    transitions, updates = agent.num_timesteps, agent._n_updates
+    transitions, updates = agent.num_timesteps, agent.n_updates
     while total < seconds:
         start = time.perf_counter()
         agent.learn(steps, reset_num_timesteps=False)
         total += time.perf_counter() - start
-    return (agent.num_timesteps - transitions) / total, (agent._n_updates - updates) / total
+    return (agent.num_timesteps - transitions) / total, (agent.n_updates - updates) / total
 
 
 def measure_population(method, env_id, n_envs, settings, env_kwargs, members: int, seconds: float,

@@ -116,6 +116,7 @@ def _scripted(args) -> int:
     from .automata import write_image
     from .ids import CONT, file_stem, parse_id
     from .registration import registered_ids
+    from .rollouts import rollout
     from .scripted import scripted_policy
     from .task_registry import tasks
 
@@ -126,20 +127,12 @@ def _scripted(args) -> int:
     for env_id in tqdm(ids, desc="scripted rollouts", unit="env"):
         env = gym.make(env_id, render_mode="rgb_array", status_panel=True)  # pictures for people: inventory shown
         policy = scripted_policy(env)
-        successes, lengths = 0, []
-        for episode in range(args.episodes):
-            env.reset(seed=args.seed + episode)
-            if episode == 0:
-                first = env.render()
-            steps, done = 0, False
-            while not done:
-                _, _, term, trunc, info = env.step(policy(None))
-                steps += 1
-                done = term or trunc
-            if episode == 0:
-                last = env.render()
-            successes += bool(info["is_success"])
-            lengths.append(steps)
+        frames = []  # the first episode's start and end
+        played = rollout(env, policy, 1, args.seed, on_reset=lambda _: frames.append(env.render()))
+        frames.append(env.render())
+        played += rollout(env, policy, args.episodes - 1, args.seed + 1)
+        first, last = frames
+        successes, lengths = sum(e.success for e in played), [e.length for e in played]
         gap = np.full((first.shape[0], 8, 3), 255, np.uint8)
         picture = out / f"{file_stem(env_id)}.png"
         cv2.imwrite(str(picture), cv2.cvtColor(np.concatenate([first, gap, last], 1), cv2.COLOR_RGB2BGR))
@@ -228,14 +221,14 @@ def _distill(args) -> int:
         source = Path(args.source)
         env_id, env_kwargs = args.env_id or _registered(args.task, "Grid7"), {}
         if source.is_dir():  # a teacher run directory: its config names the env, its checkpoint the replay
-            from .training import TeacherConfig, checkpoint_dir
+            from .training import TeacherConfig
             from .runs import RunDir, load_config
 
             if not (source / "config.json").is_file():
                 raise FileNotFoundError(f"{source} is not a teacher run directory (no config.json)")
             config = load_config(TeacherConfig, source)
             env_id, env_kwargs = config.env_id, config.env_kwargs
-            saved = checkpoint_dir(RunDir(source, config))
+            saved = RunDir(source, config).last_checkpoint()
             if saved is None:
                 raise FileNotFoundError(f"{source} has no checkpoint (model and replay buffer) yet")
             model, replay = saved / "model.zip", saved / "replay.pkl"
@@ -529,7 +522,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--episodes", type=_positive, default=1, help="episodes to record (default: 1)")
     p.add_argument("--out", default="rollout.mp4", help="output .mp4 (default: rollout.mp4)")
     p.add_argument("--seed", type=int, default=0, help="seed of the first episode (default: 0)")
-    p.add_argument("--fps", type=float, help="frames per second (default: the env's render_fps)")
+    p.add_argument("--fps", type=float, help="frames per second (default: the world's pace, the env's "
+                   "render_fps decisions a second; continuous worlds' motion is drawn between decisions)")
     p.add_argument("--product", action="store_true",
                    help="make the env with product=True (for checkpoints trained on the product MDP)")
     p.add_argument("--env", help="JSON gymnasium.make keywords, e.g. '{\"frame_skip\": 2}' "

@@ -34,6 +34,7 @@ class Reference:
 
 def reference(env_id: str, policy: str, episodes: int = 100, seed: int = 0) -> Reference:
     """Play ``episodes`` episodes of ``policy`` ("scripted" or "random") on ``env_id``."""
+    from .rollouts import rollout
     from .scripted import scripted_policy
 
     if policy not in POLICIES:
@@ -44,20 +45,17 @@ def reference(env_id: str, policy: str, episodes: int = 100, seed: int = 0) -> R
     else:
         env.action_space.seed(seed)
         act = lambda _obs: env.action_space.sample()  # noqa: E731
-    wins, lengths, edges, broken = 0, [], 0, 0
-    for episode in range(episodes):
-        obs, _ = env.reset(seed=seed + episode)
-        done, steps = False, 0
-        while not done:
-            obs, _, terminated, truncated, info = env.step(act(obs))
-            w, _, w2 = info["automaton_transition"]
-            edges += w != w2
-            steps += 1
-            done = terminated or truncated
-        wins += bool(info["is_success"])
-        broken += bool(info["violation"])
-        if info["is_success"]:
-            lengths.append(steps)
+    edges = 0
+
+    def count_edges(episode, reward, info):
+        nonlocal edges
+        w, _, w2 = info["automaton_transition"]
+        edges += w != w2
+
+    played = rollout(env, act, episodes, seed, on_step=count_edges)
+    wins = sum(e.success for e in played)
+    broken = sum(bool(e.info["violation"]) for e in played)
+    lengths = [e.length for e in played if e.success]
     env.close()
     return Reference(env_id, policy, episodes, wins / episodes, float(np.mean(lengths)) if lengths else float("nan"),
                      edges / episodes, broken / episodes)

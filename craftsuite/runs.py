@@ -15,8 +15,9 @@ A run directory holds
 * ``checkpoint/``: the last model and replay buffer, written together at each evaluation,
   and ``checkpoint-old/``, the one before, kept until the next is complete so that a
   damaged newest checkpoint can be resumed from the one before (``training._resume``,
-  which keeps the damaged one aside as ``checkpoint-unloadable/``); a student's are
-  removed when it finishes (its final model is ``model.zip``), a teacher's older one;
+  which keeps the damaged one aside as ``checkpoint-unloadable/``); ``RunDir`` rotates
+  them. A student's are removed when it finishes (its final model is ``model.zip``), a
+  teacher's older one;
 * ``tb/``: TensorBoard logs (on resume, what the killed run logged after its checkpoint is
   purged, as from the CSV logs);
 * ``result.json``: written last; its presence means the run is finished and reusable. It
@@ -36,6 +37,7 @@ import fcntl
 import hashlib
 import json
 import os
+import shutil
 import socket
 from pathlib import Path
 
@@ -143,6 +145,15 @@ def run_settings(record: dict) -> dict:
     return {k: v for k, v in record.items() if k not in RECORD_KEYS + LOCATIONS}
 
 
+EVAL_SEED = 10**7  # far from training's seeds (the run's seed and its envs' next ones)
+
+
+def eval_seed(step: int) -> int:
+    """The first episode seed of a run's evaluation at ``step`` (its episodes play the next
+    ones): every evaluation, of every kind of run and engine, on fresh seeds of its own."""
+    return EVAL_SEED + step
+
+
 class RunDir:
     """One run's directory. Use as a context manager: it holds the lock while open."""
 
@@ -228,6 +239,44 @@ class RunDir:
     @property
     def checkpoint(self) -> Path:
         return self.path / "checkpoint" / "model.zip"
+
+    # -- checkpoints: the newest being written, the last, the one before -----------------------
+    CHECKPOINTS = ("checkpoint-new", "checkpoint", "checkpoint-old")  # newest first
+
+    def new_checkpoint(self) -> Path:
+        """An empty ``checkpoint-new`` to write the next checkpoint into (what a kill left
+        there is cleared); ``commit_checkpoint`` makes it the last."""
+        new = self.path / "checkpoint-new"
+        shutil.rmtree(new, ignore_errors=True)
+        new.mkdir()
+        return new
+
+    def commit_checkpoint(self) -> None:
+        """``checkpoint-new`` becomes ``checkpoint``, and ``checkpoint`` ``checkpoint-old``
+        (the one before that is deleted): the one before the last is kept until the next is
+        complete, so a resume has a complete one to fall back on if the newest is damaged."""
+        new, last, old = (self.path / name for name in self.CHECKPOINTS)
+        if last.exists():
+            shutil.rmtree(old, ignore_errors=True)
+            last.rename(old)
+        new.rename(last)
+
+    def checkpoint_dirs(self, files=("model.zip", "replay.pkl")) -> list[Path]:
+        """The run's complete checkpoints (each holding all ``files``), newest first:
+        ``checkpoint-new`` (complete only when a kill came between its writing and the
+        commit: each file is written whole), ``checkpoint`` and ``checkpoint-old``."""
+        return [d for d in (self.path / name for name in self.CHECKPOINTS) if all((d / f).exists() for f in files)]
+
+    def last_checkpoint(self, files=("model.zip", "replay.pkl")) -> Path | None:
+        """The directory of the run's last complete checkpoint, if any."""
+        dirs = self.checkpoint_dirs(files)
+        return dirs[0] if dirs else None
+
+    def remove_checkpoints(self, keep_last: bool = False) -> None:
+        """A finished run's checkpoints (nothing resumes it), but ``checkpoint`` if ``keep_last``."""
+        for name in self.CHECKPOINTS:
+            if not (keep_last and name == "checkpoint"):
+                shutil.rmtree(self.path / name, ignore_errors=True)
 
     @property
     def result_path(self) -> Path:

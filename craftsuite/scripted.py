@@ -322,14 +322,10 @@ def scripted_policy(env):
 
 def run_episode(env, policy, seed: int | None = None, max_steps: int = 10_000):
     """Roll out ``policy`` until the episode ends: (total reward, steps, last info)."""
-    obs, info = env.reset(seed=seed)
-    total, steps = 0.0, 0
-    for steps in range(1, max_steps + 1):
-        obs, reward, terminated, truncated, info = env.step(policy(obs))
-        total += float(reward)
-        if terminated or truncated:
-            break
-    return total, steps, info
+    from .rollouts import rollout
+
+    episode = rollout(env, policy, 1, seed, max_steps=max_steps)[0]
+    return episode.total_reward, episode.length, episode.info
 
 
 __all__ = ["ObjectivePlanner", "GridScriptedPolicy", "ContinuousScriptedPolicy", "KinematicScriptedPolicy",

@@ -3,9 +3,11 @@
 ``train_teacher`` trains a product-DQN teacher on a grid until its greedy policy completes
 the task on ``target_success`` of fresh-seed evaluation episodes, then distils it into the
 automaton (``table.npz``). ``train_student`` trains any method of ``METHODS`` for a fixed
-budget. Both evaluate and checkpoint every ``eval_every`` steps into a ``RunDir``; started
-again on the same directory, a finished run is reused and a killed one resumes from its
-last checkpoint.
+budget. Both are one routine (``_train``) given what differs: the agent, the world's
+observation, the budget and the stop, the files and result of a finished run. Both
+evaluate (on ``eval_seed``'s episodes) and checkpoint every ``eval_every`` steps into a
+``RunDir``; started again on the same directory, a finished run is reused and a killed one
+resumes from its last checkpoint.
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from stable_baselines3.common.callbacks import BaseCallback
 
 from .configs import StudentConfig, TeacherConfig  # noqa: F401  (defined there, torch-free; re-exported)
 from .files import atomic_path
-from .runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, RunError, read_csv
+from .runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, RunError, eval_seed, read_csv
 
 
 class Evaluation(NamedTuple):
@@ -38,24 +40,18 @@ def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kw
     batch per step (an untrained policy that never finishes costs one batched call per
     decision of the episode limit, not ``episodes`` times as many). ``on_step(episode,
     reward, info)``, if given, sees every step (for measures beyond an ``Evaluation``'s)."""
+    from .rollouts import rollout
+
     envs = [gym.make(env_id, product=product, **(env_kwargs or {})) for _ in range(episodes)]
-    obs = np.stack([env.reset(seed=seed + i)[0] for i, env in enumerate(envs)])
-    returns, lengths, wins = np.zeros(episodes), np.zeros(episodes), np.zeros(episodes, dtype=bool)
-    active = np.ones(episodes, dtype=bool)
-    while active.any():
-        live = np.flatnonzero(active)
-        actions, _ = agent.predict(obs[live], deterministic=True)
-        for i, action in zip(live, actions):
-            obs[i], reward, term, trunc, info = envs[i].step(action)
-            returns[i] += float(reward)
-            lengths[i] += 1
-            if on_step is not None:
-                on_step(i, float(reward), info)
-            if term or trunc:
-                active[i] = False
-                wins[i] = bool(info["is_success"])
-    for env in envs:
-        env.close()
+    try:
+        played = rollout(envs, lambda obs: agent.predict(obs, deterministic=True)[0], episodes, seed,
+                         on_step=on_step)
+    finally:
+        for env in envs:
+            env.close()
+    returns = np.array([e.total_reward for e in played])
+    lengths = np.array([e.length for e in played], dtype=float)
+    wins = np.array([e.success for e in played])
     return Evaluation(float(wins.mean()), float(returns.mean()), float(lengths.mean()))
 
 
@@ -156,44 +152,14 @@ class CheckpointError(RunError):
 
 
 def save_checkpoint(agent, run: RunDir) -> None:
-    """Model and replay buffer together: written beside (each flushed to disk), then swapped
-    in. The checkpoint they replace stays as ``checkpoint-old`` until the next one is
-    complete, so a resume has a complete one to fall back on if the newest is damaged."""
-    new = run.path / "checkpoint-new"
-    shutil.rmtree(new, ignore_errors=True)  # left by a kill while it was written
-    new.mkdir()
+    """Model and replay buffer together, into the run's next checkpoint (each file flushed
+    to disk), then committed (``RunDir.commit_checkpoint`` keeps the one before)."""
+    new = run.new_checkpoint()
     with atomic_path(new / "model.zip") as tmp:
         agent.save(tmp)
     with atomic_path(new / "replay.pkl") as tmp:
         agent.save_replay_buffer(tmp)
-    _swap_in(run)
-
-
-def _swap_in(run: RunDir) -> None:
-    """``checkpoint-new`` becomes ``checkpoint``, and ``checkpoint`` ``checkpoint-old``."""
-    new, final, old = run.path / "checkpoint-new", run.checkpoint.parent, run.path / "checkpoint-old"
-    if final.exists():
-        shutil.rmtree(old, ignore_errors=True)
-        final.rename(old)
-    new.rename(final)
-
-
-def checkpoint_dirs(run: RunDir) -> list[Path]:
-    """The run's complete checkpoints (model and replay), newest first: ``checkpoint-new``
-    (complete only when a kill came between its writing and the swap: each file is written
-    whole), ``checkpoint`` and the one before it, ``checkpoint-old``."""
-    return [d for d in (run.path / "checkpoint-new", run.checkpoint.parent, run.path / "checkpoint-old")
-            if (d / "model.zip").exists() and (d / "replay.pkl").exists()]
-
-
-def checkpoint_dir(run: RunDir) -> Path | None:
-    """The directory of the run's last complete checkpoint (model and replay), if any."""
-    dirs = checkpoint_dirs(run)
-    return dirs[0] if dirs else None
-
-
-def _drop_old_checkpoint(run: RunDir) -> None:
-    shutil.rmtree(run.path / "checkpoint-old", ignore_errors=True)  # the run is finished: nothing resumes
+    run.commit_checkpoint()
 
 
 UNLOADABLE = "checkpoint-unloadable"  # where a checkpoint that failed to load is kept aside
@@ -210,7 +176,7 @@ def _resume(run: RunDir, fresh):
     import warnings
 
     failed = []
-    for saved in checkpoint_dirs(run):
+    for saved in run.checkpoint_dirs():
         try:
             agent = _load_checkpoint(saved, fresh)
         except CheckpointError as err:
@@ -225,7 +191,7 @@ def _resume(run: RunDir, fresh):
             warnings.warn(f"{run.path}: resuming from {saved.name}, the newest checkpoint that loads; "
                           f"{failed[0][1]} (kept as {aside})", RuntimeWarning, stacklevel=3)
         if saved.name == "checkpoint-new":
-            _swap_in(run)  # finish the swap a kill interrupted, so the next save keeps this one
+            run.commit_checkpoint()  # finish the commit a kill interrupted, so the next save keeps this one
         return agent
     if failed:
         raise CheckpointError(
@@ -289,39 +255,53 @@ def _stopped(run: RunDir, stop_at) -> bool:
     return stop_at is not None and bool(evals) and float(evals[-1]["success"]) >= stop_at
 
 
-def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
-    """A teacher run under ``root``; returns its directory (with teacher.zip and table.npz)."""
-    from .agents.factory import distill_from_replay, make_agent
-
-    name = config.run_name()  # checks the hyperparameters before a run directory exists
+def _train(config, name: str, root, fresh, *, product: bool, total: int, stop_at: float | None, model: str,
+           keep_checkpoint: bool, result, progress: bool, desc: str) -> Path:
+    """The routine of every run: train ``fresh()`` (or resume the run's checkpoint) up to
+    ``total`` steps or ``stop_at`` success, evaluating greedy episodes every
+    ``config.eval_every`` steps in the run's world (``product``: with the automaton state);
+    then save the agent as ``model``, write ``result(run, agent, seconds)`` as the run's
+    result and remove the checkpoints (but the last with ``keep_checkpoint``)."""
     with RunDir(Path(root) / name, config) as run:
         if run.finished():
             return run.path
         start = time.perf_counter()
-        fresh = make_agent("product-dqn", config.env_id, seed=config.seed, n_envs=config.n_envs,
-                           env_kwargs=config.env_kwargs,
-                           **config.effective()["hyperparameters"])
 
-        def evaluate_fn(model, step):
-            return evaluate(model, config.env_id, config.eval_episodes, seed=10**7 + step, product=True,
+        def evaluate_fn(agent, step):
+            return evaluate(agent, config.env_id, config.eval_episodes, seed=eval_seed(step), product=product,
                             env_kwargs=config.env_kwargs)
 
-        agent = _learn(run, fresh, config.max_steps, config.eval_every, config.eval_episodes, evaluate_fn,
-                       stop_at=config.target_success,
-                       progress=progress, desc=f"teacher {config.task}")
-        with atomic_path(run.path / "teacher.zip") as tmp:
+        agent = _learn(run, fresh(), total, config.eval_every, config.eval_episodes, evaluate_fn, stop_at=stop_at,
+                       progress=progress, desc=desc)
+        with atomic_path(run.path / model) as tmp:
             agent.save(tmp)
+        run.write_result(result(run, agent, time.perf_counter() - start))
+        run.remove_checkpoints(keep_last=keep_checkpoint)  # after the result: a kill before it resumes
+        return run.path
+
+
+def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
+    """A teacher run under ``root``; returns its directory (with teacher.zip and table.npz)."""
+    from .agents.factory import distill_from_replay, make_agent
+
+    def fresh():
+        return make_agent("product-dqn", config.env_id, seed=config.seed, n_envs=config.n_envs,
+                          env_kwargs=config.env_kwargs, **config.effective()["hyperparameters"])
+
+    def result(run, agent, seconds):
         distill_from_replay(agent).save(run.path / "table.npz")
-        _drop_old_checkpoint(run)  # its last checkpoint stays: `craftsuite distill` reads the replay there
         evals = read_csv(run.path / "evals.csv")
         success = float(evals[-1]["success"]) if evals else 0.0
-        run.write_result({"kind": "teacher", "env_id": config.env_id, "algorithm": agent.algorithm,
-                          "steps": int(agent.num_timesteps),
-                          "updates": int(agent._n_updates),
-                          "success": success, "reached_target": success >= config.target_success,
-                          "seconds_this_session": round(time.perf_counter() - start, 1),
-                          "table": "table.npz", "model": "teacher.zip"})
-        return run.path
+        return {"kind": "teacher", "env_id": config.env_id, "algorithm": agent.algorithm,
+                "steps": int(agent.num_timesteps), "updates": int(agent.n_updates),
+                "success": success, "reached_target": success >= config.target_success,
+                "seconds_this_session": round(seconds, 1), "table": "table.npz", "model": "teacher.zip"}
+
+    # the name checks the hyperparameters before a run directory exists; the last checkpoint
+    # stays: `craftsuite distill` reads the replay there
+    return _train(config, config.run_name(), root, fresh, product=True, total=config.max_steps,
+                  stop_at=config.target_success, model="teacher.zip", keep_checkpoint=True, result=result,
+                  progress=progress, desc=f"teacher {config.task}")
 
 
 def student_result(config: StudentConfig, algorithm: str, steps: int, updates: int, seconds: float,
@@ -357,28 +337,17 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
         if config.table is None:
             raise ValueError(f"method {config.method!r} needs a teacher's table (table.npz of a teacher run)")
         table = AutomatonQTable.load(config.table, resolve_task(config.task).automaton)
-    with RunDir(Path(root) / name, config) as run:
-        if run.finished():
-            return run.path
-        start = time.perf_counter()
-        fresh = make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=config.n_envs,
-                           env_kwargs=config.env_kwargs, automaton_state=config.automaton_state,
-                           **config.effective()["hyperparameters"])
 
-        def evaluate_fn(model, step):
-            return evaluate(model, config.env_id, config.eval_episodes, seed=10**7 + step, product=config.product,
-                            env_kwargs=config.env_kwargs)
+    def fresh():
+        return make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=config.n_envs,
+                          env_kwargs=config.env_kwargs, automaton_state=config.automaton_state,
+                          **config.effective()["hyperparameters"])
 
-        agent = _learn(run, fresh, config.steps, config.eval_every, config.eval_episodes, evaluate_fn,
-                       progress=progress,
-                       desc=f"{config.method} {config.task} s{config.seed}")
-        with atomic_path(run.path / "model.zip") as tmp:
-            agent.save(tmp)
-        run.write_result(student_result(config, agent.algorithm, agent.num_timesteps, agent._n_updates,
-                                        time.perf_counter() - start))
-        # a finished run is reused, never resumed (a larger budget is another run): its replay
-        # buffer, up to gigabytes (CRM keeps one row per live automaton state), is dead weight
-        shutil.rmtree(run.checkpoint.parent, ignore_errors=True)
-        _drop_old_checkpoint(run)
-        return run.path
+    def result(run, agent, seconds):
+        return student_result(config, agent.algorithm, agent.num_timesteps, agent.n_updates, seconds)
 
+    # a finished run is reused, never resumed (a larger budget is another run): its replay
+    # buffer, up to gigabytes (CRM keeps one row per live automaton state), is dead weight
+    return _train(config, name, root, fresh, product=config.product, total=config.steps, stop_at=None,
+                  model="model.zip", keep_checkpoint=False, result=result, progress=progress,
+                  desc=f"{config.method} {config.task} s{config.seed}")

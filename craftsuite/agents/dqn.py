@@ -101,6 +101,15 @@ class AutomatonDQN(NStepOwner, DQN):
         self.distill = distill
         super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, n_steps=n_steps, **kwargs)
 
+    @property
+    def n_updates(self) -> int:
+        """The gradient updates taken so far (SB3 counts them in a private attribute)."""
+        return self._n_updates
+
+    @n_updates.setter
+    def n_updates(self, value: int) -> None:
+        self._n_updates = int(value)
+
     def _td_target(self, data: AutomatonSamples) -> th.Tensor:
         """r + gamma * Q_target(s', a*), a* from the online net when double; then distilled."""
         with th.no_grad():

@@ -53,6 +53,15 @@ class AutomatonTD3(NStepOwner, TD3):
         super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, n_steps=n_steps,
                          policy_delay=self.policy_delay_at(0), **kwargs)
 
+    @property
+    def n_updates(self) -> int:
+        """The gradient updates taken so far (SB3 counts them in a private attribute)."""
+        return self._n_updates
+
+    @n_updates.setter
+    def n_updates(self, value: int) -> None:
+        self._n_updates = int(value)
+
     def policy_delay_at(self, step: int) -> int:
         return delay_at(self.delay_schedule, step)
 

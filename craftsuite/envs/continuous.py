@@ -64,7 +64,8 @@ class ContinuousWorldEnv(PlanarWorld):
     ``status_panel=True`` (for videos people watch) a 40-row strip with the inventory and
     the automaton state is added below, ``(height + 40, width, 3)``; it is off by default
     because a frame showing the automaton state would hand it to an agent that learns from
-    pixels.
+    pixels. For videos, ``set_frames_per_decision(n)`` has ``step`` draw the arena during
+    its physics steps too, and ``motion_frames()`` gives the decision's ``n`` pictures.
 
     ## Registered Configurations
     ``CraftSuite/<Task>-Cont-v0`` for every task spec in ``tasks/``, the rungs of the
@@ -223,8 +224,11 @@ class ContinuousWorldEnv(PlanarWorld):
         model, data = self.model, self.data
         data.ctrl[0] = x
         data.ctrl[1] = y
-        for _ in range(self.frame_skip):
-            mujoco.mj_step(model, data)
+        if self._drawing_motion():
+            self._motion = self._step_physics_drawing()
+        else:
+            for _ in range(self.frame_skip):
+                mujoco.mj_step(model, data)
 
         reward = self._step_reward
         px, py = data.qpos[0], data.qpos[1]
@@ -244,6 +248,20 @@ class ContinuousWorldEnv(PlanarWorld):
 
         bonus, done, info = self.tracker.advance(mask)
         return self._obs.copy(), reward + bonus, done, False, info
+
+    def _step_physics_drawing(self) -> list[np.ndarray]:
+        """The decision's physics steps, as ``step`` takes them, with a picture after every
+        ``frame_skip / frames_per_decision`` of them but the last (``render()`` draws that one,
+        after the touches)."""
+        n, skip, frames = self.frames_per_decision, self.frame_skip, []
+        for k in range(skip):
+            mujoco.mj_step(self.model, self.data)
+            if len(frames) < n - 1 and k + 1 >= round((len(frames) + 1) * skip / n):
+                frames.append(self.render())
+        return frames
+
+    def set_frames_per_decision(self, n: int) -> int:
+        return super().set_frames_per_decision(min(n, self.frame_skip))  # at most one per physics step
 
     def _remove(self, i: int):
         self._positions[i] = _FAR

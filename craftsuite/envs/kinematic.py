@@ -79,6 +79,8 @@ class KinematicWorldEnv(PlanarWorld):
     ## Rendering
     ``rgb_array``: a top-down drawing of the board, ``(height, width, 3)`` uint8 (240 by
     default, each up to ``MAX_FRAME_SIDE``); ``status_panel=True`` adds the 40-row strip.
+    For videos, ``set_frames_per_decision(n)`` has ``step`` draw the agent gliding to where
+    it jumps, and ``motion_frames()`` gives the decision's ``n`` pictures.
 
     ## Registered Configurations
     ``CraftSuite/<Task>-Kinematic-v0`` for every task; keywords ``size``, ``observation``.
@@ -212,7 +214,10 @@ class KinematicWorldEnv(PlanarWorld):
         target = self._position + self.step_size * np.array([x, y])
         reward = self._step_reward
         mask, ended = self._level_mask, False
-        if self.on_board(target):
+        accepted = self.on_board(target)
+        if self._drawing_motion():  # drawn before the move's touches change the board
+            self._motion = self._draw_motion(target if accepted else self._position)
+        if accepted:
             self._position = target
             offsets = self._positions - target
             inside = self._present & (np.einsum("ij,ij->i", offsets, offsets) < self.radius ** 2)
@@ -247,6 +252,16 @@ class KinematicWorldEnv(PlanarWorld):
     def render(self):
         if not self._can_render(bool(self._started)):
             return None
+        return self._draw(self._position)
+
+    def _draw_motion(self, end: np.ndarray) -> list[np.ndarray]:
+        """The agent on its way from where it is to ``end`` (the board moves it at once; a
+        video shows the jump as a glide): ``frames_per_decision - 1`` pictures before ``end``."""
+        n, start = self.frames_per_decision, self._position
+        return [self._draw(start + (end - start) * (k / n)) for k in range(1, n)]
+
+    def _draw(self, position: np.ndarray) -> np.ndarray:
+        """The board with the agent at ``position``."""
         frame = np.full((self.height, self.width, 3), 235, dtype=np.uint8)
         sx, sy = self.width / self.arena, self.height / self.arena
         for x, y, h in self._obstacles:
@@ -264,6 +279,6 @@ class KinematicWorldEnv(PlanarWorld):
             else:
                 cv2.ellipse(frame, (col, row), (max(1, int(self.radius * sx)), max(1, int(self.radius * sy))),
                             0, 0, 360, color, -1, cv2.LINE_AA)
-        col, row = self.world_to_pixel(*self._position)
+        col, row = self.world_to_pixel(*position)
         cv2.circle(frame, (col, row), max(1, int(0.15 * min(sx, sy))), (20, 20, 20), -1, cv2.LINE_AA)
         return add_status_panel(frame, self) if self.status_panel else frame

@@ -192,6 +192,28 @@ class PlanarWorld(CraftWorld):
         for s, count in enumerate(self.inventory_counts):
             self._obs[off + s] = count / scale[s]
 
+    # -- motion for videos -------------------------------------------------------------------
+    frames_per_decision = 1  # pictures per decision that ``motion_frames`` gives
+    _motion: list = []  # what ``step`` drew between the last two decisions (none at 1 per decision)
+
+    def set_frames_per_decision(self, n: int) -> int:
+        """Have ``step`` draw the motion of each decision, so that a video plays it rather
+        than jumps: ``n - 1`` pictures between two decisions, evenly spaced in time (with a
+        render mode; drawing costs, so 1, the default, draws none). Returns the number per
+        decision the world will give, which a world may cap (MuJoCo: one per physics step)."""
+        self.frames_per_decision = max(1, int(n))
+        return self.frames_per_decision
+
+    def _drawing_motion(self) -> bool:
+        return self.frames_per_decision > 1 and self.render_mode == "rgb_array"
+
+    def motion_frames(self) -> list[np.ndarray]:
+        """The last decision as ``frames_per_decision`` pictures, evenly spaced in time: those
+        ``step`` drew on the way, then ``render()``'s of where it ended (after a reset, call
+        ``render()``: there was no motion)."""
+        frames, self._motion = self._motion, []
+        return [*frames, self.render()]
+
     @property
     def frame_shape(self) -> tuple[int, int, int]:
         """Shape of an ``rgb_array`` frame: ``(rows, columns, 3)``."""

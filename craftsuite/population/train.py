@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import contextlib
 import json
-import shutil
 import time
 from pathlib import Path
 
@@ -27,7 +26,7 @@ from ..configs import StudentConfig
 from ..files import atomic_path, atomic_write
 from ..ids import world_kind
 from ..methods import METHODS
-from ..runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir
+from ..runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, eval_seed
 from .engine import EngineError, Population, check_supported, sparse_width
 from .envs import make_envs, step_records
 
@@ -198,7 +197,7 @@ def evaluate_members(pop: Population, config: StudentConfig, seed: int, envs=Non
 
 def _evaluate(pop, configs, runs, step, bar, envs=None) -> None:
     config = configs[0]
-    results = evaluate_members(pop, config, seed=10**7 + step, envs=envs)  # train_student's evaluation seeds
+    results = evaluate_members(pop, config, seed=eval_seed(step), envs=envs)
     for run, (success, ret, length) in zip(runs, results):
         run.append("evals.csv", EVAL_FIELDS, [{"step": step, "success": success, "return": round(ret, 4),
                                                 "episodes": config.eval_episodes, "length": round(length, 2)}])
@@ -206,33 +205,27 @@ def _evaluate(pop, configs, runs, step, bar, envs=None) -> None:
 
 
 def _checkpoint(pop: Population, runs) -> None:
-    """Every member's state into its ``checkpoint-new`` (``population.pt``, and ``step.json``
-    saying its step, read on resume without loading the state), then each swapped in
-    (``checkpoint``, and the one before as ``checkpoint-old``)."""
-    from ..training import _swap_in
-
+    """Every member's state into its run's next checkpoint (``population.pt``, and
+    ``step.json`` saying its step, read on resume without loading the state), then each
+    committed (``RunDir.commit_checkpoint``: the one before is kept)."""
     for k, run in enumerate(runs):
-        new = run.path / "checkpoint-new"
-        shutil.rmtree(new, ignore_errors=True)
-        new.mkdir()
+        new = run.new_checkpoint()
         with atomic_path(new / CHECKPOINT) as tmp:
             th.save(pop.member_state(k), tmp)
         atomic_write(new / STEP, json.dumps({"num_timesteps": pop.num_timesteps}))
     for run in runs:
-        _swap_in(run)
+        run.commit_checkpoint()
 
 
 def _saved_steps(run: RunDir) -> dict[int, Path]:
     """A member's complete checkpoints by step, newest directory first for each step."""
     found = {}
-    for name in ("checkpoint-new", "checkpoint", "checkpoint-old"):
-        folder = run.path / name
+    for folder in run.checkpoint_dirs((CHECKPOINT, STEP)):
         try:
             step = json.loads((folder / STEP).read_text())["num_timesteps"]
         except (OSError, ValueError, KeyError, TypeError):
-            continue  # none, or written only in part: not a checkpoint
-        if (folder / CHECKPOINT).exists():
-            found.setdefault(int(step), folder / CHECKPOINT)
+            continue  # written only in part: not a checkpoint
+        found.setdefault(int(step), folder / CHECKPOINT)
     return found
 
 
@@ -279,7 +272,7 @@ def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, 
                        env_kwargs=config.env_kwargs, automaton_state=config.automaton_state,
                        **config.effective()["hyperparameters"])
     pop.learner.store_member(k, agent)
-    agent.num_timesteps, agent._n_updates = pop.num_timesteps, pop.learner.n_updates
+    agent.num_timesteps, agent.n_updates = pop.num_timesteps, pop.learner.n_updates
     if pop.learner.targets is not None:
         agent.distill = pop.learner.targets.member(k)
     with atomic_path(run.path / "model.zip") as tmp:
@@ -287,5 +280,4 @@ def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, 
     agent.get_env().close()
     run.write_result(student_result(config, pop.learner.algorithm, pop.num_timesteps, pop.learner.n_updates, seconds,
                                     engine="population", members=pop.K, device=device))
-    for name in ("checkpoint", "checkpoint-old", "checkpoint-new"):
-        shutil.rmtree(run.path / name, ignore_errors=True)
+    run.remove_checkpoints()

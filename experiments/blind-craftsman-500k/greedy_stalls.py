@@ -26,10 +26,10 @@ def _load(run: Path):
     """A run's config, its last checkpoint's model, and whether it sees the automaton state."""
     from craftsuite.agents.factory import load_agent
     from craftsuite.runs import RunDir, load_config
-    from craftsuite.training import StudentConfig, checkpoint_dir
+    from craftsuite.training import StudentConfig
 
     config = load_config(StudentConfig, run)
-    saved = checkpoint_dir(RunDir(run, config))
+    saved = RunDir(run, config).last_checkpoint()
     model = saved / "model.zip" if saved is not None else run / "model.zip"  # a finished run keeps its model only
     if not model.is_file():
         raise FileNotFoundError(f"{run} has no checkpoint nor final model yet")

@@ -92,7 +92,7 @@ def run(task: str, name: str, seed: int, seconds: float, every: float, transitio
                 success, ret, _ = evaluate(agent, env_id, EVAL_EPISODES, seed=10**7 + len(rows), product=False,
                                         env_kwargs=env_kwargs)
                 rows.append({"task": task, "regime": name, "seed": seed, "seconds": round(self.trained, 1),
-                             "transitions": int(self.num_timesteps), "updates": int(agent._n_updates),
+                             "transitions": int(self.num_timesteps), "updates": int(agent.n_updates),
                              "success": success, "return": round(ret, 2)})
                 self.next += every
             self.mark = time.perf_counter()

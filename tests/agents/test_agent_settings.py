@@ -81,14 +81,14 @@ def test_the_actors_delay_is_applied_and_reported():
     agent = make_agent("td3", CONT, **SMALL_TD3)
     agent.learn(40)
     assert agent.num_timesteps < 20_000 and agent.policy_delay == 4  # the schedule's, in force now
-    agent._n_updates = 0
+    agent.n_updates = 0
     assert _actor_updates(agent, 24) == 6 and agent.policy_delay == 4
     agent.num_timesteps = 25_000
-    agent._n_updates = 0
+    agent.n_updates = 0
     assert _actor_updates(agent, 24) == 12 and agent.policy_delay == 2
     constant = make_agent("td3", CONT, policy_delay=3, **SMALL_TD3)
     constant.learn(40)
-    constant._n_updates = 0
+    constant.n_updates = 0
     assert constant.policy_delay == 3 and _actor_updates(constant, 24) == 8
     with pytest.raises(ValueError, match="not both"):
         make_agent("td3", CONT, policy_delay=3, delay_schedule=[[None, 2]], **SMALL_TD3)

@@ -38,7 +38,7 @@ def test_teacher_distills_a_table(teacher, table):
 def test_grid_methods_train(method, table):
     agent = make_agent(method, "CraftSuite/DungeonQuest-Grid10-v0", table=table, seed=1, **SMALL_DQN)
     agent.learn(300)
-    assert agent.num_timesteps == 300 and agent._n_updates > 0
+    assert agent.num_timesteps == 300 and agent.n_updates > 0
     if METHODS[method].distill:
         assert agent.distill.student_counts.sum() > 0
     if METHODS[method].crm:
@@ -50,7 +50,7 @@ def test_grid_methods_train(method, table):
 def test_cont_methods_train(method, table):
     agent = make_agent(method, CONT, table=table, seed=1, **SMALL_TD3)
     agent.learn(200)
-    assert agent.num_timesteps == 200 and agent._n_updates > 0
+    assert agent.num_timesteps == 200 and agent.n_updates > 0
     assert agent.policy_delay_at(100) == 4 and agent.policy_delay_at(25_000) == 2
 
 

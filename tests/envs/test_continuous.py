@@ -344,8 +344,10 @@ def test_video_command_writes_a_readable_mp4(tmp_path, env_id, gl_available, cap
     assert cli(["video", env_id, "--policy", "scripted", "--episodes", "2", "--out", str(out)]) == 0
     env = gym.make(env_id, status_panel=True)  # videos are for people: the command draws the panel
     policy = craftsuite.scripted.scripted_policy(env)
-    expected = sum(run_episode(env, policy, seed=s)[1] + 1 for s in range(2))  # + reset frames
     meta, frames = read_video(out)
+    per_decision = round(meta["fps"] / env.metadata["render_fps"])  # MuJoCo's: its motion, drawn between decisions
+    assert per_decision == (1 if "Grid" in env_id else 5)
+    expected = sum(per_decision * run_episode(env, policy, seed=s)[1] + 1 for s in range(2))  # + reset frames
     assert meta["codec"] == "h264" and meta["pix_fmt"].startswith("yuv420p")
     rows, columns, _ = env.unwrapped.frame_shape
     assert meta["size"] == (columns, rows) and len(frames) == expected

@@ -114,3 +114,36 @@ def test_videos_for_people_carry_the_status_panel(tmp_path, capsys):
     (run / "evals.csv").write_text("step,success,return\n20,0.0,-5.0\n")
     movie = _best_student_video([run], tmp_path)
     assert read_video(movie)[0]["size"] == (shown[1], shown[0])
+
+
+@pytest.mark.parametrize("env_id", ["CraftSuite/BlindCraftsman-Cont-v0", "CraftSuite/BlindCraftsman-Kinematic-v0"])
+def test_continuous_worlds_play_their_motion_between_decisions(tmp_path, env_id, gl_available):
+    """A continuous world's video draws each decision's motion: 15 frames a second or more
+    at the world's pace (MuJoCo's control period; the board's render_fps decisions a second),
+    the agent moving between the frames of one decision."""
+    import cv2
+    import gymnasium as gym
+
+    from craftsuite.rollouts import record_video
+    from craftsuite.scripted import run_episode, scripted_policy
+
+    if "Cont" in env_id and not gl_available:
+        pytest.skip(gl_available.reason)
+    out = tmp_path / "motion.mp4"
+    recording = record_video(env_id, "scripted", 1, str(out), seed=3, progress=False)
+    env = gym.make(env_id)
+    decisions = run_episode(env, scripted_policy(env), seed=3)[1]
+    video = cv2.VideoCapture(str(out))
+    fps, count = video.get(cv2.CAP_PROP_FPS), int(video.get(cv2.CAP_PROP_FRAME_COUNT))
+    frames = []
+    while (ok := video.read())[0]:
+        frames.append(ok[1].astype(int))
+    video.release()
+    assert fps >= 15 and recording.fps == fps
+    assert count == len(frames) == recording.frames > decisions + 1
+    per_decision = (len(frames) - 1) // decisions
+    assert per_decision * decisions + 1 == len(frames)
+    assert np.isclose(fps, per_decision * env.metadata["render_fps"])  # the world's pace
+    # within one decision the picture changes: the agent glides instead of jumping
+    moving = sum(np.abs(a - b).mean() > 0.05 for a, b in zip(frames[1:], frames[2:]))
+    assert moving > decisions

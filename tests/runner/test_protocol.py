@@ -77,7 +77,7 @@ def test_target_update_period_counted_in_gradient_steps(monkeypatch):
 
     agent._update_target = spy
     agent.learn(60)  # 30 agent steps of 2 envs; 20 transitions before learning, then 2 updates per step
-    assert agent._n_updates == steps[0] == 40
+    assert agent.n_updates == steps[0] == 40
     # every third gradient step, whatever the envs and transitions, the target made the online network
     assert copies == [(k, True) for k in range(3, 41, 3)]
     # counted in transitions (SB3's meaning), the period is in env steps over all envs: with 2 envs
@@ -119,7 +119,7 @@ def test_residual_cnn_reads_the_planes():
     assert agent.q_values(obs).shape == (1, 4)
     agent.learn(30)  # trains through the batch-norm layers
     norms = [m for m in agent.q_net.modules() if isinstance(m, th.nn.BatchNorm2d)]
-    assert norms and all(int(m.num_batches_tracked) == agent._n_updates > 0 for m in norms)  # once per update
+    assert norms and all(int(m.num_batches_tracked) == agent.n_updates > 0 for m in norms)  # once per update
     # Q-values (the greedy policy's, and the teacher's table's) read the running statistics and
     # leave them and the network's mode as they were
     agent.q_net.set_training_mode(True)

@@ -126,3 +126,28 @@ def test_a_run_that_fails_before_training_leaves_no_directory(tmp_path):
         r.append("episodes.csv", EPISODE_FIELDS, [{"step": 1, "return": 0, "length": 1, "success": 0}])
         raise RuntimeError("boom")
     assert len(read_csv(fresh / "episodes.csv")) == 1
+
+
+def test_checkpoints_rotate_keeping_the_one_before_the_last(tmp_path):
+    def save(run, step):
+        new = run.new_checkpoint()
+        for name in ("model.zip", "replay.pkl"):
+            (new / name).write_text(str(step))
+        run.commit_checkpoint()
+
+    def steps(run):
+        return [(d.name, (d / "model.zip").read_text()) for d in run.checkpoint_dirs()]
+
+    with RunDir(tmp_path / "run", StudentConfig(steps=10)) as run:
+        assert run.checkpoint_dirs() == [] and run.last_checkpoint() is None
+        for step in (1, 2, 3):
+            save(run, step)
+        assert steps(run) == [("checkpoint", "3"), ("checkpoint-old", "2")]  # the first is gone
+        (run.new_checkpoint() / "model.zip").write_text("4")  # killed before the replay was written
+        assert run.last_checkpoint().name == "checkpoint"  # an incomplete one is no checkpoint
+        save(run, 4)  # what the kill left is cleared first
+        assert steps(run) == [("checkpoint", "4"), ("checkpoint-old", "3")]
+        run.remove_checkpoints(keep_last=True)
+        assert steps(run) == [("checkpoint", "4")]
+        run.remove_checkpoints()
+        assert not any((run.path / name).exists() for name in RunDir.CHECKPOINTS)

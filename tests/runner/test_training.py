@@ -11,7 +11,7 @@ import zipfile
 import pytest
 
 from craftsuite.runs import RunDir, RunError, load_config, read_csv, settings
-from craftsuite.training import StudentConfig, TeacherConfig, checkpoint_dir, train_student, train_teacher
+from craftsuite.training import StudentConfig, TeacherConfig, train_student, train_teacher
 
 TINY_DQN = {"learning_starts": 100, "buffer_size": 5_000}
 
@@ -114,7 +114,7 @@ def test_a_killed_run_resumes_from_its_checkpoint(tmp_path):
     assert (run / ".lock").exists()  # left behind by the killed process
     kept = [(r["step"], r["return"]) for r in read_csv(run / "episodes.csv")]
     config = load_config(StudentConfig, run)
-    with zipfile.ZipFile(checkpoint_dir(RunDir(run, config)) / "model.zip") as z:
+    with zipfile.ZipFile(RunDir(run, config).last_checkpoint() / "model.zip") as z:
         checkpoint_step = json.loads(z.read("data"))["num_timesteps"]
     assert checkpoint_step >= 1_000  # so the resumed run must keep some episodes
     assert train_student(config, tmp_path, progress=False) == run  # takes the dead run's lock over

@@ -26,10 +26,11 @@ TD3_DEFAULTS = dict(learning_rate=1e-4, buffer_size=1_000_000, batch_size=64, le
                     gamma=0.99, tau=0.005, target_policy_noise=0.2, target_noise_clip=0.5,
                     action_noise={"type": "normal", "sigma": 0.3},  # a spec (agents/noise.py)
                     policy_kwargs=dict(net_arch=[400, 300]))
-# TD3's actor delay, ((until_step, delay), ..., (None, delay)): CraftSuite's choice, the
-# actor updated after every 4th critic update for the first 20,000 steps, then every 2nd
-# (SB3's constant). AutomatonTD3 runs it unless a run gives ``delay_schedule`` or a
-# constant ``policy_delay``.
+# TD3's actor delay, ((until_step, delay), ..., (None, delay)): CraftSuite's default, the
+# schedule the paper's text describes (the actor updated after every 4th critic update for
+# the first 20,000 steps, then every 2nd, SB3's constant); the authors' code delays by 2
+# throughout, as the ``paper`` suite does. AutomatonTD3 runs it unless a run gives
+# ``delay_schedule`` or a constant ``policy_delay``.
 TD3_DELAY_SCHEDULE = ((20_000, 4), (None, 2))
 
 

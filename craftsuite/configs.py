@@ -98,9 +98,6 @@ class StudentConfig:
         owned = sorted({"product", "layout_seed"} & set(self.world_kwargs))
         if owned:
             raise ValueError(f"world_kwargs may not set {owned}: the method sets product, layout_seed its own field")
-        from .registration import check_world_kwargs
-
-        check_world_kwargs(self.world, self.world_kwargs, "world_kwargs")
 
     @property
     def env_id(self) -> str:

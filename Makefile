@@ -20,8 +20,10 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(PY) -m pytest -q --nbmake tests notebooks
 
+# the slow tests alone (spawned transfers, Ray, kills, the wheel, the transfer notebook);
+# this -m replaces the default run's -m 'not slow' (pyproject.toml's addopts)
 test-slow: $(STAMP)
-	$(PY) -m pytest -q -m slow
+	$(PY) -m pytest -q -m slow --nbmake tests notebooks
 
 # Each benchmark prints its figures beside their targets and rewrites its own section of
 # docs/performance.md (about 15 minutes on 2 cores; run it on an idle machine)

@@ -161,12 +161,19 @@ def _scripted(args) -> int:
 
 
 def _video(args) -> int:
-    from . import registration  # noqa: F401  (registers the ids)
+    from .ids import is_id, parse_id
     from .rollouts import record_video
 
+    if is_id(args.target):
+        if args.world is not None:
+            raise ValueError(f"--world picks the world of a task; {args.target} is an id, which names its own")
+        env_id = args.target
+    else:
+        env_id = _registered(_task(args.target), args.world or "Cont")
+    env = _world_kwargs(args.env, parse_id(env_id)[1])
     # a video is for people: show the inventory and automaton state unless --env says otherwise
-    rec = record_video(args.env_id, args.policy, args.episodes, args.out, args.seed, args.fps, args.product,
-                       env_kwargs={"status_panel": True, **_json_object(args.env, "--env")})
+    rec = record_video(env_id, args.policy, args.episodes, args.out, args.seed, args.fps, args.product,
+                       env_kwargs={"status_panel": True, **env})
     print(f"wrote {rec.path}: {rec.frames} frames at {rec.fps} fps ({rec.codec}); "
           f"{rec.successes}/{rec.episodes} episodes completed the objective")
     return 0
@@ -183,6 +190,15 @@ def _json_object(text: str | None, flag: str = "--hyper") -> dict:
         raise ValueError(f"{flag} is not JSON ({err}): {text!r}") from None
     if not isinstance(value, dict):
         raise ValueError(f"{flag} must be a JSON object, e.g. '{{\"learning_rate\": 1e-4}}', not {text!r}")
+    return value
+
+
+def _world_kwargs(text: str | None, world: str, flag: str = "--env") -> dict:
+    """``flag``'s JSON, gymnasium.make keywords checked against ``world``'s before anything runs."""
+    from .registration import check_world_kwargs
+
+    value = _json_object(text, flag)
+    check_world_kwargs(world, value, flag)
     return value
 
 
@@ -265,7 +281,7 @@ def _student(args) -> int:
     config = StudentConfig(task=args.task, method=args.method, world=args.world, seed=args.seed, steps=args.steps,
                            table=str(Path(args.table).resolve()) if args.table else None, eval_every=args.eval_every,
                            eval_episodes=args.eval_episodes, hyperparameters=_hyper(args.hyper, METHODS[args.method].algorithm),
-                           layout_seed=args.layout_seed, world_kwargs=_json_object(args.env, "--env"),
+                           layout_seed=args.layout_seed, world_kwargs=_world_kwargs(args.env, args.world),
                            n_envs=args.n_envs, automaton_state=args.automaton_state, engine=args.engine)
     if METHODS[args.method].needs_table and not args.table:
         raise ValueError(f"method {args.method!r} needs --table (a teacher's table.npz: craftsuite teacher)")
@@ -302,7 +318,7 @@ def _transfer(args) -> int:
         changes["dqn_hyperparameters"] = {**suite.dqn_hyperparameters, **dqn}
         changes["teacher_hyperparameters"] = {**suite.teacher_hyperparameters, **dqn}
     if args.env is not None:
-        changes["cont_world_kwargs"] = _json_object(args.env, "--env")
+        changes["cont_world_kwargs"] = _world_kwargs(args.env, CONT)
     if args.board_size is not None:
         if KINEMATIC not in worlds:
             raise ValueError(f"--board-size sets the kinematic board ({KINEMATIC}); these worlds have none: {worlds}")
@@ -359,6 +375,23 @@ def _positive(text: str) -> int:
     value = int(text)
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
+    return value
+
+
+def _seed(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be 0 or more (seeds are non-negative), got {value}")
+    return value
+
+
+_seed.__name__ = "seed"  # argparse names a non-integer "invalid seed value"
+
+
+def _fraction(text: str) -> float:
+    value = float(text)
+    if not 0 <= value <= 1:
+        raise argparse.ArgumentTypeError(f"must be between 0 and 1, got {value}")
     return value
 
 
@@ -420,7 +453,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="out/scripted", help="output directory (default: out/scripted)")
     p.add_argument("--task", help=f"only this task (default: all): {task_help}")
     p.add_argument("--episodes", type=_positive, default=10, help="episodes per id (default: 10)")
-    p.add_argument("--seed", type=int, default=0, help="first seed (default: 0)")
+    p.add_argument("--seed", type=_seed, default=0, help="first seed (default: 0)")
     p.set_defaults(run=_scripted)
 
     p = sub.add_parser("teacher", help="train a grid DQN teacher until 90%% greedy success; distil it")
@@ -428,9 +461,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="runs/teachers", help="runs directory (default: runs/teachers)")
     p.add_argument("--size", type=int, default=7, help="grid size (default: 7)")
     p.add_argument("--layout-seed", type=int, default=0, help="the fixed grid instance (-1: a new one per episode)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=_seed, default=0)
     p.add_argument("--max-steps", type=_positive, default=300_000, help="give up after this many steps")
-    p.add_argument("--target-success", type=float, default=0.9, help="stop at this greedy success (default: 0.9)")
+    p.add_argument("--target-success", type=_fraction, default=0.9, help="stop at this greedy success (default: 0.9)")
     p.add_argument("--eval-every", type=_positive, default=5_000)
     p.add_argument("--eval-episodes", type=_positive, default=50)
     p.add_argument("--hyper", help="JSON overrides of the DQN settings, e.g. '{\"learning_rate\": 1e-3}'")
@@ -457,7 +490,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--table", help="a teacher's table.npz (craftsuite teacher), for the methods that distil one: "
                    + ", ".join(m for m, row in METHODS.items() if row.needs_table))
     p.add_argument("--out", default="runs/students", help="runs directory (default: runs/students)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=_seed, default=0)
     p.add_argument("--steps", type=_positive, default=20_000, help="the budget in transitions (default: 20000)")
     p.add_argument("--n-envs", type=_positive, default=1,
                    help="envs stepped side by side; each agent step collects one transition from each (default: 1)")
@@ -467,7 +500,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "'{\"action_noise\": {\"type\": \"persistent\", \"sigma\": 0.6, \"resample\": 0.1}}'")
     p.add_argument("--env", help="JSON gymnasium.make keywords beyond the registered world, e.g. the "
                    "fine-control MuJoCo world '{\"frame_skip\": 2, \"max_episode_steps\": 1000}'")
-    p.add_argument("--layout-seed", type=int, help="grid worlds: one fixed instance (default: a new one per episode)")
+    p.add_argument("--layout-seed", type=_seed, help="grid worlds: one fixed instance (default: a new one per episode)")
     p.add_argument("--engine", choices=ENGINES, default="sb3", help="sb3 (default: one SB3 agent) or population "
                    "(the same run by the population engine)")
     p.add_argument("--automaton-state", type=_on_off, metavar="on|off",
@@ -515,13 +548,15 @@ def build_parser() -> argparse.ArgumentParser:
                    "paper's claim, from one transfer directory (craftsuite transfer --suite paper)")
     p.set_defaults(run=_leaderboard)
 
-    p = sub.add_parser("video", help="record rollouts of a policy as an MP4 (grid and MuJoCo ids)")
-    p.add_argument("env_id", help="a registered id, e.g. CraftSuite/BlindCraftsman-Cont-v0")
+    p = sub.add_parser("video", help="record rollouts of a policy as an MP4 (any world of a task)")
+    p.add_argument("target", metavar="TASK_OR_ID", help=f"{task_help}, in --world; or a registered id, e.g. "
+                   "CraftSuite/BlindCraftsman-Cont-v0")
+    p.add_argument("--world", type=_world, help="the task's world: Cont (default), Kinematic or Grid<size>")
     p.add_argument("--policy", default="scripted",
                    help="'random', 'scripted' (default) or a stable-baselines3 checkpoint (.zip)")
     p.add_argument("--episodes", type=_positive, default=1, help="episodes to record (default: 1)")
     p.add_argument("--out", default="rollout.mp4", help="output .mp4 (default: rollout.mp4)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the first episode (default: 0)")
+    p.add_argument("--seed", type=_seed, default=0, help="seed of the first episode (default: 0)")
     p.add_argument("--fps", type=float, help="frames per second (default: the world's pace, the env's "
                    "render_fps decisions a second; continuous worlds' motion is drawn between decisions)")
     p.add_argument("--product", action="store_true",

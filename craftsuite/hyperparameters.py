@@ -56,6 +56,32 @@ TD3_MORE = MappingProxyType(dict(_OFF_POLICY, tau=0.005, policy_delay=OneOf((2, 
                                  delay_schedule=[list(row) for row in TD3_DELAY_SCHEDULE]))
 
 
+# The ranges of the numeric settings, (lowest, highest, whether the lowest itself is out):
+# a value outside is refused by name before anything runs. gradient_steps is left out:
+# SB3 reads -1 as "as many as the env steps collected".
+RANGES = MappingProxyType({
+    "learning_rate": (0, None, True), "buffer_size": (1, None, False), "batch_size": (1, None, False),
+    "learning_starts": (0, None, False), "gamma": (0, 1, False), "tau": (0, 1, True),
+    "target_update_interval": (1, None, False), "exploration_fraction": (0, 1, False),
+    "exploration_initial_eps": (0, 1, False), "exploration_final_eps": (0, 1, False),
+    "train_freq": (1, None, False), "n_steps": (1, None, False), "stats_window_size": (1, None, False),
+    "max_grad_norm": (0, None, True), "target_policy_noise": (0, None, False),
+    "target_noise_clip": (0, None, False), "policy_delay": (1, None, False)})
+
+
+def _out_of_range(name: str, value) -> str | None:
+    """What ``value`` of setting ``name`` must be, if it is a number out of its range; else None."""
+    if name not in RANGES or isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    low, high, open_low = RANGES[name]
+    if (value > low if open_low else value >= low) and (high is None or value <= high):
+        return None
+    above = f"above {low}" if open_low else f"at least {low}"
+    if high is not None:
+        return f"{above} and at most {high}" if open_low else f"between {low} and {high}"
+    return above
+
+
 class HyperparameterError(ValueError, TypeError):
     """Hyperparameters that name no setting of their algorithm or hold a value of the wrong
     type. A TypeError too, as Python's own error for an unknown keyword argument is."""
@@ -103,8 +129,9 @@ def check_hyperparameters(algorithm: str, overrides: Mapping | None, source: str
     ``ActionNoise``) is the algorithm constructor's to judge.
 
     Raises:
-        HyperparameterError: an unknown setting (the message lists the valid ones) or a
-            value of the wrong type (the message names the setting and what it takes).
+        HyperparameterError: an unknown setting (the message lists the valid ones), a
+            value of the wrong type, or a number out of its range (``RANGES``); the message
+            names the setting and what it takes.
     """
     examples = hyperparameter_examples(algorithm)
     more = TD3_MORE if algorithm == "td3" else DQN_MORE
@@ -119,12 +146,15 @@ def check_hyperparameters(algorithm: str, overrides: Mapping | None, source: str
             continue
         # a setting of several forms says so in its row of *_MORE, though its default has one
         types, text = _forms(more[name] if isinstance(more.get(name), OneOf) else examples[name])
+        example = examples[name][0] if isinstance(examples[name], OneOf) else examples[name]
+        # CraftSuite's defaults are what a run gets; the other settings' examples are the
+        # library's defaults, which CraftSuite may replace (TD3's policy_delay: its schedule)
+        shown = f"default {example!r}" if name in defaults else f"e.g. {example!r}"
         if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
-            example = examples[name][0] if isinstance(examples[name], OneOf) else examples[name]
-            # CraftSuite's defaults are what a run gets; the other settings' examples are the
-            # library's defaults, which CraftSuite may replace (TD3's policy_delay: its schedule)
-            shown = f"default {example!r}" if name in defaults else f"e.g. {example!r}"
             raise HyperparameterError(f"{source}: {name} must be {text} ({shown}), got {value!r}")
+        bound = _out_of_range(name, value)
+        if bound:
+            raise HyperparameterError(f"{source}: {name} must be {bound} ({shown}), got {value!r}")
         choices = DQN_CHOICES.get(name) if algorithm == "dqn" else None
         if choices and value not in choices:
             raise HyperparameterError(f"{source}: {name} must be one of {list(choices)}, got {value!r}")

@@ -7,15 +7,71 @@ The tasks themselves live in ``task_registry`` (names, ladder, user specs), the 
 
 from __future__ import annotations
 
+import functools
+import inspect
 from pathlib import Path
 
 import gymnasium as gym
 
-from .ids import NAMESPACE, WORLD_KINDS, cont_id, grid_id, kinematic_id, parse_id, world_kind  # noqa: F401  (re-exported)
+from .ids import CONT, NAMESPACE, WORLD_KINDS, cont_id, grid_id, kinematic_id, parse_id, world_kind  # noqa: F401  (re-exported)
+from .ids import KINEMATIC as KINEMATIC_WORLD
 from .spec import KINEMATIC_CONFIG, TaskSpec
 from .task_registry import add_task, carried, ladder, resolve_task, tasks  # noqa: F401  (re-exported)
 
+# gymnasium.make's own keywords: it takes them itself, so a world's entry point never sees them
+MAKE_KEYWORDS = ("max_episode_steps", "disable_env_checker")
+_ENTRY_POINTS: dict[str, object] = {}  # world ("Grid", "Cont", "Kinematic") -> its entry point, unchecked
+_WORLD_NAMES = {"Grid": "grid", CONT: "MuJoCo", KINEMATIC_WORLD: "kinematic"}
+# keywords another world takes that a world refuses for a reason of its own, stated in the error
+_WHY_NOT = {"Grid": {side: "the grid world draws every cell {tile} pixels a side (Grid7: {frame}x{frame} "
+                           "frames); it has no frame size to set" for side in ("width", "height")}}
 
+
+def world_keywords(world: str) -> tuple[str, ...]:
+    """The keywords ``gymnasium.make`` takes for a world (``Grid7``, ``Cont``, ``Kinematic``)
+    beyond its id: its entry point's, then gymnasium.make's own."""
+    make = _ENTRY_POINTS[_entry_key(world)]
+    return tuple(p for p in inspect.signature(make).parameters if p != "task") + MAKE_KEYWORDS
+
+
+def check_world_kwargs(world: str, kwargs, source: str | None = None) -> None:
+    """Raise a ValueError (``source``: where they came from, e.g. ``--env``) when ``kwargs``
+    hold a keyword ``world`` does not take, naming the keywords it does; before anything
+    is built, so a misspelt keyword is not Python's "unexpected keyword argument"."""
+    accepted = world_keywords(world)
+    unknown = sorted(set(kwargs) - set(accepted) - {"task"})
+    if not unknown:
+        return
+    kind = _entry_key(world)
+    prefix = f"{source}: " if source else ""
+    why = [_WHY_NOT.get(kind, {}).get(k) for k in unknown]
+    if all(why):
+        from .rendering.grid import TILE
+
+        raise ValueError(f"{prefix}{', '.join(unknown)}: " + why[0].format(tile=TILE, frame=7 * TILE))
+    raise ValueError(f"{prefix}unknown keyword{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))} "
+                     f"for the {_WORLD_NAMES[kind]} world; it accepts {', '.join(accepted)}")
+
+
+def _entry_key(world: str) -> str:
+    return world if world in _ENTRY_POINTS else "Grid" if world_kind(world) == "Grid" else world
+
+
+def _entry_point(world: str):
+    """A world's entry point, its keywords checked first (``check_world_kwargs``): every
+    gymnasium.make of a CraftSuite id goes through one."""
+    def wrap(make):
+        _ENTRY_POINTS[world] = make
+
+        @functools.wraps(make)
+        def checked(*args, **kwargs):
+            check_world_kwargs(world, kwargs)
+            return make(*args, **kwargs)
+        return checked
+    return wrap
+
+
+@_entry_point("Grid")
 def make_grid(task: str | TaskSpec, size: int, product: bool = False,
               render_mode: str | None = None, layout_seed: int | None = None,
               status_panel: bool = False) -> gym.Env:
@@ -33,6 +89,7 @@ def make_grid(task: str | TaskSpec, size: int, product: bool = False,
 make_grid.metadata = {"render_modes": ["rgb_array", "ansi"], "render_fps": 8}
 
 
+@_entry_point(CONT)
 def make_continuous(task: str | TaskSpec, product: bool = False, render_mode: str | None = None,
                     width: int = 240, height: int = 240, frame_skip: int | None = None,
                     status_panel: bool = False) -> gym.Env:
@@ -51,6 +108,7 @@ def make_continuous(task: str | TaskSpec, product: bool = False, render_mode: st
 make_continuous.metadata = {"render_modes": ["rgb_array"], "render_fps": 4}  # the default world; each env sets its own
 
 
+@_entry_point(KINEMATIC_WORLD)
 def make_kinematic(task: str | TaskSpec, product: bool = False, render_mode: str | None = None,
                    width: int = 240, height: int = 240, status_panel: bool = False, size: int = 7,
                    observation: str = "authors") -> gym.Env:

@@ -165,6 +165,8 @@ class RunDir:
     # -- ownership -------------------------------------------------------------------------------
     def __enter__(self) -> "RunDir":
         self._created = not self.path.exists()
+        # the folders this run makes, its own and any missing above it (a new --out)
+        self._made = [d for d in (self.path, *self.path.parents) if not d.exists()]
         self.path.mkdir(parents=True, exist_ok=True)
         self._acquire()
         try:
@@ -206,12 +208,14 @@ class RunDir:
 
     def _remove_if_unused(self) -> None:
         """A run that failed before it wrote anything but its config (an agent that could not
-        be built: a bad ``--hyper``) leaves no directory behind to be mistaken for a run."""
+        be built: a bad ``--hyper``) leaves no directory behind to be mistaken for a run, nor
+        the empty folders it made above it."""
         if {p.name for p in self.path.iterdir()} <= {"config.json", ".lock"}:
             for name in ("config.json", ".lock"):
                 (self.path / name).unlink(missing_ok=True)
             try:
-                self.path.rmdir()
+                for made in self._made:  # innermost first; one that is not empty stops it
+                    made.rmdir()
             except OSError:  # something arrived meanwhile: leave it
                 pass
 

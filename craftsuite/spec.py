@@ -257,7 +257,18 @@ class TaskSpec:
 
     @cached_property
     def automaton(self) -> Automaton:
-        return compile_ltlf(self.formula, self.proposition_names)
+        """The formula's DFA.
+
+        Raises:
+            SpecError: the objective can never be satisfied (no accepting state is reachable
+                from the initial one), naming the file.
+        """
+        automaton = compile_ltlf(self.formula, self.proposition_names)
+        if not automaton.satisfiable:
+            raise SpecError(f"{self.path or f'task spec {self.name!r}'}: formula: {self.formula!r} can never be "
+                            "satisfied (its automaton reaches no accepting state); no episode could succeed: "
+                            "change the objective")
+        return automaton
 
     def digest(self) -> str:
         """A short hash of the rules: everything that changes what an agent experiences, not
@@ -394,13 +405,19 @@ def _merge(base: dict, override: dict) -> dict:
 
 
 def _read_toml(path: Path) -> dict:
+    if path.is_dir():
+        raise SpecError(f"{path}: is a directory; give a task spec file in it (path/to/task.toml)")
     if not path.is_file():
         raise SpecError(f"{path}: no such task spec file")
     try:
         with path.open("rb") as f:
-            return tomllib.load(f)
+            data = tomllib.load(f)
     except tomllib.TOMLDecodeError as err:
         raise SpecError(f"{path}: not valid TOML: {err}") from None
+    if not data:
+        raise SpecError(f"{path}: is empty; a task spec needs at least name, formula and [propositions] "
+                        "(see the specs in tasks/)")
+    return data
 
 
 def _raw(path: Path, seen: tuple[Path, ...] = ()) -> dict:

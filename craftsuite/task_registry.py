@@ -64,6 +64,7 @@ def add_task(source: str | Path | TaskSpec | Mapping) -> TaskSpec:
         SpecError: a spec that cannot be used, naming the file, the field and the problem.
     """
     spec = source if isinstance(source, TaskSpec) else _load(source)
+    spec.automaton  # compiled now: an objective that can never be satisfied is refused before it is known
     tasks()[spec.name] = spec
     return spec
 
@@ -113,5 +114,6 @@ def carried(spec: TaskSpec) -> str | dict:
 
 
 def is_spec_file(argument: str) -> bool:
-    """Whether a task argument names a spec file (``*.toml``) rather than a task."""
-    return str(argument).endswith(SPEC_SUFFIX)
+    """Whether a task argument names a spec file (``*.toml``, or any path: a task name has
+    no ``/``) rather than a task."""
+    return str(argument).endswith(SPEC_SUFFIX) or "/" in str(argument)

@@ -225,6 +225,8 @@ def _learn(run: RunDir, fresh, total: int, eval_every: int, eval_episodes: int, 
     """Train ``fresh`` (or the run's checkpoint, if there is one) up to ``total`` steps."""
     agent = _resume(run, fresh)
     if agent is not None:
+        print(f"{run.path}: resuming from its checkpoint at step {agent.num_timesteps} of {total} "
+              "(episodes logged after it are dropped and played again)")
         run.trim_logs(agent.num_timesteps)
     else:
         agent = fresh

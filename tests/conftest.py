@@ -10,6 +10,10 @@ _SCRATCH = tempfile.mkdtemp(prefix="craftsuite-tests-")
 atexit.register(shutil.rmtree, _SCRATCH, ignore_errors=True)
 os.environ.setdefault("CRAFTSUITE_CACHE_DIR", os.path.join(_SCRATCH, "cache"))
 os.environ.setdefault("SB3_LOGDIR", os.path.join(_SCRATCH, "sb3"))
+# One torch thread, set before torch is imported, as real runs do (training sets it): these
+# nets are small, and on a machine with other work OpenMP's spinning threads made a
+# 300-step smoke test take a minute instead of half a second.
+os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 
 import pytest  # noqa: E402

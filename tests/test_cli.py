@@ -181,3 +181,14 @@ def test_teacher_and_student_train_on_a_spec_file(spec_file, tmp_path, capsys):
     assert [n.rsplit("-", 1)[0] for n in made] == ["student-CliTreasure-Grid5-dqn-s0", "teacher-CliTreasure-Grid5-s0"]
     for run in runs.iterdir():
         assert json.loads((run / "result.json").read_text())["env_id"] == "CraftSuite/CliTreasure-Grid5-v0"
+
+
+def test_video_takes_a_task_or_a_spec_file_in_a_world(spec_file, tmp_path, capsys):
+    out = tmp_path / "v.mp4"
+    assert main(["video", str(spec_file), "--world", "Grid5", "--out", str(out)]) == 0
+    assert f"wrote {out}" in capsys.readouterr().out and out.stat().st_size > 0
+    assert main(["video", "Reach", "--world", "Grid5", "--out", str(tmp_path / "w.mp4")]) == 2
+    assert "task 'Reach' has no Grid5 world" in capsys.readouterr().err
+    assert main(["video", "CraftSuite/Reach-Grid7-v0", "--world", "Grid7", "--out", str(tmp_path / "w.mp4")]) == 2
+    assert "--world picks the world of a task" in capsys.readouterr().err
+    assert not (tmp_path / "w.mp4").exists()

@@ -48,6 +48,20 @@ class Automaton:
         return stay & ~self.accepting
 
     @cached_property
+    def satisfiable(self) -> bool:
+        """Whether some trace satisfies the formula: an accepting state is reachable from
+        the initial one."""
+        seen, frontier = {self.initial}, [self.initial]
+        while frontier:
+            state = frontier.pop()
+            if self.accepting[state]:
+                return True
+            new = set(self._rows[state]) - seen
+            seen |= new
+            frontier += new
+        return False
+
+    @cached_property
     def fingerprint(self) -> str:
         """Identity of the language and its encoding (propositions, table, acceptance)."""
         h = hashlib.sha256()

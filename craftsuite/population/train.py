@@ -259,6 +259,8 @@ def _resume(pop: Population, runs) -> None:
             raise CheckpointError(f"{path} cannot be loaded ({type(err).__name__}: {err}): move it aside to "
                                   "resume from the checkpoint before it, or train the population again") from None
     pop.load_states(states)
+    print(f"{', '.join(str(r.path) for r in runs)}: resuming from their checkpoints at step {step} "
+          "(episodes logged after it are dropped and played again)")
     for run in runs:
         run.trim_logs(step)
 

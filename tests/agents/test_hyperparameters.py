@@ -27,6 +27,27 @@ def test_a_value_of_the_wrong_type_is_named(overrides, message):
         check_hyperparameters("dqn", overrides, source="--hyper")
 
 
+@pytest.mark.parametrize("algorithm,overrides,message", [
+    ("dqn", {"batch_size": -1}, "batch_size must be at least 1 (default 64), got -1"),
+    ("dqn", {"learning_rate": -1}, "learning_rate must be above 0 (default 0.0005), got -1"),
+    ("dqn", {"learning_rate": 0}, "learning_rate must be above 0"),
+    ("dqn", {"gamma": 1.5}, "gamma must be between 0 and 1 (default 0.99), got 1.5"),
+    ("dqn", {"exploration_final_eps": -0.1}, "exploration_final_eps must be between 0 and 1"),
+    ("td3", {"tau": 0}, "tau must be above 0 and at most 1 (default 0.005), got 0"),
+    ("td3", {"policy_delay": 0}, "policy_delay must be at least 1 (e.g. 2), got 0"),
+    ("td3", {"buffer_size": 0}, "buffer_size must be at least 1"),
+])
+def test_a_number_out_of_its_range_is_named(algorithm, overrides, message):
+    with pytest.raises(HyperparameterError, match="^--hyper: " + message.replace("(", r"\(").replace(")", r"\)")):
+        check_hyperparameters(algorithm, overrides, source="--hyper")
+
+
+def test_the_edges_of_the_ranges_pass():
+    edges = {"gamma": 1, "learning_starts": 0, "exploration_final_eps": 0.0, "batch_size": 1, "gradient_steps": -1}
+    assert check_hyperparameters("dqn", edges) == edges
+    assert check_hyperparameters("td3", {"tau": 1.0, "target_policy_noise": 0}) == {"tau": 1.0, "target_policy_noise": 0}
+
+
 def test_an_unknown_setting_lists_the_valid_ones():
     with pytest.raises(HyperparameterError) as err:
         check_hyperparameters("td3", {"learning_rat": 1e-3})

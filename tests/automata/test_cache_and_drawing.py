@@ -67,6 +67,7 @@ def _compile_in_child(args):
     return compile_ltlf(formula, props).fingerprint
 
 
+@pytest.mark.slow  # four spawned processes
 def test_parallel_processes_share_the_cache(cache):
     spec = builtin_specs()["DiamondMine"]
     args = [(str(cache.parent), spec.formula, spec.proposition_names)] * 4

@@ -61,7 +61,8 @@ def test_equivalent_to_flloat_on_paper_tasks(task):
     assert ok, why
 
 
-@pytest.mark.parametrize("formula, props", [TOY, TWO_TRACES], ids=["toy", "two-traces"])
+@pytest.mark.parametrize("formula, props", [TOY, pytest.param(*TWO_TRACES, marks=pytest.mark.slow)],
+                         ids=["toy", "two-traces"])  # flloat takes seconds on five propositions
 def test_equivalent_to_flloat_on_paper_figures(formula, props):
     ok, why = flloat_equivalent(formula, props)
     assert ok, why

@@ -163,7 +163,7 @@ def test_object_offsets_are_divided_by_the_arena_side():
 
 def test_the_offsets_keyword_is_gone():
     """The square-root offsets experiment did not help students; the world has one scaling."""
-    with pytest.raises(TypeError, match="unexpected keyword argument 'offsets'"):
+    with pytest.raises(ValueError, match="unknown keyword 'offsets' for the MuJoCo world"):
         gym.make("CraftSuite/BlindCraftsman-Cont-v0", offsets="sqrt")
     with pytest.raises(TypeError, match="offsets"):
         ContinuousWorldEnv(offsets="linear")

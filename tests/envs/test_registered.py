@@ -214,3 +214,34 @@ def test_the_public_view_of_the_objects_agrees_with_the_world_and_is_a_snapshot(
         if env.objects.present.sum() < before.present.sum():
             break
     assert env.objects.present.sum() == before.present.sum() - 1 and before.present.all()
+
+
+@pytest.mark.parametrize("env_id,keywords,problem", [
+    ("CraftSuite/Reach-Grid7-v0", {"foo": 1}, "unknown keyword 'foo' for the grid world; it accepts size, product, "
+                                               "render_mode, layout_seed, status_panel, max_episode_steps"),
+    ("CraftSuite/Reach-Cont-v0", {"layout_seed": 3}, "unknown keyword 'layout_seed' for the MuJoCo world; "
+                                                     "it accepts product, render_mode, width, height, frame_skip"),
+    ("CraftSuite/Reach-Kinematic-v0", {"frame_skip": 2}, "unknown keyword 'frame_skip' for the kinematic world; "
+                                                         "it accepts product, render_mode, width, height, status_panel, "
+                                                         "size, observation"),
+    ("CraftSuite/Reach-Grid7-v0", {"width": 480}, "width: the grid world draws every cell 32 pixels a side "
+                                                  "(Grid7: 224x224 frames); it has no frame size to set"),
+])
+def test_an_unknown_keyword_names_the_keywords_the_world_accepts(env_id, keywords, problem):
+    with pytest.raises(ValueError) as err:
+        gym.make(env_id, **keywords)
+    assert str(err.value).startswith(problem) and "unexpected keyword" not in str(err.value)
+
+
+def test_every_keyword_a_world_lists_is_taken():
+    from craftsuite.registration import world_keywords
+
+    values = {"product": True, "render_mode": "rgb_array", "layout_seed": 1, "status_panel": True, "width": 64,
+              "height": 48, "frame_skip": 2, "size": 10, "observation": "craftsuite", "max_episode_steps": 5,
+              "disable_env_checker": True}
+    for world in ("Grid7", "Cont", "Kinematic"):
+        keywords = {k: values[k] for k in world_keywords(world) if not (world == "Grid7" and k == "size")}
+        env = gym.make(f"CraftSuite/Reach-{world}-v0", **keywords)
+        env.reset(seed=0)
+        assert env.spec.max_episode_steps == 5
+        env.close()

@@ -50,6 +50,52 @@ def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
     assert not out.exists()
 
 
+@pytest.mark.parametrize("command,message", [
+    (["student", "BlindCraftsman", "--method", "td3", "--env", '{"frame_skp": 10}'],
+     "--env: unknown keyword 'frame_skp' for the MuJoCo world; it accepts product, render_mode, width, height, "
+     "frame_skip, status_panel, max_episode_steps"),
+    (["student", "BlindCraftsman", "--method", "dqn", "--world", "Grid7", "--env", '{"width": 480}'],
+     "--env: width: the grid world draws every cell 32 pixels a side"),
+    (["student", "BlindCraftsman", "--method", "dqn", "--world", "Grid7", "--hyper", '{"batch_size": -1}'],
+     "--hyper: batch_size must be at least 1 (default 64), got -1"),
+    (["teacher", "BlindCraftsman", "--hyper", '{"learning_rate": -1}'],
+     "--hyper: learning_rate must be above 0 (default 0.0005), got -1"),
+    (["transfer", "--dqn-hyper", '{"batch_size": -1}'], "--dqn-hyper: batch_size must be at least 1"),
+    (["transfer", "--env", '{"layout_seed": 1}'], "--env: unknown keyword 'layout_seed' for the MuJoCo world"),
+])
+def test_a_refused_command_names_its_flag_and_leaves_no_output_folder(tmp_path, capsys, command, message):
+    out = tmp_path / "new" / "runs"
+    assert main([*command, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"craftsuite {command[0]}: error: {message}") and err.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("command", [["student", "Reach", "--seed", "-1"], ["teacher", "Reach", "--seed", "-1"],
+                                     ["student", "Reach", "--steps", "0"], ["teacher", "Reach", "--max-steps", "-5"],
+                                     ["teacher", "Reach", "--target-success", "1.5"],
+                                     ["transfer", "--steps", "0"]])
+def test_a_number_out_of_range_is_refused_naming_the_flag(tmp_path, capsys, command):
+    with pytest.raises(SystemExit):
+        main([*command, "--out", str(tmp_path / "runs")])
+    flag = command[-2]
+    assert f"argument {flag}: must be" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_run_that_fails_in_its_directory_removes_the_folders_it_made(tmp_path):
+    root = tmp_path / "new" / "runs"
+    with pytest.raises(TypeError):  # the policy's constructor refuses the keyword
+        train_teacher(TeacherConfig(max_steps=100, hyperparameters={"policy_kwargs": {"bogus": 1}}), root,
+                      progress=False)
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "kept").mkdir()  # a folder that was there before stays
+    with pytest.raises(TypeError):
+        train_teacher(TeacherConfig(max_steps=100, hyperparameters={"policy_kwargs": {"bogus": 1}}),
+                      tmp_path / "kept", progress=False)
+    assert [p.name for p in tmp_path.iterdir()] == ["kept"] and list((tmp_path / "kept").iterdir()) == []
+
+
 # -- damaged checkpoints ----------------------------------------------------------------------------
 CONFIG = StudentConfig(method="dqn", world="Grid7", steps=300, eval_every=100, eval_episodes=1, hyperparameters=TINY)
 
@@ -71,11 +117,13 @@ def _truncate(path):
 
 
 @pytest.mark.parametrize("name", ["replay.pkl", "model.zip"])
-def test_a_damaged_checkpoint_falls_back_to_the_one_before(interrupted, name):
+def test_a_damaged_checkpoint_falls_back_to_the_one_before(interrupted, name, capsys):
     run = interrupted
     _truncate(run / "checkpoint" / name)
+    capsys.readouterr()
     with pytest.warns(RuntimeWarning, match=f"resuming from checkpoint-old.*checkpoint/{name} cannot be loaded"):
         assert train_student(CONFIG, run.parent, progress=False) == run
+    assert f"{run}: resuming from its checkpoint at step 200 of 300" in capsys.readouterr().out
     result = json.loads((run / "result.json").read_text())
     assert result["steps"] == 300 and result["algorithm"] == "dqn"
     # resumed at 200: the evaluation at 300 was made again, once

@@ -186,6 +186,7 @@ def test_suite_selection_errors_name_the_problem(tmp_path):
         dataclasses.replace(quick, methods=("td3", "td4")).student_configs(tmp_path)
 
 
+@pytest.mark.slow  # a whole suite in a pool of spawned workers
 def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenance(tmp_path, monkeypatch):
     from craftsuite import suite_runner
     from craftsuite.provenance import read
@@ -231,6 +232,7 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
     assert text.count("min on ") == 2 and text.count("did not finish on ") == 1
 
 
+@pytest.mark.slow  # starts a Ray instance
 def test_students_on_a_local_ray_instance(tmp_path):
     pytest.importorskip("ray")
     configs = [StudentConfig(method="dqn", world="Grid7", seed=s, steps=300, eval_every=150, eval_episodes=1,
@@ -260,6 +262,7 @@ def _alive(pid: int) -> bool:
     return state not in ("Z", "X")  # an orphaned zombie waits for a reaper that may never come
 
 
+@pytest.mark.slow  # spawns a driver and its workers, waits up to 120 s for them
 def test_killing_the_driver_stops_its_student_processes(tmp_path):
     driver = subprocess.Popen([sys.executable, "-c", _DRIVER, str(tmp_path)])
     workers = []
@@ -285,6 +288,7 @@ def test_killing_the_driver_stops_its_student_processes(tmp_path):
     assert not any(tmp_path.glob("*/result.json"))  # killed mid-run: both stay resumable
 
 
+@pytest.mark.slow  # spawned workers
 def test_a_failing_student_stops_the_others_at_once(tmp_path):
     """A worker's error surfaces when it happens, and the other students are stopped (they
     resume when asked for again), rather than after they have run their budgets."""

@@ -57,6 +57,7 @@ def test_aggregate_estimates_need_two_runs_per_task():
         stats.probability_of_improvement([np.array([1.0, 0.5])], [])
 
 
+@pytest.mark.slow  # bootstraps of both libraries
 def test_the_estimates_agree_with_rliable():
     """rliable's IQM, probability of improvement and performance profile on the same
     runs x tasks matrices: point estimates equal, bootstrap intervals within resampling

@@ -93,6 +93,7 @@ train_student(config, sys.argv[1], progress=False)
 """
 
 
+@pytest.mark.slow  # a training process killed after its second checkpoint, waited for up to 120 s
 def test_a_killed_run_resumes_from_its_checkpoint(tmp_path):
     proc = subprocess.Popen([sys.executable, "-c", _KILLABLE, str(tmp_path)])
     try:

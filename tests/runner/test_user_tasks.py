@@ -19,6 +19,7 @@ def user_task(treasure_spec):
     return path
 
 
+@pytest.mark.slow  # spawned workers
 def test_students_of_a_user_task_run_in_fresh_worker_processes(user_task, tmp_path):
     # the pool's workers are spawned: they know only the built-in tasks, unless the job brings its task
     config = StudentConfig(task="WorkerTreasure", method="dqn", world="Grid4", steps=100, eval_every=100,

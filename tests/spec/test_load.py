@@ -166,3 +166,21 @@ def test_user_spec_registers_and_runs(tmp_path):
     assert env.unwrapped.automaton.propositions == ("coin", "trap")
     assert env.spec.max_episode_steps == 50
     env.close()
+
+
+def test_a_directory_or_an_empty_file_is_named_as_such(tmp_path):
+    with pytest.raises(SpecError, match=re.escape(f"{tmp_path}: is a directory; give a task spec file in it")):
+        load_spec(tmp_path)
+    with pytest.raises(SpecError, match=re.escape(f"{tmp_path / 'empty.toml'}: is empty; a task spec needs")):
+        load_spec(write(tmp_path, "\n", "empty.toml"))
+
+
+def test_an_objective_that_can_never_be_satisfied_is_refused_when_added(tmp_path):
+    from craftsuite import task_registry
+
+    path = write(tmp_path, GOOD.replace('"F(coin) & G(!trap)"', '"F(coin) & G(!coin)"').replace("Treasure", "Never"))
+    with pytest.raises(SpecError, match=re.escape(f"{path}: formula: 'F(coin) & G(!coin)' can never be satisfied")):
+        craftsuite.register_task(path)
+    assert "Never" not in task_registry.tasks() and not [i for i in gym.registry if "Never" in i]
+    spec = load_spec(write(tmp_path, GOOD))  # a satisfiable one: the automaton reaches acceptance
+    assert spec.automaton.satisfiable and spec.automaton.accepts([spec.automaton.mask({"coin"})])

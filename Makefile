@@ -1,7 +1,8 @@
 # The two commands a new user needs (both do the whole set-up first, once):
 #   make demo   the main job: the quick transfer benchmark (grid teachers -> MuJoCo students),
 #               ending in a leaderboard, learning curves and a video in runs/quick
-#   make test   the default test run (slow tests excluded; `make test-slow` runs them)
+#   make test   the linter (ruff), then the default test run (slow tests excluded;
+#               `make test-slow` runs them)
 VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.craftsuite-setup
@@ -18,6 +19,7 @@ demo: $(STAMP)
 	$(PY) -m craftsuite transfer --suite quick --out runs/quick
 
 test: $(STAMP)
+	$(PY) -m ruff check .
 	$(PY) -m pytest -q --nbmake tests notebooks
 
 # the slow tests alone (spawned transfers, Ray, kills, the wheel, the transfer notebook);

@@ -64,7 +64,7 @@ def machine() -> str:
         memory = f", {kib / 2**20:.0f} GiB"
     except (OSError, ValueError, IndexError):
         pass
-    load = ", load average {:.2f}".format(os.getloadavg()[0]) if hasattr(os, "getloadavg") else ""
+    load = f", load average {os.getloadavg()[0]:.2f}" if hasattr(os, "getloadavg") else ""
     return (f"{os.cpu_count()} cores ({model}){memory}, {platform.system()} {platform.release()}, "
             f"Python {platform.python_version()}{load}")
 

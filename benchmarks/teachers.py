@@ -61,7 +61,7 @@ def train(tasks: list[str], args, out: str) -> None:
     report(f"| task (7x7, seed {args.seed}) | env steps to >= 90% greedy success (target: within {args.max_steps:,}) "
            "| minutes | success at stop | evaluations (step:success) |")
     report("|---|---|---|---|---|")
-    for task, r, curve, path in rows:
+    for task, r, curve, _path in rows:
         reached = f"{r['steps']:,}" if r["reached_target"] else f"**not within {r['steps']:,}**"
         report(f"| {task} | {reached} | {r['seconds_this_session'] / 60:.1f} | {r['success']:.2f} | {curve} |")
     if args.out:

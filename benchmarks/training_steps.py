@@ -87,7 +87,8 @@ def main():
                 best[i] = max(best[i], rate(build(), steps))
         rows.append((name, world, steps, *best))
     report = Report()
-    report(f"| algorithm | env | steps | plain SB3 steps/s | distilled, SB3 settings | ratio (target >= {TARGET_RATIO}) | "
+    report("| algorithm | env | steps | plain SB3 steps/s | distilled, SB3 settings | "
+           f"ratio (target >= {TARGET_RATIO}) | "
            "full agent | full agent, distilled | ratio | targets met |")
     report("|---|---|---|---|---|---|---|---|---|---|")
     for name, world, steps, sb3, student, full, full_dist in rows:  # (``plain`` names the helper above)

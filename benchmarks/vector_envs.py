@@ -23,7 +23,6 @@ import argparse
 import time
 
 import gymnasium as gym
-import numpy as np
 
 import craftsuite  # noqa: F401  (registers the ids)
 from _page import Report, add_page_argument

@@ -76,7 +76,8 @@ def _tasks(args) -> int:
         from .references import write_tasks_page
 
         if args.tag:
-            raise ValueError("--markdown writes the page of every rung; --tag selects rungs to list: use one or the other")
+            raise ValueError("--markdown writes the page of every rung; --tag selects rungs to list: "
+                             "use one or the other")
         path = write_tasks_page(args.markdown, episodes=args.episodes)
         print(f"wrote {path}")
         return 0
@@ -146,7 +147,7 @@ def _scripted(args) -> int:
         except RuntimeError as err:  # no Graphviz: keep the DOT text
             print(f"note: {err}", file=sys.stderr)
             write_image(spec.automaton, out / f"{name}-automaton.dot")
-    print(f"\n| id | scripted successes | mean steps | picture (start, end) |\n|---|---|---|---|")
+    print("\n| id | scripted successes | mean steps | picture (start, end) |\n|---|---|---|---|")
     for env_id, ok, n, steps, pic in rows:
         print(f"| {env_id} | {ok}/{n} | {steps:.1f} | {out / pic} |")
     print(f"\nautomata drawn in {out}/<Task>-automaton.png")
@@ -213,7 +214,8 @@ def _teacher(args) -> int:
     from .configs import TeacherConfig
     from .training import train_teacher
 
-    config = TeacherConfig(task=args.task, size=args.size, layout_seed=None if args.layout_seed < 0 else args.layout_seed,
+    config = TeacherConfig(task=args.task, size=args.size,
+                           layout_seed=None if args.layout_seed < 0 else args.layout_seed,
                            seed=args.seed, max_steps=args.max_steps, target_success=args.target_success,
                            eval_every=args.eval_every, eval_episodes=args.eval_episodes,
                            hyperparameters=_hyper(args.hyper, "dqn"), n_envs=args.n_envs)
@@ -280,7 +282,8 @@ def _student(args) -> int:
 
     config = StudentConfig(task=args.task, method=args.method, world=args.world, seed=args.seed, steps=args.steps,
                            table=str(Path(args.table).resolve()) if args.table else None, eval_every=args.eval_every,
-                           eval_episodes=args.eval_episodes, hyperparameters=_hyper(args.hyper, METHODS[args.method].algorithm),
+                           eval_episodes=args.eval_episodes,
+                           hyperparameters=_hyper(args.hyper, METHODS[args.method].algorithm),
                            layout_seed=args.layout_seed, world_kwargs=_world_kwargs(args.env, args.world),
                            n_envs=args.n_envs, automaton_state=args.automaton_state, engine=args.engine)
     if METHODS[args.method].needs_table and not args.table:
@@ -305,7 +308,8 @@ def _transfer(args) -> int:
     if args.tags is not None or args.tasks is not None:  # the rungs given replace the suite's
         suite = dataclasses.replace(suite, tags=tuple(args.tags or ()), tasks=tuple(map(_task, args.tasks or ())))
     changes = {k: v for k, v in (("worlds", tuple(args.worlds) if args.worlds else None), ("seeds", args.seeds),
-                                 ("student_steps", args.steps), ("methods", tuple(args.methods) if args.methods else None),
+                                 ("student_steps", args.steps),
+                                 ("methods", tuple(args.methods) if args.methods else None),
                                  ("teacher_max_steps", args.teacher_steps), ("eval_every", args.eval_every))
                if v is not None}
     worlds = list(changes.get("worlds", suite.worlds))

@@ -100,6 +100,15 @@ def parse_id(value: str) -> tuple[str, str]:
     return parts[0], parts[1]
 
 
+def is_id(value: str) -> bool:
+    """Whether ``value`` is a CraftSuite id (by its form; registered or not)."""
+    try:
+        parse_id(value)
+    except ValueError:
+        return False
+    return True
+
+
 def file_stem(value: str) -> str:
     """An id as a file name, without its namespace: ``CraftSuite/Reach-Cont-v0`` -> ``Reach-Cont-v0``.
 

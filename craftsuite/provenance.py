@@ -15,7 +15,7 @@ import shlex
 import subprocess
 import sys
 import uuid
-from datetime import datetime, timezone
+from datetime import datetime, UTC
 from pathlib import Path
 
 from .files import atomic_write
@@ -45,7 +45,8 @@ def machine() -> str:
         memory = f", {os.sysconf('SC_PAGE_SIZE') * os.sysconf('SC_PHYS_PAGES') / 2**30:.1f} GiB"
     except (ValueError, OSError, AttributeError):
         pass
-    return f"{platform.system()} {platform.machine()}, {os.cpu_count()} cores{memory}, Python {platform.python_version()}"
+    return (f"{platform.system()} {platform.machine()}, {os.cpu_count()} cores{memory}, "
+            f"Python {platform.python_version()}")
 
 
 def versions() -> dict[str, str]:
@@ -63,7 +64,7 @@ def versions() -> dict[str, str]:
 def stamp() -> dict:
     """The code that runs now, as a run's ``config.json`` records each session that trains
     it: the time, the git commit and the package versions (CraftSuite's among them)."""
-    return {"at": datetime.now(timezone.utc).isoformat(timespec="seconds"), "commit": git_commit(),
+    return {"at": datetime.now(UTC).isoformat(timespec="seconds"), "commit": git_commit(),
             "versions": versions()}
 
 
@@ -82,7 +83,7 @@ def start_session(command: list[str] | str | None = None) -> dict:
     if command is None:
         command = command_line()
     return {"id": uuid.uuid4().hex[:12], "command": command if isinstance(command, str) else shlex.join(command),
-            "started": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+            "started": datetime.now(UTC).isoformat(timespec="seconds"),
             "commit": git_commit(), "machine": machine(), "versions": versions()}
 
 

@@ -84,7 +84,7 @@ def tasks_page(episodes: int = 100, progress: bool = True) -> str:
     ids = [(spec, env_id) for spec in specs for env_id in _ids_of(spec.name)]
     periods = ", ".join(sorted({f"{s.continuous.control_period:g} s" for s in specs}))
     refs = {}
-    for spec, env_id in tqdm(ids, desc="references", unit="id", disable=not progress):
+    for _spec, env_id in tqdm(ids, desc="references", unit="id", disable=not progress):
         for policy in POLICIES:
             refs[env_id, policy] = reference(env_id, policy, episodes)
     lines = [

@@ -24,7 +24,8 @@ A run directory holds
   names the agent's ``algorithm``, as the saved model does.
 
 Every whole-file write goes through ``craftsuite.files`` (a temporary file, then
-``os.replace``), so a killed run never leaves a half-written file. An advisory lock (``flock`` on ``.lock``, which names its
+``os.replace``), so a killed run never leaves a half-written file.
+An advisory lock (``flock`` on ``.lock``, which names its
 holder) keeps two live runs out of one directory; the kernel drops it when its holder
 dies, so a killed run can be started again at once (it resumes).
 """
@@ -163,7 +164,7 @@ class RunDir:
         self._lock = self.path / ".lock"
 
     # -- ownership -------------------------------------------------------------------------------
-    def __enter__(self) -> "RunDir":
+    def __enter__(self) -> RunDir:
         self._created = not self.path.exists()
         # the folders this run makes, its own and any missing above it (a new --out)
         self._made = [d for d in (self.path, *self.path.parents) if not d.exists()]

@@ -70,7 +70,8 @@ from .ids import TASK_NAME
 from .paths import assets_dir, tasks_dir
 
 __all__ = [
-    "LEVELS", "SpecError", "TaskSpec", "Item", "Place", "BoardTile", "Recipe", "Proposition", "GridConfig", "ContinuousConfig",
+    "LEVELS", "SpecError", "TaskSpec", "Item", "Place", "BoardTile", "Recipe", "Proposition", "GridConfig",
+    "ContinuousConfig",
     "load_spec", "builtin_specs",
 ]
 

@@ -64,7 +64,7 @@ def add_task(source: str | Path | TaskSpec | Mapping) -> TaskSpec:
         SpecError: a spec that cannot be used, naming the file, the field and the problem.
     """
     spec = source if isinstance(source, TaskSpec) else _load(source)
-    spec.automaton  # compiled now: an objective that can never be satisfied is refused before it is known
+    _ = spec.automaton  # compiled now: an objective that can never be satisfied is refused before it is known
     tasks()[spec.name] = spec
     return spec
 

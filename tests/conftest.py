@@ -82,3 +82,20 @@ def treasure_spec(tmp_path):
         for env_id in [i for i in gym.registry if i.startswith(f"CraftSuite/{name}-")]:
             del gym.registry[env_id]
         task_registry.tasks().pop(name, None)
+
+
+@pytest.fixture(autouse=True)
+def _registered_tasks_are_the_tests_own():
+    """A task a test registers (and its gymnasium ids) is gone after it: the ladder and the
+    suites read every registered task, so one left behind would change tests that follow."""
+    from craftsuite import task_registry
+    import gymnasium as gym
+
+    tasks = dict(task_registry.tasks())
+    ids = set(gym.registry)
+    yield
+    task_registry.tasks().clear()
+    task_registry.tasks().update(tasks)
+    for env_id in set(gym.registry) - ids:
+        del gym.registry[env_id]
+

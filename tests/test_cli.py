@@ -156,7 +156,8 @@ def test_a_missing_or_bad_spec_file_is_named_and_nothing_is_written(tmp_path, ca
     assert main(["teacher", str(tmp_path / "missing.toml"), "--out", str(out)]) == 2
     assert "missing.toml: no such task spec file" in capsys.readouterr().err
     bad = tmp_path / "bad.toml"
-    bad.write_text('name = "Bad"\nformula = "F(x)"\n[propositions]\nx = { obtained = "gold" }\n[items.coin]\ncount = 1\n')
+    bad.write_text('name = "Bad"\nformula = "F(x)"\n[propositions]\nx = { obtained = "gold" }\n'
+                   '[items.coin]\ncount = 1\n')
     assert main(["student", str(bad), "--out", str(out)]) == 2
     assert "bad.toml: propositions.x.obtained: unknown inventory name 'gold'" in capsys.readouterr().err
     assert not out.exists() and not list(tmp_path.glob("teacher-*"))

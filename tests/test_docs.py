@@ -57,7 +57,7 @@ def test_every_relative_link_resolves_to_a_tracked_file(page):
         target = ((ROOT / page).parent / link).resolve()
         if not target.is_relative_to(ROOT.resolve()):
             broken.append(link)  # outside the repository
-        elif (name := target.relative_to(ROOT.resolve()).as_posix()) not in files | folders:
+        elif target.relative_to(ROOT.resolve()).as_posix() not in files | folders:
             broken.append(link)
     assert not broken, f"{page} links to what the repository does not hold: {broken}"
 

@@ -85,7 +85,7 @@ class AutomatonQTable:
         return path
 
     @classmethod
-    def load(cls, path, automaton: Automaton | None = None) -> "AutomatonQTable":
+    def load(cls, path, automaton: Automaton | None = None) -> AutomatonQTable:
         """The table saved at ``path``; with ``automaton``, checked to be made for it.
 
         Raises:

@@ -65,7 +65,8 @@ class PopulationDQN:
     def act(self, observations: np.ndarray) -> np.ndarray:
         """Greedy actions ``(K, n)`` for observations ``(K, n, obs_dim)``."""
         with th.no_grad():
-            return self.q_values(self.q_net, th.as_tensor(observations, device=self.device)).argmax(dim=-1).cpu().numpy()
+            return self.q_values(self.q_net,
+                                 th.as_tensor(observations, device=self.device)).argmax(dim=-1).cpu().numpy()
 
     def td_target(self, batch: Batch, next_obs) -> th.Tensor:
         """The one target rule (``AutomatonDQN._td_target`` for K members), ``(K, B, 1)``."""

@@ -56,7 +56,8 @@ class PopulationTD3:
         self.actor_optimizer = th.optim.Adam(self.actor.parameters(), lr=lr, **optimizer_kwargs)
         self.critic_optimizer = th.optim.Adam(self.critics.parameters(), lr=lr, **optimizer_kwargs)
         self.gamma, self.tau = float(settings["gamma"]), float(settings["tau"])
-        self.policy_noise, self.noise_clip = float(settings["target_policy_noise"]), float(settings["target_noise_clip"])
+        self.policy_noise, self.noise_clip = (float(settings["target_policy_noise"]),
+                                              float(settings["target_noise_clip"]))
         self.prioritized = bool(settings.get("prioritized", True))
         self.targets = targets
         self.n_updates = 0
@@ -120,7 +121,8 @@ class PopulationTD3:
         """Each stacked network beside its SB3 counterpart in an ``AutomatonTD3``."""
         policy = agent.policy
         return [(self.actor, policy.actor.mu), (self.actor_target, policy.actor_target.mu),
-                *zip(self.critics, policy.critic.q_networks), *zip(self.critics_target, policy.critic_target.q_networks)]
+                *zip(self.critics, policy.critic.q_networks),
+                *zip(self.critics_target, policy.critic_target.q_networks)]
 
     def load_member(self, k: int, agent) -> None:
         """Member ``k``'s networks from an ``AutomatonTD3`` (its actor, critics and targets)."""

@@ -191,8 +191,8 @@ def evaluate_members(pop: Population, config: StudentConfig, seed: int, envs=Non
         if own:
             envs.close()
     shape = (K, E)
-    return [(float(w.mean()), float(r.mean()), float(l.mean()))
-            for w, r, l in zip(wins.reshape(shape), returns.reshape(shape), lengths.reshape(shape))]
+    return [(float(w.mean()), float(r.mean()), float(n.mean()))
+            for w, r, n in zip(wins.reshape(shape), returns.reshape(shape), lengths.reshape(shape))]
 
 
 def _evaluate(pop, configs, runs, step, bar, envs=None) -> None:

@@ -105,7 +105,7 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
         notes = [f"*{e.label}: " + "; ".join(f"{k} = {json.dumps(v)}" for k, v in e.differs.items()) + "*"
                  for e in rows if e.variant]
         if notes:
-            lines += ["", f"Runs of one method that differ in more than the seed are not pooled; "
+            lines += ["", "Runs of one method that differ in more than the seed are not pooled; "
                       "each setting is a row of its own (put runs of another setting in another directory):", ""]
             lines += [f"- {n}" for n in notes]
         waiting = [u for u in board.unfinished if (u.task, u.world_label) == (task, world)]
@@ -164,7 +164,8 @@ def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = 
 def leaderboard_csv(board: Board) -> str:
     buf = io.StringIO()
     writer = csv.writer(buf)
-    writer.writerow(["task", "world", "method", "variant", "seeds", *(f"{m}{s}" for m in METRICS for s in ("", "_lo", "_hi")),
+    writer.writerow(["task", "world", "method", "variant", "seeds",
+                     *(f"{m}{s}" for m in METRICS for s in ("", "_lo", "_hi")),
                      "success_per_seed", "reached_80", "reached_80_median", "differs_in", "budget_transitions",
                      "updates"])
     for e in board:
@@ -221,7 +222,8 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
             lines += [f"![{plot.stem}]({plot.relative_to(path.parent).as_posix()})", ""]
         for video in sorted(runs.path.glob("best-*.mp4")):
             shutil.copy(video, images / video.name)
-            lines += [f"Video of the best student: [{video.name}]({(images / video.name).relative_to(path.parent).as_posix()})", ""]
+            lines += [f"Video of the best student: [{video.name}]"
+                      f"({(images / video.name).relative_to(path.parent).as_posix()})", ""]
     atomic_write(path, "\n".join(lines))
     return path
 

@@ -129,10 +129,12 @@ def plot_profiles(board: Board, out, aggs: list[Aggregate] | None = None) -> lis
         fig = Figure(figsize=(6, 3.8))
         ax = fig.subplots()
         for method in sorted(agg.scores, key=lambda m: -agg.iqm[m]["auc"].value):
-            value, low, high = stats.performance_profile(agg.scores[method], taus - 1e-9)  # >= tau: a rate of tau counts
+            # >= tau: a rate of tau counts
+            value, low, high = stats.performance_profile(agg.scores[method], taus - 1e-9)
             line, = ax.plot(taus, value, label=f"{method} ({agg.runs[method]} runs)")
             ax.fill_between(taus, low, high, color=line.get_color(), alpha=0.2)
-        ax.set(title=f"{agg.world_label}: {len(agg.tasks)} task{'s' if len(agg.tasks) > 1 else ''}", xlabel="final greedy success \u03c4",
+        ax.set(title=f"{agg.world_label}: {len(agg.tasks)} task{'s' if len(agg.tasks) > 1 else ''}",
+               xlabel="final greedy success \u03c4",
                ylabel="share of runs with success \u2265 \u03c4", ylim=(-0.02, 1.02))
         ax.legend(fontsize=8)
         fig.tight_layout()

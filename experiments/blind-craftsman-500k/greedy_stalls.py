@@ -143,7 +143,8 @@ def main(argv=None) -> None:
             print("|---|---|---|---|---|---|")
             for r in stalls:
                 near = ", ".join(f"{k} {d:.2f}" for k, d in sorted(r["nearest"].items(), key=lambda kv: kv[1]))
-                print(f"| {r['inventory']} | {near} | {'yes' if r['at_wall'] else ''} | ({r['actor'][0]:+.2f}, {r['actor'][1]:+.2f}) "
+                print(f"| {r['inventory']} | {near} | {'yes' if r['at_wall'] else ''} "
+                      f"| ({r['actor'][0]:+.2f}, {r['actor'][1]:+.2f}) "
                       f"| ({r['critic_best'][0]:+.1f}, {r['critic_best'][1]:+.1f}) | {r['q_spread']:.1f} |")
             close = np.mean([min(r["nearest"].values()) < 1.0 for r in stalls])
             print(f"\nStuck within 1 m of an object (the pickup radius is 0.4 m): {close:.0%}")

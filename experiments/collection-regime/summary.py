@@ -19,7 +19,7 @@ def main(paths):
     for r in rows:
         runs[r["task"], r["regime"], r["seed"]].append(r)
     cells = defaultdict(list)
-    for (task, regime, seed), evals in runs.items():
+    for (task, regime, _seed), evals in runs.items():
         cells[task, regime].append(sorted(evals, key=lambda e: e["seconds"]))
     checkpoints = sorted({int(round(e["seconds"] / 10) * 10) for r in rows for e in [r]})
     marks = [m for m in (30, 60, 120, 180, 300) if m <= max(checkpoints)]

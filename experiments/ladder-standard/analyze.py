@@ -61,7 +61,8 @@ def main(root):
         print("|---|---|---|---|---|---|")
         rows = {}
         order = list(METHODS)
-        for (t, w, method), runs in sorted(groups.items(), key=lambda g: order.index(g[0][2]) if g[0][2] in order else 99):
+        for (t, w, method), runs in sorted(groups.items(),
+                                           key=lambda g: order.index(g[0][2]) if g[0][2] in order else 99):
             if (t, w) != (task, world):
                 continue
             runs.sort(key=lambda r: r["seed"])
@@ -75,7 +76,8 @@ def main(root):
                   f"| [{t_[1]:.2f}, {t_[2]:.2f}] | {a[0]:.2f} [{a[1]:.2f}, {a[2]:.2f}] |")
         apart = []
         for m1, m2 in combinations(sorted(rows), 2):
-            for name, pick in (("success, bootstrap", lambda r: r["success"][0]), ("success, t", lambda r: r["success"][1]),
+            for name, pick in (("success, bootstrap", lambda r: r["success"][0]),
+                               ("success, t", lambda r: r["success"][1]),
                                ("AUC, t", lambda r: r["auc"])):
                 (_, lo1, hi1), (_, lo2, hi2) = pick(rows[m1]), pick(rows[m2])
                 if hi1 < lo2 or hi2 < lo1:

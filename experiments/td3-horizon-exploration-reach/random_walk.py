@@ -50,7 +50,8 @@ def main():
     parser.add_argument("--frame-skip", type=int, default=2)
     args = parser.parse_args()
     print(f"persistent random walk, {args.episodes} episodes per task, frame_skip {args.frame_skip}")
-    print("| task | rewarded events / episode | automaton changes / episode | successes | violations | mean length (steps) |")
+    print("| task | rewarded events / episode | automaton changes / episode | successes | violations "
+          "| mean length (steps) |")
     print("|---|---|---|---|---|---|")
     for task in args.tasks:
         r = random_walk(task, args.episodes, args.frame_skip)

@@ -41,7 +41,8 @@ def noise_processes(sigma: float, resample: float) -> dict:
     z = np.zeros(2)
     return {"N(0, 0.3) per step (package default)": lambda s: NormalActionNoise(z, 0.3 * np.ones(2)),
             "Ornstein-Uhlenbeck (SB3 defaults, sigma 0.3)": lambda s: OrnsteinUhlenbeckActionNoise(z, 0.3 * np.ones(2)),
-            f"persistent N(0, {sigma}), redrawn w.p. {resample}": lambda s: PersistentActionNoise(sigma, resample, seed=s)}
+            f"persistent N(0, {sigma}), redrawn w.p. {resample}":
+                lambda s: PersistentActionNoise(sigma, resample, seed=s)}
 
 
 def coverage(task: str, make_noise, episodes: int = 20) -> dict:
@@ -84,7 +85,8 @@ def main():
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--methods", nargs="+", default=["td3", "td3-dynamic"])
     parser.add_argument("--hyper", type=json.loads, default={}, help="make_agent keywords as JSON")
-    parser.add_argument("--env", type=json.loads, default={}, help="gymnasium.make keywords for the students' world, as JSON")
+    parser.add_argument("--env", type=json.loads, default={},
+                        help="gymnasium.make keywords for the students' world, as JSON")
     parser.add_argument("--sigma", type=float, default=0.6)
     parser.add_argument("--resample", type=float, default=0.05)
     args = parser.parse_args()
@@ -98,13 +100,16 @@ def main():
         results = list(pool.map(train, args.methods, [args] * len(args.methods)))
     print(f"\n{args.task}, seed {args.seed}, persistent noise N(0, {args.sigma}) redrawn w.p. "
           f"{args.resample}, hyper {json.dumps(args.hyper)}, env {json.dumps(args.env)}")
-    print("| method | step | greedy success | greedy return | events / greedy episode | automaton steps / greedy episode "
-          f"| violations / {EVAL_EPISODES} greedy episodes | training wins | training violations | events / training episode |")
+    print("| method | step | greedy success | greedy return | events / greedy episode "
+          "| automaton steps / greedy episode "
+          f"| violations / {EVAL_EPISODES} greedy episodes | training wins | training violations "
+          "| events / training episode |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     for rows in results:
         for r in rows:
             print(f"| {r['method']} | {r['step']:,} | {r['eval_success']:.2f} | {r['eval_return']} "
-                  f"| {r['eval_events']:.1f} | {r['eval_edges']:.1f} | {r['eval_violations'] * EVAL_EPISODES:.0f} | {r['train_wins']} "
+                  f"| {r['eval_events']:.1f} | {r['eval_edges']:.1f} | {r['eval_violations'] * EVAL_EPISODES:.0f} "
+                  f"| {r['train_wins']} "
                   f"| {r['train_violations']} | {r['events_per_episode']} |")
 
 

@@ -129,12 +129,14 @@ def main(argv=None, entry_point: str | None = None):
         events = " ".join(f"{r['eval_events']:.1f}" for r in rows)
         print(f"| {scene} | {HORIZONS[skip][0]} | {noise_label(noise, args.resample)} | {seed} | {curve} | {events} "
               f"| {rows[-1]['train_wins']} / {rows[-1]['train_episodes']} |")
-    print(f"\n| scene | control period, episode | exploration noise | greedy success at {args.steps:,} (mean over seeds {args.seeds}) |")
+    print("\n| scene | control period, episode | exploration noise "
+          f"| greedy success at {args.steps:,} (mean over seeds {args.seeds}) |")
     print("|---|---|---|---|")
     for setting in product(args.scenes, args.frame_skips, args.noises):
         last = [rows[-1]["eval_success"] for s, rows in zip(settings, results) if s[:3] == setting]
         scene, skip, noise = setting
-        print(f"| {scene} | {HORIZONS[skip][0]} | {noise_label(noise, args.resample)} | {np.mean(last):.2f} ({', '.join(f'{x:.1f}' for x in last)}) |")
+        print(f"| {scene} | {HORIZONS[skip][0]} | {noise_label(noise, args.resample)} "
+              f"| {np.mean(last):.2f} ({', '.join(f'{x:.1f}' for x in last)}) |")
 
 
 if __name__ == "__main__":

@@ -107,7 +107,8 @@ def test_load_agent_takes_the_class_the_model_records(tmp_path, monkeypatch):
         tried = []
         for other in (AutomatonDQN, AutomatonTD3):  # only the recorded class is asked to load
             real = other.load.__func__
-            monkeypatch.setattr(other, "load", classmethod(lambda c, *a, real=real, **k: (tried.append(c), real(c, *a, **k))[1]))
+            monkeypatch.setattr(other, "load",
+                                classmethod(lambda c, *a, real=real, **k: (tried.append(c), real(c, *a, **k))[1]))
         back = load_agent(tmp_path / f"{method}.zip")
         monkeypatch.undo()
         assert type(back) is cls and tried == [cls]

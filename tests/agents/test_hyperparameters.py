@@ -45,7 +45,8 @@ def test_a_number_out_of_its_range_is_named(algorithm, overrides, message):
 def test_the_edges_of_the_ranges_pass():
     edges = {"gamma": 1, "learning_starts": 0, "exploration_final_eps": 0.0, "batch_size": 1, "gradient_steps": -1}
     assert check_hyperparameters("dqn", edges) == edges
-    assert check_hyperparameters("td3", {"tau": 1.0, "target_policy_noise": 0}) == {"tau": 1.0, "target_policy_noise": 0}
+    assert (check_hyperparameters("td3", {"tau": 1.0, "target_policy_noise": 0})
+            == {"tau": 1.0, "target_policy_noise": 0})
 
 
 def test_an_unknown_setting_lists_the_valid_ones():

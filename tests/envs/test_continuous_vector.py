@@ -13,7 +13,7 @@ import pytest
 import craftsuite  # noqa: F401  (registers the ids; chooses MUJOCO_GL before mujoco is imported)
 import mujoco  # noqa: E402,I001
 from craftsuite.envs.continuous_vector import ContinuousVectorEnv
-from tests.envs.test_vector import MODES, assert_same, compare, engine_part, make_pair
+from tests.envs.test_vector import MODES, assert_same, compare, make_pair
 
 CONT_IDS = [f"CraftSuite/{t}-Cont-v0" for t in ("Reach", "BlindCraftsman", "DungeonQuest")]
 N_ENVS = 4

@@ -215,7 +215,7 @@ def test_random_play_matches_a_reimplementation_of_the_authors_step():
     for seed in range(60):
         obs, _ = env.reset(seed=seed)
         theirs = AuthorsBlindCraftsman({tuple(p): n for p, n in zip(u._positions.tolist(), names)}, u.agent_position)
-        for t in range(1000):
+        for _ in range(1000):
             action = rng.uniform(-1, 1, 2).astype(np.float32)
             obs, reward, term, trunc, info = env.step(action)
             their_obs, their_reward, their_done, their_labels = theirs.step(action.astype(np.float64))
@@ -258,7 +258,7 @@ def test_episodes_truncate_at_1000_steps():
     # standing still far from the goal: the episode can only run out
     env.unwrapped._position = np.array([0.5, 0.5])
     env.unwrapped._positions[:] = (6.0, 6.0)
-    for t in range(1, 1001):
+    for t in range(1, 1001):  # noqa: B007  (t: how long the episode ran)
         _, _, term, trunc, _ = env.step(np.zeros(2, dtype=np.float32))
         assert not term
         if trunc:

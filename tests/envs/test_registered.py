@@ -222,8 +222,8 @@ def test_the_public_view_of_the_objects_agrees_with_the_world_and_is_a_snapshot(
     ("CraftSuite/Reach-Cont-v0", {"layout_seed": 3}, "unknown keyword 'layout_seed' for the MuJoCo world; "
                                                      "it accepts product, render_mode, width, height, frame_skip"),
     ("CraftSuite/Reach-Kinematic-v0", {"frame_skip": 2}, "unknown keyword 'frame_skip' for the kinematic world; "
-                                                         "it accepts product, render_mode, width, height, status_panel, "
-                                                         "size, observation"),
+                                                         "it accepts product, render_mode, width, height, "
+                                                         "status_panel, size, observation"),
     ("CraftSuite/Reach-Grid7-v0", {"width": 480}, "width: the grid world draws every cell 32 pixels a side "
                                                   "(Grid7: 224x224 frames); it has no frame size to set"),
 ])

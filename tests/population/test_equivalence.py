@@ -74,7 +74,7 @@ def test_dqn_update_matches_automaton_dqn(loss, prioritized, sparse):
     pop = PopulationDQN(1, agent.observation_space.shape[0], 4, settings, MemberTargets(agent.distill, 1))
     pop.targets.counts[0] = agent.distill.student_counts.reshape(-1)
     pop.load_member(0, agent)
-    for step in range(3):  # the target network is copied after the second; clipping bites (0.05)
+    for _ in range(3):  # the target network is copied after the second; clipping bites (0.05)
         samples = agent.replay_buffer.sample(32)
         _same_sample(agent, samples)
         agent.train(gradient_steps=1, batch_size=32)

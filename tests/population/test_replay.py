@@ -52,14 +52,15 @@ def test_counterfactuals_at_sampling_equal_the_stored_ones(task, sparse):
     replay = PopulationReplay(1, 40, 1, 6 + S, (2,), crm=view, prioritized=False, seed=2,
                               sparse_width=7 if sparse else None)
     stored = []
-    for i in range(40):
+    for _ in range(40):
         w = int(rng.choice(view.live))
         sigma = int(rng.integers(automaton.delta.shape[1]))
         obs, next_obs = rng.random(6 + S).astype(np.float32), rng.random(6 + S).astype(np.float32)
         obs[-S:], next_obs[-S:] = np.eye(S)[w], np.eye(S)[automaton.delta[w, sigma]]
         reward = -0.1 + spec.completion_reward * automaton.accepting[automaton.delta[w, sigma]]
         action = rng.random(2)
-        terminal = bool(automaton.accepting[automaton.delta[w, sigma]] or automaton.rejecting[automaton.delta[w, sigma]])
+        terminal = bool(automaton.accepting[automaton.delta[w, sigma]]
+                        or automaton.rejecting[automaton.delta[w, sigma]])
         replay.add(obs[None, None], next_obs[None, None], action[None, None], np.array([[reward]]),
                    np.array([[terminal]]), np.array([[w]]), np.array([[sigma]]))
         stored.append(counterfactuals(automaton, spec.completion_reward, obs, next_obs, action, reward, False,

@@ -122,7 +122,8 @@ def test_a_population_that_cannot_resume_says_so_and_deletes_nothing(tmp_path, m
 
 
 def test_a_population_is_reproducible(tmp_path):
-    configs = [c.__class__(**{**c.__dict__, "hyperparameters": {**TD3, "action_noise": {"type": "normal", "sigma": 0.3}}})
+    configs = [c.__class__(**{**c.__dict__,
+                              "hyperparameters": {**TD3, "action_noise": {"type": "normal", "sigma": 0.3}}})
                for c in _cell(seeds=(0, 1), steps=800)]
     first = train_population(configs, tmp_path / "a", progress=False)
     again = train_population(configs, tmp_path / "b", progress=False)

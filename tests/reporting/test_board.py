@@ -100,7 +100,8 @@ def test_a_run_recorded_by_an_older_version_loads_beside_new_ones_but_is_not_poo
     rows = {e.label: e for e in build(runs) if e.method == "td3"}
     assert set(rows) == {"td3 (a)", "td3 (b)"}
     assert sorted(json.dumps(e.differs) for e in rows.values()) == sorted(
-        json.dumps(d) for d in ({"effective.hyperparameters.lr": 1}, {"effective.hyperparameters.lr": "(not recorded)"}))
+        json.dumps(d) for d in ({"effective.hyperparameters.lr": 1},
+                                {"effective.hyperparameters.lr": "(not recorded)"}))
 
 
 def test_runs_in_another_world_setting_get_their_own_row(runs):
@@ -165,7 +166,7 @@ def test_each_task_says_whether_a_method_reaches_80_percent_in_half_of_scratchs_
     for seed, speed in enumerate(["early", "late", "late"]):  # median 1,000: not met, though one seed was early
         fake_run(root, "td3-dynamic", seed, evals[speed], [])
     board = build(root)
-    line = next(l for l in leaderboard_markdown(board).splitlines() if l.startswith("Transfer target"))
+    line = next(row for row in leaderboard_markdown(board).splitlines() if row.startswith("Transfer target"))
     assert "`td3` needs" in line
     assert "`td3-crm-edges` met (500 against 1,000)" in line
     assert "`td3-dynamic` not met (1,000 against 1,000)" in line
@@ -175,8 +176,8 @@ def test_each_task_says_whether_a_method_reaches_80_percent_in_half_of_scratchs_
         fake_run(never, "td3", seed, evals["never"], [])
         fake_run(never, "td3-crm-edges", seed, evals["early"] if seed else evals["never"], [])
         fake_run(never, "td3-dynamic", seed, evals["never"], [])
-    line = next(l for l in leaderboard_markdown(build(never)).splitlines()
-                if l.startswith("Transfer target"))
+    line = next(row for row in leaderboard_markdown(build(never)).splitlines()
+                if row.startswith("Transfer target"))
     assert "`td3-crm-edges` met: scratch never got there (500 against never in 1,000)" in line  # never, 500, 500
     assert "`td3-dynamic` not met (never in 1,000 against never in 1,000)" in line
     # scratch with a smaller budget than the student's never says enough
@@ -185,8 +186,8 @@ def test_each_task_says_whether_a_method_reaches_80_percent_in_half_of_scratchs_
         fake_run(small, "td3", seed, [(250, 0.0), (500, 0.0)], [], budget=500)
         fake_run(small, "td3-crm-edges", seed, [(750, 0.8), (1000, 0.9)], [])
         fake_run(small, "product-td3", seed, evals["early"], [])  # no distilled target: no verdict
-    line = next(l for l in leaderboard_markdown(build(small)).splitlines()
-                if l.startswith("Transfer target"))
+    line = next(row for row in leaderboard_markdown(build(small)).splitlines()
+                if row.startswith("Transfer target"))
     assert line.endswith("`td3-crm-edges` not met (750 against never in 500).")
 
 

@@ -27,7 +27,8 @@ def test_a_transfer_output_and_a_directory_of_student_runs_read_alike(tmp_path):
 def test_a_directory_holding_only_a_damaged_run_names_the_file_not_just_no_runs(tmp_path, capsys):
     run = fake_run(tmp_path / "students", "td3", 0, [(1000, 1.0)], [(995, 1.0)])
     (run / "result.json").write_text("{torn")
-    with pytest.raises(ValueError, match=r"no finished student runs under .*; not read: .*result.json is not valid JSON"):
+    with pytest.raises(ValueError,
+                       match=r"no finished student runs under .*; not read: .*result.json is not valid JSON"):
         read_runs(tmp_path)
     assert main(["leaderboard", str(tmp_path)]) == 2
     [line] = capsys.readouterr().err.strip().splitlines()

@@ -84,7 +84,8 @@ def test_cli_errors_name_the_problem(tmp_path, capsys):
     assert "these worlds have none: ['Grid10']" in capsys.readouterr().err
     # the kinematic board has TD3 students but not the MuJoCo world's keywords
     assert main(["transfer", "--worlds", "Kinematic", "--env", '{"frame_skip": 10}', "--out", str(tmp_path / "t")]) == 2
-    assert "--env sets the MuJoCo students' world (Cont); these worlds have none: ['Kinematic']" in capsys.readouterr().err
+    assert ("--env sets the MuJoCo students' world (Cont); these worlds have none: ['Kinematic']"
+            in capsys.readouterr().err)
 
 
 def test_mujoco_keywords_reach_only_the_mujoco_students(tmp_path):
@@ -207,7 +208,8 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
     board = result.leaderboard.read_text()
     assert "## Reach (Cont)" in board and "| 300 / " in board and "- `td3-dynamic-edges`:" in board
     [session] = read(tmp_path / "out")
-    assert session["command"] == f"python: craftsuite.suite_runner.transfer(suite 'quick', out {str(tmp_path / 'out')!r})"
+    assert session["command"] == ("python: craftsuite.suite_runner.transfer(suite 'quick', "
+                                  f"out {str(tmp_path / 'out')!r})")
     assert session["machine"] and "torch" in session["versions"]
     page = write_results_page([tmp_path / "out"], tmp_path / "docs" / "results.md")
     text = page.read_text()

@@ -126,7 +126,8 @@ def test_residual_cnn_reads_the_planes():
     before = [b.clone() for b in agent.q_net.features_extractor.buffers()]
     batch = np.stack([agent.get_env().observation_space.sample() for _ in range(7)])
     first, second = agent.q_values(batch), agent.q_values(batch[:3])
-    np.testing.assert_allclose(first[:3], second, rtol=1e-5, atol=1e-6)  # a row's value does not depend on its batch (up to the kernels' rounding)
+    # a row's value does not depend on its batch (up to the kernels' rounding)
+    np.testing.assert_allclose(first[:3], second, rtol=1e-5, atol=1e-6)
     assert agent.q_net.training
     assert all((a == b).all() for a, b in zip(before, agent.q_net.features_extractor.buffers()))
     from craftsuite.agents.networks import features_policy_kwargs

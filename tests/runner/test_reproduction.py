@@ -74,13 +74,15 @@ def test_the_authors_curves_are_their_six_runs_on_their_axis():
     from craftsuite.reproduction import authors_curves
 
     curves = authors_curves()
-    assert set(curves) == {(t, m) for t in ("BlindCraftsman", "DungeonQuest", "GoldMine") for m in ("td3", "td3-dynamic")}
-    for (task, method), curve in curves.items():
+    assert set(curves) == {(t, m) for t in ("BlindCraftsman", "DungeonQuest", "GoldMine")
+                           for m in ("td3", "td3-dynamic")}
+    for _key, curve in curves.items():
         steps = [s for s, _ in curve]
         assert steps == sorted(steps) and 19_000_000 < steps[-1] <= 20_000_000  # 2M steps of 10 envs
     # their reference rows (the last 5% of each run) agree with the binned curves' end
     last = {m: curves["GoldMine", m][-5:] for m in ("td3", "td3-dynamic")}
-    assert sum(r for _, r in last["td3-dynamic"]) / 5 == pytest.approx(PAPER_REFERENCE["GoldMine"]["td3-dynamic"], abs=2.5)
+    assert (sum(r for _, r in last["td3-dynamic"]) / 5
+            == pytest.approx(PAPER_REFERENCE["GoldMine"]["td3-dynamic"], abs=2.5))
 
 
 def test_bad_input_is_named(tmp_path, capsys):

@@ -97,7 +97,8 @@ def test_the_committed_tasks_page_lists_every_builtin_rung():
     without regenerating it fails here."""
     page = (Path(__file__).resolve().parents[2] / "docs" / "tasks.md").read_text()
     for spec in BUILTIN.values():
-        assert f"## {spec.name}" in page, f"docs/tasks.md lacks {spec.name}: run craftsuite tasks --markdown docs/tasks.md"
+        assert f"## {spec.name}" in page, (f"docs/tasks.md lacks {spec.name}: "
+                                           "run craftsuite tasks --markdown docs/tasks.md")
         for world in ("Grid7", "Grid10", "Cont", "Kinematic"):
             assert f"`CraftSuite/{spec.name}-{world}-v0`" in page
     # every id row's episode limit is the registered one (a changed limit or a stale id fails)

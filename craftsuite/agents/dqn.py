@@ -27,7 +27,8 @@ from torch import nn
 from ..hyperparameters import DQN_CHOICES
 from .distillation import DistilledTarget
 from .networks import features_policy_kwargs
-from .replay import AutomatonReplayBuffer, AutomatonSamples, NStepOwner, automaton_buffer_kwargs
+from .base import AutomatonAlgorithm
+from .replay import AutomatonReplayBuffer, AutomatonSamples, automaton_buffer_kwargs
 
 
 LOSSES, TARGET_UPDATE_UNITS = DQN_CHOICES["loss"], DQN_CHOICES["target_update_unit"]
@@ -61,7 +62,7 @@ class DuelingDQNPolicy(DQNPolicy):
         return DuelingQNetwork(**net_args).to(self.device)
 
 
-class AutomatonDQN(NStepOwner, DQN):
+class AutomatonDQN(AutomatonAlgorithm, DQN):
     """DQN for CraftSuite worlds: dueling, double, prioritized, optionally distilled.
 
     Args (beyond SB3's DQN):
@@ -100,15 +101,6 @@ class AutomatonDQN(NStepOwner, DQN):
         self.double = double
         self.distill = distill
         super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, n_steps=n_steps, **kwargs)
-
-    @property
-    def n_updates(self) -> int:
-        """The gradient updates taken so far (SB3 counts them in a private attribute)."""
-        return self._n_updates
-
-    @n_updates.setter
-    def n_updates(self, value: int) -> None:
-        self._n_updates = int(value)
 
     def _td_target(self, data: AutomatonSamples) -> th.Tensor:
         """r + gamma * Q_target(s', a*), a* from the online net when double; then distilled."""

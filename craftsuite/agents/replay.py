@@ -13,7 +13,6 @@ priorities stay those of the first transition.
 
 from __future__ import annotations
 
-import warnings
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -215,17 +214,3 @@ def automaton_buffer_kwargs(prioritized: bool, n_steps: int, gamma: float, given
         raise ValueError(f"n_steps is the algorithm's setting: pass n_steps={given['n_steps']}, "
                          f"not replay_buffer_kwargs={{'n_steps': ...}} (the algorithm's is {n_steps})")
     return {"prioritized": prioritized, "n_steps": n_steps, "gamma": gamma, **given}
-
-
-class NStepOwner:
-    """Mixin of ``AutomatonDQN`` and ``AutomatonTD3`` (before SB3's class): SB3's ``n_steps``
-    attribute is the one setting of n-step returns, and the ``AutomatonReplayBuffer`` reads it
-    from its keywords (``replay_buffer_kwargs``)."""
-
-    def _setup_model(self) -> None:
-        with warnings.catch_warnings():
-            if isinstance(self.replay_buffer_class, type) and issubclass(self.replay_buffer_class,
-                                                                          AutomatonReplayBuffer):
-                # SB3 warns that n_steps is ignored with a buffer class of one's own; ours takes it
-                warnings.filterwarnings("ignore", message=r"`n_steps=\d+` is ignored")
-            super()._setup_model()

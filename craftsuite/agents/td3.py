@@ -21,10 +21,11 @@ from stable_baselines3.common.utils import polyak_update
 
 from ..hyperparameters import TD3_DELAY_SCHEDULE
 from .distillation import DistilledTarget
-from .replay import AutomatonReplayBuffer, AutomatonSamples, NStepOwner, automaton_buffer_kwargs
+from .base import AutomatonAlgorithm
+from .replay import AutomatonReplayBuffer, AutomatonSamples, automaton_buffer_kwargs
 
 
-class AutomatonTD3(NStepOwner, TD3):
+class AutomatonTD3(AutomatonAlgorithm, TD3):
     """TD3 for CraftSuite worlds: prioritized, delay-scheduled, optionally distilled.
 
     Args (beyond SB3's TD3):
@@ -52,15 +53,6 @@ class AutomatonTD3(NStepOwner, TD3):
         self.delay_schedule = _delay_schedule(delay_schedule, policy_delay)
         super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, n_steps=n_steps,
                          policy_delay=self.policy_delay_at(0), **kwargs)
-
-    @property
-    def n_updates(self) -> int:
-        """The gradient updates taken so far (SB3 counts them in a private attribute)."""
-        return self._n_updates
-
-    @n_updates.setter
-    def n_updates(self, value: int) -> None:
-        self._n_updates = int(value)
 
     def policy_delay_at(self, step: int) -> int:
         return delay_at(self.delay_schedule, step)

@@ -14,11 +14,15 @@ def _task(argument: str) -> str:
     Raises:
         KeyError: an unknown task name, listing the known ones.
         SpecError: a spec file that is missing or cannot be used.
+        ValueError: an id (or something shaped like one) where a task goes.
     """
-    from .ids import parse_id
+    from .ids import NAMESPACE, parse_id
     from .registration import register_task
     from .task_registry import is_spec_file, resolve_task
 
+    if str(argument).startswith(f"{NAMESPACE}/"):  # an id where a task goes: not a path to look for
+        task, _ = parse_id(argument)  # a malformed one: the id format, named
+        raise ValueError(f"{argument} is an id; give its task ({task}) and the world with --world")
     if is_spec_file(argument):
         return parse_id(register_task(Path(argument))[0])[0]
     return resolve_task(argument).name

@@ -83,8 +83,8 @@ def _out_of_range(name: str, value) -> str | None:
 
 
 class HyperparameterError(ValueError, TypeError):
-    """Hyperparameters that name no setting of their algorithm or hold a value of the wrong
-    type. A TypeError too, as Python's own error for an unknown keyword argument is."""
+    """Hyperparameters that name no setting of their algorithm, hold a value of the wrong
+    type or a number out of its range. A TypeError too, as Python's own error for an unknown keyword argument is."""
 
 
 def _forms(example) -> tuple[tuple[type, ...], str]:

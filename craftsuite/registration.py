@@ -38,12 +38,17 @@ def check_world_kwargs(world: str, kwargs, source: str | None = None) -> None:
     """Raise a ValueError (``source``: where they came from, e.g. ``--env``) when ``kwargs``
     hold a keyword ``world`` does not take, naming the keywords it does; before anything
     is built, so a misspelt keyword is not Python's "unexpected keyword argument"."""
+    kind = _entry_key(world)
+    prefix = f"{source}: " if source else ""
     accepted = world_keywords(world)
+    if source is not None:  # a run's flag: what the id or the run's own settings fix is not the flag's
+        owned = sorted(set(kwargs) & set(_run_owns(kind)))
+        if owned:
+            raise ValueError(f"{prefix}{owned[0]}: {_run_owns(kind)[owned[0]]}; leave it out of {source}")
+        accepted = tuple(k for k in accepted if k not in _run_owns(kind))
     unknown = sorted(set(kwargs) - set(accepted) - {"task"})
     if not unknown:
         return
-    kind = _entry_key(world)
-    prefix = f"{source}: " if source else ""
     why = [_WHY_NOT.get(kind, {}).get(k) for k in unknown]
     if all(why):
         from .rendering.grid import TILE
@@ -51,6 +56,15 @@ def check_world_kwargs(world: str, kwargs, source: str | None = None) -> None:
         raise ValueError(f"{prefix}{', '.join(unknown)}: " + why[0].format(tile=TILE, frame=7 * TILE))
     raise ValueError(f"{prefix}unknown keyword{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))} "
                      f"for the {_WORLD_NAMES[kind]} world; it accepts {', '.join(accepted)}")
+
+
+def _run_owns(kind: str) -> dict[str, str]:
+    """The keywords of ``kind``'s entry point that a run sets itself, each with who sets it."""
+    owns = {"product": "whether the automaton state is observed is the run's to say (its method; video's --product)"}
+    if kind == "Grid":
+        owns["size"] = "the world (Grid7, Grid10) fixes the grid's size"
+        owns["layout_seed"] = "a run's layout seed is its own setting (--layout-seed)"
+    return owns
 
 
 def _entry_key(world: str) -> str:

@@ -1,7 +1,7 @@
 """A policy's episodes in an env: the one rollout loop, and its recording as an MP4.
 
 ``rollout`` is the loop every caller shares (training's evaluation, the reference scores,
-the scripted policy's episodes, the demo and the videos); what a caller measures beyond
+the scripted policy's episodes, the ``scripted`` command and the videos); what a caller measures beyond
 an episode's record, or draws, it sees through the loop's callbacks.
 """
 

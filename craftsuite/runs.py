@@ -151,7 +151,8 @@ EVAL_SEED = 10**7  # far from training's seeds (the run's seed and its envs' nex
 
 def eval_seed(step: int) -> int:
     """The first episode seed of a run's evaluation at ``step`` (its episodes play the next
-    ones): every evaluation, of every kind of run and engine, on fresh seeds of its own."""
+    ones), the same rule for every kind of run and engine; evaluations fewer than
+    ``eval_episodes`` steps apart share some of their seeds."""
     return EVAL_SEED + step
 
 
@@ -241,10 +242,6 @@ class RunDir:
         os.close(self._fd)  # releases the lock; the file stays (unlinking it would race a new owner)
 
     # -- files -----------------------------------------------------------------------------------
-    @property
-    def checkpoint(self) -> Path:
-        return self.path / "checkpoint" / "model.zip"
-
     # -- checkpoints: the newest being written, the last, the one before -----------------------
     CHECKPOINTS = ("checkpoint-new", "checkpoint", "checkpoint-old")  # newest first
 

@@ -171,7 +171,7 @@ def _resume(run: RunDir, fresh):
     """The agent of the run's newest checkpoint that loads whole (model and replay buffer,
     both from one checkpoint), or None when the run has none. A checkpoint that cannot be
     loaded (a truncated file, say) is skipped with a warning for the one before it, and kept
-    aside as ``checkpoint-unloadable``, so that the next swap keeps the one resumed from;
+    aside as ``checkpoint-unloadable``, so that the next commit keeps the one resumed from;
     when none loads, the error names each file, why, and what to do. Nothing is deleted."""
     import warnings
 
@@ -258,12 +258,13 @@ def _stopped(run: RunDir, stop_at) -> bool:
 
 
 def _train(config, name: str, root, fresh, *, product: bool, total: int, stop_at: float | None, model: str,
-           keep_checkpoint: bool, result, progress: bool, desc: str) -> Path:
+           keep_checkpoint: bool, result, progress: bool, desc: str, write_more=None) -> Path:
     """The routine of every run: train ``fresh()`` (or resume the run's checkpoint) up to
     ``total`` steps or ``stop_at`` success, evaluating greedy episodes every
     ``config.eval_every`` steps in the run's world (``product``: with the automaton state);
-    then save the agent as ``model``, write ``result(run, agent, seconds)`` as the run's
-    result and remove the checkpoints (but the last with ``keep_checkpoint``)."""
+    then save the agent as ``model`` and what ``write_more(run, agent)`` writes beside it
+    (timed with the run), write ``result(run, agent, seconds)`` as the run's result and
+    remove the checkpoints (but the last with ``keep_checkpoint``)."""
     with RunDir(Path(root) / name, config) as run:
         if run.finished():
             return run.path
@@ -277,6 +278,8 @@ def _train(config, name: str, root, fresh, *, product: bool, total: int, stop_at
                        progress=progress, desc=desc)
         with atomic_path(run.path / model) as tmp:
             agent.save(tmp)
+        if write_more is not None:
+            write_more(run, agent)
         run.write_result(result(run, agent, time.perf_counter() - start))
         run.remove_checkpoints(keep_last=keep_checkpoint)  # after the result: a kill before it resumes
         return run.path
@@ -290,8 +293,10 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
         return make_agent("product-dqn", config.env_id, seed=config.seed, n_envs=config.n_envs,
                           env_kwargs=config.env_kwargs, **config.effective()["hyperparameters"])
 
-    def result(run, agent, seconds):
+    def write_table(run, agent):
         distill_from_replay(agent).save(run.path / "table.npz")
+
+    def result(run, agent, seconds):
         evals = read_csv(run.path / "evals.csv")
         success = float(evals[-1]["success"]) if evals else 0.0
         return {"kind": "teacher", "env_id": config.env_id, "algorithm": agent.algorithm,
@@ -303,7 +308,7 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
     # stays: `craftsuite distill` reads the replay there
     return _train(config, config.run_name(), root, fresh, product=True, total=config.max_steps,
                   stop_at=config.target_success, model="teacher.zip", keep_checkpoint=True, result=result,
-                  progress=progress, desc=f"teacher {config.task}")
+                  progress=progress, desc=f"teacher {config.task}", write_more=write_table)
 
 
 def student_result(config: StudentConfig, algorithm: str, steps: int, updates: int, seconds: float,

@@ -193,3 +193,27 @@ def test_video_takes_a_task_or_a_spec_file_in_a_world(spec_file, tmp_path, capsy
     assert main(["video", "CraftSuite/Reach-Grid7-v0", "--world", "Grid7", "--out", str(tmp_path / "w.mp4")]) == 2
     assert "--world picks the world of a task" in capsys.readouterr().err
     assert not (tmp_path / "w.mp4").exists()
+
+
+def test_an_id_given_as_a_task_is_named_as_an_id(tmp_path, capsys):
+    out = tmp_path / "runs"
+    assert main(["student", "CraftSuite/BlindCraftsman-Cont-v0", "--out", str(out)]) == 2
+    assert "CraftSuite/BlindCraftsman-Cont-v0 is an id; give its task (BlindCraftsman) and the world with --world" \
+        in capsys.readouterr().err
+    assert main(["video", "CraftSuite/BlindCraftsman-Cont-v1", "--out", str(tmp_path / "v.mp4")]) == 2
+    assert "is not a CraftSuite id (CraftSuite/<Task>-<World>-v0" in capsys.readouterr().err
+    assert not out.exists() and not (tmp_path / "v.mp4").exists()
+
+
+def test_env_keywords_the_run_sets_itself_are_refused_by_name(tmp_path, capsys):
+    out = tmp_path / "runs"
+    grid = ["student", "Reach", "--world", "Grid7", "--method", "dqn", "--out", str(out)]
+    assert main([*grid, "--env", '{"size": 10}']) == 2
+    assert "--env: size: the world (Grid7, Grid10) fixes the grid's size; leave it out of --env" \
+        in capsys.readouterr().err
+    assert main([*grid, "--env", '{"sze": 10}']) == 2
+    err = capsys.readouterr().err
+    assert "unknown keyword 'sze' for the grid world; it accepts render_mode" in err and "size" not in err.split(";")[1]
+    assert main(["student", "Reach", "--env", '{"product": true}', "--out", str(out)]) == 2
+    assert "--env: product: whether the automaton state is observed" in capsys.readouterr().err
+    assert not out.exists()

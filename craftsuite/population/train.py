@@ -231,7 +231,7 @@ def _saved_steps(run: RunDir) -> dict[int, Path]:
 
 def _resume(pop: Population, runs) -> None:
     """Load the newest step every member has a checkpoint of (a kill between two members'
-    swaps leaves the one before), and trim each member's logs to it. With no checkpoint at
+    commits leaves the one before), and trim each member's logs to it. With no checkpoint at
     all, the population starts at step 0. A checkpoint that cannot be loaded is an error that
     names it (nothing is deleted); so is a population whose members share no step."""
     from ..training import _RESOURCES, CheckpointError
@@ -261,7 +261,9 @@ def _resume(pop: Population, runs) -> None:
     pop.load_states(states)
     print(f"{', '.join(str(r.path) for r in runs)}: resuming from their checkpoints at step {step} "
           "(episodes logged after it are dropped and played again)")
-    for run in runs:
+    for run, steps in zip(runs, found):
+        if steps[step].parent.name == run.CHECKPOINTS[0]:  # a kill came between its writing and its commit
+            run.commit_checkpoint()  # as a single run does: the next checkpoint keeps this one
         run.trim_logs(step)
 
 

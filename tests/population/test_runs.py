@@ -106,6 +106,27 @@ def test_a_killed_population_resumes_from_its_checkpoint(tmp_path, monkeypatch):
         assert len(json.loads((path / "config.json").read_text())["provenance"]) == 2
 
 
+def test_a_checkpoint_written_but_not_committed_is_committed_when_resumed(tmp_path, monkeypatch):
+    """A kill between a member's checkpoint-new and its commit: the population resumes from
+    it and commits it, so that the next checkpoint keeps the one resumed from."""
+    from craftsuite.runs import RunDir
+
+    configs = _cell(seeds=(0, 1))
+    _killed_at_the_second_evaluation(configs, tmp_path, monkeypatch)
+    member = tmp_path / configs[0].run_name()
+    (member / "checkpoint").rename(member / "checkpoint-new")
+    folders = {}
+
+    def stop(self, step):  # after the resume's commits, before training on
+        folders[self.path.name] = sorted(p.name for p in self.path.glob("checkpoint*"))
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(RunDir, "trim_logs", stop)
+    with pytest.raises(KeyboardInterrupt):
+        train_population(configs, tmp_path, progress=False)
+    assert folders[member.name] == ["checkpoint"]
+
+
 def test_a_population_that_cannot_resume_says_so_and_deletes_nothing(tmp_path, monkeypatch):
     from craftsuite.training import CheckpointError
 

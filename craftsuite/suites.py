@@ -170,7 +170,7 @@ TRANSFER_METHODS = ("dqn", "dynamic", "crm-edges", "td3", "td3-dynamic", "td3-cr
 # on 2 cores for the standard suite (no TD3 student learns them in so few).
 SUITES = {s.name: s for s in (
     Suite("quick", "the calibration rung and the two-stage rung in MuJoCo: TD3 from scratch and distilled "
-          "(about 10 minutes on 2 cores)",
+          "(about 12 minutes on 2 cores)",
           tags=("calibration", "medium"), worlds=("Cont",), methods=("td3", "td3-dynamic-edges"), seeds=2,
           budgets={"Cont": {"easy": 200_000, "medium": 800_000}}, **TD3_REGIME),
     Suite("standard", "every rung x the paper's methods and baselines, 5 seeds (about 3 hours on 2 cores with "

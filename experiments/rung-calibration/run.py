@@ -45,6 +45,7 @@ def main(argv=None) -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results")
     parser.add_argument("--check", action="store_true", help="only the scripted and random completion")
+    parser.add_argument("--rungs", nargs="+", help="only these spec files' stems (default: every spec)")
     args = parser.parse_args(argv)
     if args.check:
         return check()
@@ -52,7 +53,7 @@ def main(argv=None) -> None:
 
     standard = SUITES["standard"]
     configs = []
-    for path in SPECS:
+    for path in [p for p in SPECS if not args.rungs or p.stem in args.rungs]:
         task = craftsuite.register_task(path)[0].split("/")[1].split("-")[0]
         for seed in range(args.seeds):
             configs.append(StudentConfig(task=task, method="td3", world="Cont", seed=seed, steps=args.steps,

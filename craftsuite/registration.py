@@ -25,6 +25,12 @@ _WORLD_NAMES = {"Grid": "grid", CONT: "MuJoCo", KINEMATIC_WORLD: "kinematic"}
 # keywords another world takes that a world refuses for a reason of its own, stated in the error
 _WHY_NOT = {"Grid": {side: "the grid world draws every cell {tile} pixels a side (Grid7: {frame}x{frame} "
                            "frames); it has no frame size to set" for side in ("width", "height")}}
+# keywords of a world's entry point that a run sets itself, refused in a run's flags (--env)
+# with who sets them; the others' listings leave them out
+_PRODUCT = "whether the automaton state is observed is the run's to say (its method; video's --product)"
+_RUN_OWNS = {"Grid": {"product": _PRODUCT, "size": "the world (Grid7, Grid10) fixes the grid's size",
+                      "layout_seed": "a run's layout seed is its own setting (--layout-seed)"},
+             CONT: {"product": _PRODUCT}, KINEMATIC_WORLD: {"product": _PRODUCT}}
 
 
 def world_keywords(world: str) -> tuple[str, ...]:
@@ -42,10 +48,11 @@ def check_world_kwargs(world: str, kwargs, source: str | None = None) -> None:
     prefix = f"{source}: " if source else ""
     accepted = world_keywords(world)
     if source is not None:  # a run's flag: what the id or the run's own settings fix is not the flag's
-        owned = sorted(set(kwargs) & set(_run_owns(kind)))
+        owns = _RUN_OWNS.get(kind, {})
+        owned = sorted(set(kwargs) & set(owns))
         if owned:
-            raise ValueError(f"{prefix}{owned[0]}: {_run_owns(kind)[owned[0]]}; leave it out of {source}")
-        accepted = tuple(k for k in accepted if k not in _run_owns(kind))
+            raise ValueError(f"{prefix}{owned[0]}: {owns[owned[0]]}; leave it out of {source}")
+        accepted = tuple(k for k in accepted if k not in owns)
     unknown = sorted(set(kwargs) - set(accepted) - {"task"})
     if not unknown:
         return
@@ -56,15 +63,6 @@ def check_world_kwargs(world: str, kwargs, source: str | None = None) -> None:
         raise ValueError(f"{prefix}{', '.join(unknown)}: " + why[0].format(tile=TILE, frame=7 * TILE))
     raise ValueError(f"{prefix}unknown keyword{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))} "
                      f"for the {_WORLD_NAMES[kind]} world; it accepts {', '.join(accepted)}")
-
-
-def _run_owns(kind: str) -> dict[str, str]:
-    """The keywords of ``kind``'s entry point that a run sets itself, each with who sets it."""
-    owns = {"product": "whether the automaton state is observed is the run's to say (its method; video's --product)"}
-    if kind == "Grid":
-        owns["size"] = "the world (Grid7, Grid10) fixes the grid's size"
-        owns["layout_seed"] = "a run's layout seed is its own setting (--layout-seed)"
-    return owns
 
 
 def _entry_key(world: str) -> str:

@@ -17,6 +17,7 @@ import numpy as np
 
 import craftsuite
 from craftsuite.configs import StudentConfig
+from craftsuite.ids import cont_id, parse_id
 from craftsuite.rollouts import rollout
 from craftsuite.scripted import scripted_policy
 from craftsuite.suites import SUITES
@@ -27,7 +28,7 @@ SPECS = sorted((Path(__file__).parent / "specs").glob("*.toml"))
 def check(episodes: int = 50) -> None:
     """Each rung's completion by its scripted policy and by uniformly random actions."""
     for path in SPECS:
-        env_id = next(i for i in craftsuite.register_task(path) if i.endswith("-Cont-v0"))
+        env_id = cont_id(parse_id(craftsuite.register_task(path)[0])[0])
         env = gym.make(env_id)
         policy = scripted_policy(env.unwrapped)
         scripted = rollout(env, lambda obs: policy(), episodes, seed=0)
@@ -54,7 +55,7 @@ def main(argv=None) -> None:
     standard = SUITES["standard"]
     configs = []
     for path in [p for p in SPECS if not args.rungs or p.stem in args.rungs]:
-        task = craftsuite.register_task(path)[0].split("/")[1].split("-")[0]
+        task = parse_id(craftsuite.register_task(path)[0])[0]
         for seed in range(args.seeds):
             configs.append(StudentConfig(task=task, method="td3", world="Cont", seed=seed, steps=args.steps,
                                          eval_every=args.steps // 20, eval_episodes=standard.eval_episodes,

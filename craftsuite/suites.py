@@ -29,8 +29,10 @@ class Suite:
     seeds: int = 5
     # each run's budget in transitions, by world kind and rung level (TaskSpec.level), e.g.
     # {"Cont": {"easy": 150_000, "hard": 100_000}, "Grid": {...}}: the two worlds' students
-    # collect at different rates and learn at different rates per transition. student_steps,
-    # when set, is one budget for every run.
+    # collect at different rates and learn at different rates per transition. A rung's own
+    # name overrides its level ({"Cont": {"medium": 800_000, "TwoToolsHome": 1_200_000}}): the
+    # middle rungs are each calibrated to a budget. student_steps, when set, is one budget for
+    # every run.
     budgets: dict = field(default_factory=dict)
     student_steps: int | None = None
     teacher_max_steps: int = 300_000
@@ -76,6 +78,8 @@ class Suite:
         if self.student_steps is not None:
             return self.student_steps
         kind = world_kind(world)
+        if spec.name in self.budgets.get(kind, {}):
+            return self.budgets[kind][spec.name]
         if spec.level not in self.budgets.get(kind, {}):
             raise ValueError(f"suite {self.name!r} has no {kind} budget for {spec.name}'s level {spec.level!r} "
                              f"(tags {list(spec.tags)}); budgets: {self.budgets}. Give every run the same "
@@ -163,22 +167,30 @@ PAPER_PROTOCOL = dict(teacher_layout_seed=None, teacher_n_envs=10, teacher_hyper
 PAPER_METHODS = tuple(name for name, m in METHODS.items() if not (m.crm and m.distill))
 TRANSFER_METHODS = ("dqn", "dynamic", "crm-edges", "td3", "td3-dynamic", "td3-crm-edges")
 
-# Budgets, in transitions: TD3 students on the easy and medium rungs get enough to pass the
+# Budgets, in transitions. TD3 students on the easy and medium rungs get enough to pass the
 # collapse that follows their first success (greedy success falls for 30-80k transitions
 # before it settles: experiments/collection-regime, "Stability"), so that the last
-# evaluation reads what was learned; the hard rungs get what is left of about 3 hours
-# on 2 cores for the standard suite (no TD3 student learns them in so few).
+# evaluation reads what was learned. The middle rungs (tagged ``middle``) each get the
+# budget at which TD3 from scratch lands between 20% and 80% greedy success in MuJoCo
+# (experiments/rung-calibration): where methods can differ. The paper's tasks get 1M
+# transitions per run, in their own suite: on 2 cores it takes a working day.
 SUITES = {s.name: s for s in (
     Suite("quick", "the calibration rung and the two-stage rung in MuJoCo: TD3 from scratch and distilled "
           "(about 12 minutes on 2 cores)",
-          tags=("calibration", "medium"), worlds=("Cont",), methods=("td3", "td3-dynamic-edges"), seeds=2,
+          tasks=("Reach", "FirstTool"), worlds=("Cont",), methods=("td3", "td3-dynamic-edges"), seeds=2,
           budgets={"Cont": {"easy": 200_000, "medium": 800_000}}, **TD3_REGIME),
-    Suite("standard", "every rung x the paper's methods and baselines, 5 seeds (about 3 hours on 2 cores with "
-          "SB3 agents; its students' rates with populations project 1.2 h)",
-          tags=("easy", "medium", "hard"), worlds=("Grid10", "Cont"), methods=PAPER_METHODS, seeds=5,
-          budgets={"Cont": {"easy": 250_000, "medium": 800_000, "hard": 60_000},
-                   "Grid": {"easy": 30_000, "medium": 60_000, "hard": 60_000}},
+    Suite("standard", "the easy, medium and middle rungs x the paper's methods and baselines, Grid10 and MuJoCo, "
+          "5 seeds (about 4 hours on 2 cores with the population engine; the paper's tasks are the hard suite)",
+          tags=("easy", "medium"), worlds=("Grid10", "Cont"), methods=PAPER_METHODS, seeds=5,
+          budgets={"Cont": {"easy": 250_000, "medium": 800_000, "TwoToolsHome": 1_200_000,
+                            "KeySwordDragon": 400_000},
+                   "Grid": {"easy": 30_000, "medium": 150_000}},
           **TD3_REGIME, **DQN_REGIME),
+    Suite("hard", "the paper's tasks x the paper's methods and baselines at 1M transitions per run, Grid10 and "
+          "MuJoCo, 5 seeds (on 2 cores with the population engine about 5 hours per world: run each with "
+          "--worlds, on any machine; the results archive gathers them)",
+          tags=("hard",), worlds=("Grid10", "Cont"), methods=PAPER_METHODS, seeds=5,
+          budgets={"Cont": {"hard": 1_000_000}, "Grid": {"hard": 1_000_000}}, **TD3_REGIME, **DQN_REGIME),
     Suite("paper", "the paper's protocol as the authors' code ran it: the paper's methods and baselines on its tasks "
           "in the grid, MuJoCo and kinematic worlds, 20 seeds, 2M steps of 10 envs (20M transitions) per run",
           tags=("paper",), worlds=("Grid10", "Cont", "Kinematic"), methods=PAPER_METHODS, seeds=20,

@@ -147,11 +147,14 @@ def test_suites_are_well_formed(tmp_path):
     assert both.teachers() == {}  # no method needs a teacher
     grid_distiller = dataclasses.replace(SUITES["quick"], methods=("td3", "dynamic"))
     assert grid_distiller.teachers() == {}  # `dynamic` needs one, but runs on the grids, not in this suite's world
-    # standard: every rung x the paper's methods and baselines (each in its world) x 5 seeds, budgets by level
+    # standard and hard: every rung x the paper's methods and baselines (each in its world) x 5 seeds,
+    # budgets by level or by the rung's own name
     from craftsuite.suites import PAPER_METHODS
 
     standard = SUITES["standard"].student_configs(tmp_path)
-    assert {(c.task, c.method) for c in standard} == set(product([s.name for s in ladder()], PAPER_METHODS))
+    hard = SUITES["hard"].student_configs(tmp_path)
+    assert {(c.task, c.method) for c in standard + hard} == set(product([s.name for s in ladder()], PAPER_METHODS))
+    assert {c.task for c in hard} == {s.name for s in ladder("paper")} and {c.steps for c in hard} == {1_000_000}
     assert set(METHODS) - set(PAPER_METHODS) == {"crm-edges", "td3-crm-edges"}  # the transfer suite's
     transfer = SUITES["transfer"].student_configs(tmp_path)
     assert {c.method for c in transfer} == {"dqn", "dynamic", "crm-edges", "td3", "td3-dynamic", "td3-crm-edges"}
@@ -160,7 +163,11 @@ def test_suites_are_well_formed(tmp_path):
     assert {c.table is not None for c in transfer if c.method.endswith("crm-edges")} == {True}
     assert {c.seed for c in standard} == set(range(5))
     budgets, specs = SUITES["standard"].budgets, {s.name: s for s in ladder()}
-    assert all(c.steps == budgets["Cont" if c.world == "Cont" else "Grid"][specs[c.task].level] for c in standard)
+    for c in standard:
+        table = budgets["Cont" if c.world == "Cont" else "Grid"]
+        assert c.steps == table.get(c.task, table[specs[c.task].level])
+    assert {c.steps for c in standard if c.task == "TwoToolsHome" and c.world == "Cont"} == {1_200_000}
+    assert {c.steps for c in standard if c.task == "ToolHome" and c.world == "Cont"} == {budgets["Cont"]["medium"]}
     assert {c.steps for c in standard if c.world == "Cont"} != {c.steps for c in standard if c.world == "Grid10"}
     paper = SUITES["paper"].student_configs(tmp_path)
     assert {c.task for c in paper} == {s.name for s in ladder("paper")}
@@ -180,7 +187,7 @@ def test_suite_selection_errors_name_the_problem(tmp_path):
     with pytest.raises(KeyError, match=r"no task spec has tag \['hardest'\]"):
         dataclasses.replace(quick, tags=("hardest",)).student_configs(tmp_path)
     with pytest.raises(ValueError, match="selects no rung"):
-        dataclasses.replace(quick, tags=()).student_configs(tmp_path)
+        dataclasses.replace(quick, tags=(), tasks=()).student_configs(tmp_path)
     with pytest.raises(ValueError, match="has no Grid budget for Reach's level 'easy'.*--steps N"):
         dataclasses.replace(quick, worlds=("Grid10",), methods=("dqn",)).student_configs(tmp_path)
     with pytest.raises(KeyError, match="unknown method"):

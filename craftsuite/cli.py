@@ -338,13 +338,40 @@ def _transfer(args) -> int:
     suite = dataclasses.replace(suite, **changes)
     print(f"suite {suite.name}: {suite.description}")
     out = args.out or f"runs/{args.suite}"
+    if args.archive and args.no_archive:
+        raise ValueError("--archive DIR keeps the runs in that archive, --no-archive keeps none: give one or neither")
+    archive = None if args.no_archive or not (args.archive or suite.archived) else (args.archive or "results")
     result = transfer(suite, out, workers=args.workers, ray=args.ray, video=not args.no_video, command=command_line(),
-                      device=args.device)
+                      device=args.device, archive=archive)
     print(f"leaderboard: {result.leaderboard} (and .csv)")
     for plot in result.plots:
         print(f"learning curves: {plot}")
     if result.video:
         print(f"video of the best student: {result.video}")
+    return 0
+
+
+def _archive(args) -> int:
+    from .archive import add, size, suite_runs
+    from .provenance import command_line, record_session, start_session
+    from .suites import SUITES
+
+    if args.suite not in SUITES:
+        raise KeyError(f"unknown suite {args.suite!r}; suites: {sorted(SUITES)}")
+    session = start_session(command_line())
+    archive = Path(args.archive) / args.suite
+    names = suite_runs(SUITES[args.suite])
+    kept, total = {"teachers": 0, "students": 0}, 0
+    for source in args.runs:
+        more, skipped = add(source, archive, names)
+        for reason in skipped:
+            print(f"skipped {reason}")
+        kept = {k: kept[k] + more[k] for k in kept}
+        total += sum(more.values())
+    if total:
+        record_session(archive, {**session, "archived": kept}, 0.0)
+    print(f"kept {kept['students']} student runs and {kept['teachers']} teachers in {archive} "
+          f"({size(archive) / 1e6:.1f} MB in all)")
     return 0
 
 
@@ -541,10 +568,21 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=_positive, help="parallel local processes (default: one per core)")
     p.add_argument("--ray", metavar="ADDRESS", help="run the students on Ray ('local' starts one here)")
     p.add_argument("--no-video", action="store_true", help="skip the rollout video of the best student")
+    p.add_argument("--archive", metavar="DIR", help="the results archive: runs found in DIR/<suite> are not trained "
+                   "again, and every finished run's records are kept there (default: results, for the suites that "
+                   "keep their runs: all but quick)")
+    p.add_argument("--no-archive", action="store_true", help="neither read nor write a results archive")
     p.add_argument("--engine", choices=ENGINES, help="what trains the students: population (each cell's seeds in "
                    "one process) or sb3 (one SB3 agent per run); default: the suite's")
     p.add_argument("--device", default="cpu", help="the population engine's torch device: cpu (default) or cuda")
     p.set_defaults(run=_transfer)
+
+    p = sub.add_parser("archive", help="keep finished runs' records in the results archive (results/<suite>)")
+    p.add_argument("runs", nargs="+", help="transfer output directories, or directories of student runs")
+    p.add_argument("--suite", required=True, help="the suite they are runs of (a run of no such config is skipped, "
+                   "and named)")
+    p.add_argument("--archive", default="results", help="the archive (default: results)")
+    p.set_defaults(run=_archive)
 
     p = sub.add_parser("leaderboard", help="leaderboard (Markdown, CSV) and learning curves from run directories")
     p.add_argument("runs", nargs="+", help="a transfer output directory, or a directory of student runs "

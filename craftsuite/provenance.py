@@ -23,18 +23,23 @@ from .files import atomic_write
 FILE = "provenance.json"
 
 
+COMMIT_VARIABLE = "CRAFTSUITE_COMMIT"
+
+
 def git_commit() -> str | None:
-    """The checkout's commit (``-dirty`` with uncommitted changes), None outside a checkout."""
+    """The checkout's commit (``-dirty`` with uncommitted changes); outside a checkout (a
+    copy of the tree on another machine, without ``.git``), what ``CRAFTSUITE_COMMIT``
+    says, else None."""
     here = Path(__file__).resolve().parent
     try:
         commit = subprocess.run(["git", "rev-parse", "--short=10", "HEAD"], cwd=here, capture_output=True,
                                 text=True, timeout=10)
         if commit.returncode != 0:
-            return None
+            return os.environ.get(COMMIT_VARIABLE) or None
         dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=here,
                                capture_output=True, text=True, timeout=10).stdout.strip()
-    except (OSError, subprocess.SubprocessError):
-        return None
+    except (OSError, subprocess.SubprocessError):  # no git on this machine
+        return os.environ.get(COMMIT_VARIABLE) or None
     return commit.stdout.strip() + ("-dirty" if dirty else "")
 
 

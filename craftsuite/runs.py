@@ -314,7 +314,15 @@ class RunDir:
 
 
 def read_csv(path) -> list[dict]:
+    """A run's CSV log as rows (none if it is missing); ``<name>.gz`` beside a missing
+    ``<name>`` is read instead (the results archive keeps ``episodes.csv`` compressed)."""
+    import gzip
+
     path = Path(path)
+    packed = path.with_name(path.name + ".gz")
+    if not path.exists() and packed.exists():
+        with gzip.open(packed, "rt", newline="") as f:
+            return [row for row in csv.DictReader(f) if None not in row.values()]
     if not path.exists():
         return []
     with open(path, newline="") as f:

@@ -169,12 +169,18 @@ class TransferResult:
 
 
 def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None = None, video: bool = True,
-             progress: bool = True, log=print, command: list[str] | None = None, device: str = "cpu") -> TransferResult:
+             progress: bool = True, log=print, command: list[str] | None = None, device: str = "cpu",
+             archive=None) -> TransferResult:
     """The suite end to end: teachers and distillation, students, leaderboard, plots, video.
 
     ``device``: the torch device of the population engine's students (``cpu``, ``cuda``).
     ``command``: how this run was asked for, as ``provenance.json`` records it (the CLI
-    passes its command line); by default, this Python call."""
+    passes its command line); by default, this Python call. ``archive``: a results archive
+    (``craftsuite.archive``; e.g. ``results``): the runs it holds under ``<archive>/<suite>``
+    are not trained again, and every run that finishes here is kept there, even if a later
+    one fails."""
+    from .archive import keep_all, restore
+    from .archive import size as archive_size
     from .provenance import read, record_session, start_session
     from .reporting.board import build
     from .reporting.pages import write_leaderboard
@@ -191,8 +197,19 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     atomic_write(out / "suite.json", json.dumps(dataclasses.asdict(suite), indent=2) + "\n")
     record_session(out, session, None)  # if this session is killed, its command and commit stay on record
     teachers = suite.teachers()
-    students = run_students(configs, out / "students", workers=workers, ray=ray, progress=progress,
-                            teachers=teachers, teacher_root=out / "teachers", log=log, device=device)
+    names = {"teachers": {t.run_name() for t in teachers.values()}, "students": {c.run_name() for c in configs}}
+    kept = None if archive is None else Path(archive) / suite.name
+    if kept is not None:
+        restored = restore(kept, out, names, log=log)
+        log(f"results archive {kept}: {restored['students']} of {len(configs)} student runs and "
+            f"{restored['teachers']} of {len(teachers)} teachers are there already (not trained again)")
+    try:
+        students = run_students(configs, out / "students", workers=workers, ray=ray, progress=progress,
+                                teachers=teachers, teacher_root=out / "teachers", log=log, device=device)
+    finally:  # what finished is kept, whatever stopped the rest
+        if kept is not None:
+            record_session(out, session, None)
+            keep_all(out, kept, names, suite=dataclasses.asdict(suite))
     board = build(out / "students")
     board_md = write_leaderboard(board, out)
     plots = plot_curves(board, out)
@@ -202,6 +219,9 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     if video:
         movie = _best_student_video(students, out)
     record_session(out, session, time.perf_counter() - clock)
+    if kept is not None:
+        keep_all(out, kept, names)  # this session's duration
+        log(f"results archive {kept}: {archive_size(kept) / 1e6:.1f} MB")
     return TransferResult(out, {task: out / "teachers" / t.run_name() for task, t in teachers.items()},
                           students, board_md, plots, movie)
 
@@ -252,6 +272,10 @@ def _best_student_video(students: list[Path], out: Path) -> Path | None:
     if not runs:
         return None
     _, run, r = max(runs, key=lambda x: x[0])
+    if not (run / r["model"]).exists():
+        print(f"no video: the best student, {run.name}, has its records but not its model "
+              "(restored from the results archive)")
+        return None
     name = f"best-{file_stem(r['env_id'])}-{r['method']}-s{r['seed']}.mp4"
     rec = record_video(r["env_id"], str(run / r["model"]), 1, str(out / name), seed=10**8,
                        product=r["product"], progress=False,

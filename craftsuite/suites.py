@@ -64,6 +64,9 @@ class Suite:
     # what trains the students: "population" (the seeds of each cell in one process,
     # craftsuite.population) or "sb3" (one SB3 agent per run); teachers are SB3 agents
     engine: str = "population"
+    # whether ``craftsuite transfer`` keeps its runs' records in the results archive by
+    # default (``craftsuite.archive``); the quick suite trains afresh every time, for its video
+    archived: bool = True
 
     def rungs(self) -> list[TaskSpec]:
         """The suite's tasks, easiest first."""
@@ -178,7 +181,7 @@ SUITES = {s.name: s for s in (
     Suite("quick", "the calibration rung and the two-stage rung in MuJoCo: TD3 from scratch and distilled "
           "(about 12 minutes on 2 cores)",
           tasks=("Reach", "FirstTool"), worlds=("Cont",), methods=("td3", "td3-dynamic-edges"), seeds=2,
-          budgets={"Cont": {"easy": 200_000, "medium": 800_000}}, **TD3_REGIME),
+          budgets={"Cont": {"easy": 200_000, "medium": 800_000}}, archived=False, **TD3_REGIME),
     Suite("standard", "the easy, medium and middle rungs x the paper's methods and baselines, Grid10 and MuJoCo, "
           "5 seeds (about 4 hours on 2 cores with the population engine; the paper's tasks are the hard suite)",
           tags=("easy", "medium"), worlds=("Grid10", "Cont"), methods=PAPER_METHODS, seeds=5,

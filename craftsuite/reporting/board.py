@@ -73,7 +73,7 @@ def _log(path: Path, row) -> list[tuple]:
     """
     try:
         return [row(r) for r in read_csv(path)]
-    except (KeyError, ValueError) as err:
+    except (KeyError, ValueError, OSError, EOFError) as err:  # OSError, EOFError: a damaged .gz
         raise RunError(f"{path} does not read as a run's log ({type(err).__name__}: {err}): "
                        "the run's record is damaged") from None
 

@@ -123,3 +123,17 @@ def test_where_the_teachers_table_lies_is_recorded_but_not_hashed(tmp_path):
         pass
     record = read_config(tmp_path / "r")
     assert record["table"] == moved.table and record["effective"]["teacher"] == "teacher-X-k1/table.npz"
+
+
+def test_a_copied_tree_names_its_commit_from_the_environment(tmp_path, monkeypatch):
+    # a copy of the tree without .git (another machine's working copy): git fails there
+    import subprocess
+
+    def no_checkout(*args, **kwargs):
+        return subprocess.CompletedProcess(args, 128, "", "fatal: not a git repository")
+
+    monkeypatch.setattr(provenance.subprocess, "run", no_checkout)
+    monkeypatch.delenv(provenance.COMMIT_VARIABLE, raising=False)
+    assert provenance.git_commit() is None
+    monkeypatch.setenv(provenance.COMMIT_VARIABLE, "5009c5b0aa")
+    assert provenance.git_commit() == "5009c5b0aa"

@@ -1,0 +1,218 @@
+"""The results archive: finished runs' records, kept where they outlive the machine that
+trained them (in this repository, ``results/``), so that a campaign accumulates across
+machines and every results page regenerates from data.
+
+One directory per suite, shaped as a transfer output, so that every reader of runs reads
+it as one::
+
+    results/<suite>/suite.json, provenance.json      the suite as last run; every session
+    results/<suite>/teachers/<run name>/              config.json, result.json, evals.csv,
+                                                      episodes.csv.gz, table.npz
+    results/<suite>/students/<run name>/              config.json, result.json, evals.csv,
+                                                      episodes.csv.gz
+
+Only records: never checkpoints, replay buffers, models or TensorBoard logs (a run
+restored from here says it has no model). ``episodes.csv``, one row per training episode
+and the largest record, is kept compressed (``runs.read_csv`` reads either form).
+
+A record is checked before it is used: its ``config.json`` and ``result.json`` must read
+as a finished run's and the directory's name must be the run key of the settings it
+records. One that does not (damaged, or copied in from elsewhere under another name) is
+named and skipped, never pooled.
+"""
+
+from __future__ import annotations
+
+import gzip
+import hashlib
+import json
+import shutil
+from pathlib import Path
+
+from .files import atomic_path, atomic_write
+from .runs import RunError, read_config, run_settings
+
+RECORDS = ("config.json", "result.json", "evals.csv", "table.npz")  # kept as they are (table.npz: teachers)
+COMPRESSED = ("episodes.csv",)  # kept as <name>.gz
+KINDS = ("teachers", "students")
+
+
+def record_key(record: dict) -> str:
+    """The run key of a ``config.json`` record: what ``runs.config_key`` hashed when the run
+    was made, read back from the settings it recorded (so a record of an older version's
+    defaults keeps its own key)."""
+    return hashlib.sha256(json.dumps(run_settings(record), sort_keys=True).encode()).hexdigest()[:10]
+
+
+def check_record(run: Path, kind: str | None = None) -> str | None:
+    """Why the run at ``run`` cannot be archived or used from the archive (None: it can): a
+    missing or damaged record, an unfinished run, a result of another kind than ``kind``
+    (``teachers``, ``students``; by default the name of the run's parent directory), or a
+    directory name that is not its settings' run key."""
+    try:
+        record = read_config(run)
+    except RunError as err:
+        return str(err)
+    result = run / "result.json"
+    if not result.exists():
+        return f"{run} has no result.json: not a finished run's record"
+    try:
+        kind_of = json.loads(result.read_text()).get("kind")
+    except (ValueError, AttributeError) as err:
+        return f"{result} is not a run's result ({err}): the record is damaged"
+    expected = kind or run.parent.name
+    if f"{kind_of}s" != expected:
+        return f"{result} is a {kind_of}'s result, not one of the {expected}: a record from elsewhere"
+    key = record_key(record)
+    if not run.name.endswith(f"-{key}"):
+        return (f"{run.name} is not the name of the run its config.json records (its key is {key}): "
+                "a record copied in from elsewhere, or edited")
+    return None
+
+
+def archived(archive: Path, kind: str) -> tuple[dict[str, Path], list[str]]:
+    """The usable runs of one kind (``teachers``, ``students``) under ``archive``, by run
+    name, and the reason each unusable one was skipped."""
+    runs, skipped = {}, []
+    root = Path(archive) / kind
+    for run in sorted(root.iterdir()) if root.is_dir() else []:
+        if not run.is_dir():
+            continue
+        reason = check_record(run)
+        if reason is None:
+            runs[run.name] = run
+        else:
+            skipped.append(reason)
+    return runs, skipped
+
+
+def keep(run: Path, archive: Path, kind: str) -> Path:
+    """Copy a finished run's records into ``archive/kind/<run name>`` (replacing what was
+    there); returns that directory.
+
+    Raises:
+        RunError: the run is not finished (it has no result.json).
+    """
+    run = Path(run)
+    if not (run / "result.json").exists():
+        raise RunError(f"{run} is not finished (no result.json): only finished runs are archived")
+    dest = Path(archive) / kind / run.name
+    dest.mkdir(parents=True, exist_ok=True)
+    for name in RECORDS:
+        if (run / name).exists() and name != "result.json":
+            with atomic_path(dest / name) as tmp:
+                shutil.copyfile(run / name, tmp)
+    for name in COMPRESSED:
+        if (run / name).exists():
+            # mtime 0: the same log compresses to the same bytes, so a re-archived run is no change
+            atomic_write(dest / f"{name}.gz", gzip.compress((run / name).read_bytes(), compresslevel=9, mtime=0))
+    with atomic_path(dest / "result.json") as tmp:  # last: its presence marks the record whole
+        shutil.copyfile(run / "result.json", tmp)
+    return dest
+
+
+def restore(archive: Path, out: Path, names: dict[str, set[str]], log=print) -> dict[str, int]:
+    """Copy into ``out/<kind>/`` the archived runs named in ``names`` (kind -> run names)
+    that ``out`` does not hold finished: a run there is finished, so it is reused and not
+    trained again. Unusable archived runs are named through ``log`` and skipped. Returns how
+    many of each kind were restored."""
+    restored = {}
+    for kind in KINDS:
+        runs, skipped = archived(archive, kind)
+        for reason in skipped:
+            log(f"results archive: skipped {reason}")
+        count = 0
+        for name in sorted(names.get(kind, set()) & set(runs)):
+            dest = Path(out) / kind / name
+            if (dest / "result.json").exists():
+                continue
+            if dest.exists():  # an unfinished run of the same settings: the archive's finished one wins
+                shutil.rmtree(dest)
+            shutil.copytree(runs[name], dest)
+            count += 1
+        restored[kind] = count
+    return restored
+
+
+def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict | None = None) -> dict[str, int]:
+    """Archive the finished runs of ``out`` named in ``names`` (kind -> run names), the
+    suite as run (``suite.json``) and every session that ran into ``out`` (merged into the
+    archive's ``provenance.json`` by session id). Returns how many of each kind were kept."""
+    from .provenance import FILE, read
+
+    out, archive = Path(out), Path(archive)
+    kept = {}
+    for kind in KINDS:
+        count = 0
+        for name in sorted(names.get(kind, set())):
+            run = out / kind / name
+            if (run / "result.json").exists() and not _same(run, archive / kind / name):
+                keep(run, archive, kind)
+                count += 1
+        kept[kind] = count
+    if suite is not None:
+        atomic_write(archive / "suite.json", json.dumps(suite, indent=2) + "\n")
+    sessions = read(archive)
+    known = {s.get("id") for s in sessions}
+    for session in read(out):
+        if session.get("id") in known:
+            sessions = [session if s.get("id") == session["id"] else s for s in sessions]
+        else:
+            sessions.append(session)
+    if sessions:
+        atomic_write(archive / FILE, json.dumps(sessions, indent=2) + "\n")
+    return kept
+
+
+def _same(run: Path, archived_run: Path) -> bool:
+    """Whether the archive already holds this run's result (a run restored from it, or kept before)."""
+    theirs = archived_run / "result.json"
+    return theirs.exists() and theirs.read_bytes() == (run / "result.json").read_bytes()
+
+
+def size(archive: Path) -> int:
+    """The archive's size in bytes."""
+    return sum(p.stat().st_size for p in Path(archive).rglob("*") if p.is_file())
+
+
+def suite_runs(suite) -> dict[str, set[str]]:
+    """The run names of a suite's teachers and students (kind -> names): what its archive holds."""
+    return {"teachers": {t.run_name() for t in suite.teachers().values()},
+            "students": {c.run_name() for c in suite.student_configs("teachers")}}  # (a table's place is not in a name)
+
+
+def add(source, archive: Path, names: dict[str, set[str]]) -> tuple[dict[str, int], list[str]]:
+    """Archive the finished runs under ``source`` (a transfer output, with ``students/`` and
+    ``teachers/``, or a directory of student runs) whose names are in ``names`` (kind ->
+    run names: one suite's runs), with the sessions of its ``provenance.json``. Returns how
+    many of each kind were kept and why each other run was skipped.
+
+    Raises:
+        FileNotFoundError: ``source`` is not a directory.
+    """
+    source = Path(source)
+    if not source.is_dir():
+        raise FileNotFoundError(f"no run directory at {source}")
+    roots = {kind: source / kind for kind in KINDS if (source / kind).is_dir()} or {"students": source}
+    skipped, found = [], {kind: set() for kind in KINDS}
+    for kind, root in roots.items():
+        for run in sorted(p for p in root.iterdir() if p.is_dir()):
+            if not (run / "result.json").exists():
+                skipped.append(f"{run}: not finished (no result.json)")
+                continue
+            reason = check_record(run, kind)
+            if reason is None and run.name not in names.get(kind, set()):
+                reason = f"{run.name} is not a run of this suite (another budget, setting or suite)"
+            if reason is None:
+                found[kind].add(run.name)
+            else:
+                skipped.append(reason)
+    kept = {kind: 0 for kind in KINDS}
+    for kind, root in roots.items():
+        for name in sorted(found[kind]):
+            if not _same(root / name, Path(archive) / kind / name):
+                keep(root / name, archive, kind)
+                kept[kind] += 1
+    keep_all(source, archive, {})  # the sessions that made them
+    return kept, skipped
+

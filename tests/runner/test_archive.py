@@ -1,0 +1,128 @@
+"""The results archive: records kept without models, restored so that nothing trains twice,
+and damaged or foreign records named and skipped."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import pytest
+
+from craftsuite import archive
+from craftsuite.cli import main
+from craftsuite.reporting.board import build
+from craftsuite.runs import EPISODE_FIELDS, EVAL_FIELDS, read_csv, settings, write_csv
+from craftsuite.suites import SUITES
+
+
+def _run(root, name="student-Reach-Cont-td3-s0", seed=0, kind="student", steps=1000):
+    """A finished run directory whose name carries its record's key, as a real run's does."""
+    record = {"task": "Reach", "world": "Cont", "method": "td3", "seed": seed, "steps": steps,
+              "format": 2, "provenance": [{"commit": "abc"}]}
+    run = root / f"{name}-{archive.record_key(record)}"
+    run.mkdir(parents=True)
+    (run / "config.json").write_text(json.dumps(record))
+    write_csv(run / "evals.csv", EVAL_FIELDS, [{"step": steps, "success": 0.5, "return": 1.0, "episodes": 4}])
+    write_csv(run / "episodes.csv", EPISODE_FIELDS,
+              [{"step": s, "return": -1.5, "length": 10, "success": s % 2} for s in range(10, steps + 1, 10)])
+    for junk in ("model.zip", "checkpoint/replay.pkl", "tb/events"):  # what the archive never keeps
+        (run / junk).parent.mkdir(exist_ok=True)
+        (run / junk).write_text("big")
+    (run / "result.json").write_text(json.dumps({"kind": kind, "steps": steps, "model": "model.zip"}))
+    return run
+
+
+def test_a_kept_run_has_its_records_only_and_reads_the_same(tmp_path):
+    run = _run(tmp_path / "out" / "students")
+    kept = archive.keep(run, tmp_path / "results" / "quick", "students")
+    assert sorted(p.name for p in kept.iterdir()) == ["config.json", "episodes.csv.gz", "evals.csv", "result.json"]
+    assert read_csv(kept / "episodes.csv") == read_csv(run / "episodes.csv")  # read through the .gz
+    assert (kept / "episodes.csv.gz").stat().st_size < (run / "episodes.csv").stat().st_size / 3
+    # the leaderboard reads the archived run as it read the run itself
+    before, after = build(run.parent).entries[0], build(kept.parent).entries[0]
+    assert before.values == after.values
+    # keeping it again writes the same bytes (a re-archived run is no change in the repository)
+    packed = (kept / "episodes.csv.gz").read_bytes()
+    archive.keep(run, tmp_path / "results" / "quick", "students")
+    assert (kept / "episodes.csv.gz").read_bytes() == packed
+    unfinished = _run(tmp_path / "out" / "students", seed=1)
+    (unfinished / "result.json").unlink()
+    with pytest.raises(RuntimeError, match="not finished"):
+        archive.keep(unfinished, tmp_path / "results" / "quick", "students")
+
+
+def test_damaged_and_foreign_records_are_named_and_skipped(tmp_path):
+    store = tmp_path / "results" / "quick"
+    good = archive.keep(_run(tmp_path / "a" / "students", seed=0), store, "students")
+    damaged = archive.keep(_run(tmp_path / "a" / "students", seed=1), store, "students")
+    (damaged / "result.json").write_text("{not json")
+    renamed = archive.keep(_run(tmp_path / "a" / "students", seed=2), store, "students")
+    renamed = renamed.rename(renamed.with_name("student-Reach-Cont-td3-s2-0123456789"))
+    teacher = archive.keep(_run(tmp_path / "a" / "students", name="teacher-Reach", seed=3, kind="teacher"),
+                           store, "students")
+    runs, skipped = archive.archived(store, "students")
+    assert list(runs) == [good.name]
+    assert len(skipped) == 3
+    assert any(str(damaged / "result.json") in s and "damaged" in s for s in skipped)
+    assert any(renamed.name in s and "not the name of the run its config.json records" in s for s in skipped)
+    assert any(str(teacher / "result.json") in s and "teacher's result" in s for s in skipped)
+    # restoring names each skipped record and copies only the usable ones that are asked for
+    said = []
+    names = {"students": {good.name, renamed.name, damaged.name}}
+    assert archive.restore(store, tmp_path / "out", names, log=said.append) == {"teachers": 0, "students": 1}
+    assert len(said) == 3 and all(s.startswith("results archive: skipped ") for s in said)
+    assert [p.name for p in (tmp_path / "out" / "students").iterdir()] == [good.name]
+
+
+def test_restore_fills_what_is_missing_and_never_overwrites_a_finished_run(tmp_path):
+    store = tmp_path / "results" / "quick"
+    kept = archive.keep(_run(tmp_path / "a" / "students"), store, "students")
+    out = tmp_path / "out"
+    mine = _run(out / "students")  # the same run, finished here (with its model)
+    assert archive.restore(store, out, {"students": {kept.name}}) == {"teachers": 0, "students": 0}
+    assert (mine / "model.zip").exists()
+    (mine / "result.json").unlink()  # unfinished here: the archive's finished record replaces it
+    assert archive.restore(store, out, {"students": {kept.name}}) == {"teachers": 0, "students": 1}
+    assert not (mine / "model.zip").exists() and (mine / "episodes.csv.gz").exists()
+
+
+def test_the_archive_command_keeps_a_suites_runs_and_names_the_rest(tmp_path, capsys):
+    suite = dataclasses.replace(SUITES["standard"], tags=(), tasks=("Reach",), worlds=("Cont",), methods=("td3",),
+                                seeds=1)
+    [config] = suite.student_configs(tmp_path)
+    source = tmp_path / "elsewhere"
+    run = source / config.run_name()
+    run.mkdir(parents=True)
+    record = {**json.loads(json.dumps(settings(config))), "format": 2, "provenance": []}  # as a run writes it
+    (run / "config.json").write_text(json.dumps(record))
+    (run / "result.json").write_text(json.dumps({"kind": "student", "steps": config.steps}))
+    write_csv(run / "evals.csv", EVAL_FIELDS, [{"step": config.steps, "success": 1.0, "return": 1.0, "episodes": 1}])
+    _run(source)  # not a run of the standard suite (its budget and settings differ)
+    assert main(["archive", str(source), "--suite", "standard", "--archive", str(tmp_path / "results")]) == 0
+    out = capsys.readouterr().out
+    assert "is not a run of this suite" in out and "kept 1 student runs and 0 teachers" in out
+    assert (tmp_path / "results" / "standard" / "students" / run.name / "result.json").exists()
+    [session] = json.loads((tmp_path / "results" / "standard" / "provenance.json").read_text())
+    assert session["archived"] == {"teachers": 0, "students": 1} and session["seconds"] == 0.0
+    assert main(["archive", str(tmp_path / "nowhere"), "--suite", "standard"]) == 2
+    assert "no run directory at" in capsys.readouterr().err
+    assert main(["archive", str(source), "--suite", "biggest"]) == 2
+
+
+def test_transfer_flags_choose_the_archive(tmp_path, monkeypatch):
+    import craftsuite.suite_runner
+
+    seen = {}
+
+    def fake_transfer(suite, out, **kwargs):
+        seen[suite.name] = kwargs["archive"]
+        return craftsuite.suite_runner.TransferResult(out, {}, [], out, [], None)
+
+    monkeypatch.setattr(craftsuite.suite_runner, "transfer", fake_transfer)
+    monkeypatch.chdir(tmp_path)
+    args = ["transfer", "--tasks", "Reach", "--worlds", "Grid10", "--methods", "dqn"]
+    assert main(args + ["--suite", "standard"]) == 0 and seen["standard"] == "results"
+    assert main(["transfer", "--suite", "quick"]) == 0 and seen["quick"] is None  # the demo trains afresh
+    assert main(args + ["--suite", "standard", "--archive", "elsewhere"]) == 0 and seen["standard"] == "elsewhere"
+    assert main(args + ["--suite", "standard", "--no-archive"]) == 0 and seen["standard"] is None
+    assert main(args + ["--suite", "standard", "--no-archive", "--archive", "x"]) == 2

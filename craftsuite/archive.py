@@ -175,17 +175,13 @@ def size(archive: Path) -> int:
     return sum(p.stat().st_size for p in Path(archive).rglob("*") if p.is_file())
 
 
-def suite_runs(suite) -> dict[str, set[str]]:
-    """The run names of a suite's teachers and students (kind -> names): what its archive holds."""
-    return {"teachers": {t.run_name() for t in suite.teachers().values()},
-            "students": {c.run_name() for c in suite.student_configs("teachers")}}  # (a table's place is not in a name)
-
-
-def add(source, archive: Path, names: dict[str, set[str]]) -> tuple[dict[str, int], list[str]]:
+def add(source, archive: Path) -> tuple[dict[str, int], list[str]]:
     """Archive the finished runs under ``source`` (a transfer output, with ``students/`` and
-    ``teachers/``, or a directory of student runs) whose names are in ``names`` (kind ->
-    run names: one suite's runs), with the sessions of its ``provenance.json``. Returns how
-    many of each kind were kept and why each other run was skipped.
+    ``teachers/``, or a directory of student runs), with the sessions of its
+    ``provenance.json``: runs made without the archive, or on another machine. Returns how
+    many of each kind were kept and why each other run was skipped. (Runs of other budgets
+    or settings than the suite's own are kept too, as ``--steps`` makes them: the
+    leaderboard never pools them with the suite's.)
 
     Raises:
         FileNotFoundError: ``source`` is not a directory.
@@ -201,8 +197,6 @@ def add(source, archive: Path, names: dict[str, set[str]]) -> tuple[dict[str, in
                 skipped.append(f"{run}: not finished (no result.json)")
                 continue
             reason = check_record(run, kind)
-            if reason is None and run.name not in names.get(kind, set()):
-                reason = f"{run.name} is not a run of this suite (another budget, setting or suite)"
             if reason is None:
                 found[kind].add(run.name)
             else:

@@ -352,7 +352,7 @@ def _transfer(args) -> int:
 
 
 def _archive(args) -> int:
-    from .archive import add, size, suite_runs
+    from .archive import add, size
     from .provenance import command_line, record_session, start_session
     from .suites import SUITES
 
@@ -360,10 +360,9 @@ def _archive(args) -> int:
         raise KeyError(f"unknown suite {args.suite!r}; suites: {sorted(SUITES)}")
     session = start_session(command_line())
     archive = Path(args.archive) / args.suite
-    names = suite_runs(SUITES[args.suite])
     kept, total = {"teachers": 0, "students": 0}, 0
     for source in args.runs:
-        more, skipped = add(source, archive, names)
+        more, skipped = add(source, archive)
         for reason in skipped:
             print(f"skipped {reason}")
         kept = {k: kept[k] + more[k] for k in kept}
@@ -579,8 +578,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("archive", help="keep finished runs' records in the results archive (results/<suite>)")
     p.add_argument("runs", nargs="+", help="transfer output directories, or directories of student runs")
-    p.add_argument("--suite", required=True, help="the suite they are runs of (a run of no such config is skipped, "
-                   "and named)")
+    p.add_argument("--suite", required=True, help="the suite they are runs of: they are kept in its archive")
     p.add_argument("--archive", default="results", help="the archive (default: results)")
     p.set_defaults(run=_archive)
 

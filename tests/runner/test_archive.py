@@ -97,10 +97,12 @@ def test_the_archive_command_keeps_a_suites_runs_and_names_the_rest(tmp_path, ca
     (run / "config.json").write_text(json.dumps(record))
     (run / "result.json").write_text(json.dumps({"kind": "student", "steps": config.steps}))
     write_csv(run / "evals.csv", EVAL_FIELDS, [{"step": config.steps, "success": 1.0, "return": 1.0, "episodes": 1}])
-    _run(source)  # not a run of the standard suite (its budget and settings differ)
+    foreign = _run(source)
+    foreign.rename(foreign.with_name("student-Reach-Cont-td3-s0-0000000000"))  # not the run its record says
     assert main(["archive", str(source), "--suite", "standard", "--archive", str(tmp_path / "results")]) == 0
     out = capsys.readouterr().out
-    assert "is not a run of this suite" in out and "kept 1 student runs and 0 teachers" in out
+    assert "student-Reach-Cont-td3-s0-0000000000 is not the name of the run" in out
+    assert "kept 1 student runs and 0 teachers" in out
     assert (tmp_path / "results" / "standard" / "students" / run.name / "result.json").exists()
     [session] = json.loads((tmp_path / "results" / "standard" / "provenance.json").read_text())
     assert session["archived"] == {"teachers": 0, "students": 1} and session["seconds"] == 0.0

@@ -27,19 +27,21 @@ COMMIT_VARIABLE = "CRAFTSUITE_COMMIT"
 
 
 def git_commit() -> str | None:
-    """The checkout's commit (``-dirty`` with uncommitted changes); outside a checkout (a
-    copy of the tree on another machine, without ``.git``), what ``CRAFTSUITE_COMMIT``
-    says, else None."""
+    """The commit ``CRAFTSUITE_COMMIT`` names, if set: a copy of the tree on another machine
+    says so, since a ``.git`` copied with it may be another commit's. Else the checkout's
+    commit (``-dirty`` with uncommitted changes), or None outside a checkout."""
+    if os.environ.get(COMMIT_VARIABLE):
+        return os.environ[COMMIT_VARIABLE]
     here = Path(__file__).resolve().parent
     try:
         commit = subprocess.run(["git", "rev-parse", "--short=10", "HEAD"], cwd=here, capture_output=True,
                                 text=True, timeout=10)
         if commit.returncode != 0:
-            return os.environ.get(COMMIT_VARIABLE) or None
+            return None
         dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=here,
                                capture_output=True, text=True, timeout=10).stdout.strip()
     except (OSError, subprocess.SubprocessError):  # no git on this machine
-        return os.environ.get(COMMIT_VARIABLE) or None
+        return None
     return commit.stdout.strip() + ("-dirty" if dirty else "")
 
 

@@ -126,14 +126,19 @@ def test_where_the_teachers_table_lies_is_recorded_but_not_hashed(tmp_path):
 
 
 def test_a_copied_tree_names_its_commit_from_the_environment(tmp_path, monkeypatch):
-    # a copy of the tree without .git (another machine's working copy): git fails there
     import subprocess
+
+    monkeypatch.delenv(provenance.COMMIT_VARIABLE, raising=False)
+    checkout = provenance.git_commit()
+    assert checkout  # this checkout's own
+    # a copy of the tree on another machine may carry a .git of another commit: the variable wins
+    monkeypatch.setenv(provenance.COMMIT_VARIABLE, "5009c5b0aa")
+    assert provenance.git_commit() == "5009c5b0aa"
 
     def no_checkout(*args, **kwargs):
         return subprocess.CompletedProcess(args, 128, "", "fatal: not a git repository")
 
     monkeypatch.setattr(provenance.subprocess, "run", no_checkout)
-    monkeypatch.delenv(provenance.COMMIT_VARIABLE, raising=False)
-    assert provenance.git_commit() is None
-    monkeypatch.setenv(provenance.COMMIT_VARIABLE, "5009c5b0aa")
     assert provenance.git_commit() == "5009c5b0aa"
+    monkeypatch.delenv(provenance.COMMIT_VARIABLE)
+    assert provenance.git_commit() is None

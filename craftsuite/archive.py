@@ -175,10 +175,11 @@ def size(archive: Path) -> int:
     return sum(p.stat().st_size for p in Path(archive).rglob("*") if p.is_file())
 
 
-def add(source, archive: Path) -> tuple[dict[str, int], list[str]]:
+def add(source, archive: Path, suite: dict | None = None) -> tuple[dict[str, int], list[str]]:
     """Archive the finished runs under ``source`` (a transfer output, with ``students/`` and
     ``teachers/``, or a directory of student runs), with the sessions of its
-    ``provenance.json``: runs made without the archive, or on another machine. Returns how
+    ``provenance.json`` (and ``suite``, the suite's definition, as ``suite.json``): runs
+    made without the archive, or on another machine. Returns how
     many of each kind were kept and why each other run was skipped. (Runs of other budgets
     or settings than the suite's own are kept too, as ``--steps`` makes them: the
     leaderboard never pools them with the suite's.)
@@ -207,6 +208,6 @@ def add(source, archive: Path) -> tuple[dict[str, int], list[str]]:
             if not _same(root / name, Path(archive) / kind / name):
                 keep(root / name, archive, kind)
                 kept[kind] += 1
-    keep_all(source, archive, {})  # the sessions that made them
+    keep_all(source, archive, {}, suite=suite)  # the sessions that made them, and the suite
     return kept, skipped
 

@@ -352,6 +352,8 @@ def _transfer(args) -> int:
 
 
 def _archive(args) -> int:
+    import dataclasses
+
     from .archive import add, size
     from .provenance import command_line, record_session, start_session
     from .suites import SUITES
@@ -362,7 +364,7 @@ def _archive(args) -> int:
     archive = Path(args.archive) / args.suite
     kept, total = {"teachers": 0, "students": 0}, 0
     for source in args.runs:
-        more, skipped = add(source, archive)
+        more, skipped = add(source, archive, suite=dataclasses.asdict(SUITES[args.suite]))
         for reason in skipped:
             print(f"skipped {reason}")
         kept = {k: kept[k] + more[k] for k in kept}

@@ -66,6 +66,27 @@ def t_interval(values, level: float = LEVEL, bounds: tuple[float, float] = (-mat
     return Estimate(mean, max(bounds[0], mean - half), min(bounds[1], mean + half))
 
 
+def difference(x, y, level: float = LEVEL) -> Estimate:
+    """mean(x) - mean(y) of two independent samples (one value per seed each) with Welch's
+    t-interval (no equal variances assumed). Fewer than ``MIN_SEEDS_FOR_INTERVAL`` values
+    on a side: the difference alone. Both samples constant (every seed at 1.0, say): the
+    interval is the difference itself, all the seeds say."""
+    from scipy import stats
+
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if len(x) == 0 or len(y) == 0 or not (np.isfinite(x).all() and np.isfinite(y).all()):
+        return Estimate(math.nan)
+    d = float(x.mean() - y.mean())
+    if min(len(x), len(y)) < MIN_SEEDS_FOR_INTERVAL:
+        return Estimate(d)
+    vx, vy = x.var(ddof=1) / len(x), y.var(ddof=1) / len(y)
+    if vx + vy == 0:
+        return Estimate(d, d, d)
+    dof = (vx + vy) ** 2 / (vx**2 / (len(x) - 1) + vy**2 / (len(y) - 1))  # Welch-Satterthwaite
+    half = float(stats.t.ppf(0.5 + level / 2, dof) * math.sqrt(vx + vy))
+    return Estimate(d, d - half, d + half)
+
+
 def iqm(values) -> float:
     """The interquartile mean: the mean of the middle 50% of ``values`` (all runs of all
     tasks, flattened), as rliable defines it (``scipy.stats.trim_mean`` cutting 25% from

@@ -27,7 +27,7 @@ from .configs import StudentConfig, TeacherConfig
 from .files import atomic_write
 from .ids import file_stem
 from .methods import METHODS, methods_for
-from .suites import Suite
+from .suites import SUITES, Suite
 from .task_registry import carried, resolve_task
 from .worker_pool import WorkerPool
 
@@ -209,7 +209,8 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     finally:  # what finished is kept, whatever stopped the rest
         if kept is not None:
             record_session(out, session, None)
-            keep_all(out, kept, names, suite=dataclasses.asdict(suite))
+            # the suite as defined, not as this session narrowed it: an archive gathers many sessions' parts
+            keep_all(out, kept, names, suite=dataclasses.asdict(SUITES.get(suite.name, suite)))
     board = build(out / "students")
     board_md = write_leaderboard(board, out)
     plots = plot_curves(board, out)
@@ -217,7 +218,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     log(board_md.read_text())
     movie = None
     if video:
-        movie = _best_student_video(students, out)
+        movie = _best_student_video(students, out, log)
     record_session(out, session, time.perf_counter() - clock)
     if kept is not None:
         keep_all(out, kept, names)  # this session's duration
@@ -253,28 +254,20 @@ def _check_students(configs: list[StudentConfig], device: str = "cpu") -> None:
         agent.get_env().close()
 
 
-def _best_student_video(students: list[Path], out: Path) -> Path | None:
-    """A rollout of the best of this suite's student runs (highest final success, then
-    the hardest rung, then return); runs of another config in the same directory are not
-    candidates."""
+def _best_student_video(students: list[Path], out: Path, log=print) -> Path | None:
+    """A rollout of the best of this suite's student runs (``reporting.board.best_run``);
+    runs of another config in the same directory are not candidates."""
+    from .reporting.board import best_run, build
     from .rollouts import record_video
-    from .runs import read_csv
 
-    runs = []
-    for run in students:
-        result = run / "result.json"
-        if result.exists():
-            r = json.loads(result.read_text())
-            evals = read_csv(run / "evals.csv")
-            last = evals[-1] if evals else {"success": 0, "return": float("-inf")}
-            level = resolve_task(r["task"]).rung[0]
-            runs.append(((float(last["success"]), level, float(last["return"])), run, r))
-    if not runs:
+    best = best_run(build(out / "students"), among=students)
+    if best is None:
         return None
-    _, run, r = max(runs, key=lambda x: x[0])
+    run = best[0]
+    r = json.loads((run / "result.json").read_text())
     if not (run / r["model"]).exists():
-        print(f"no video: the best student, {run.name}, has its records but not its model "
-              "(restored from the results archive)")
+        log(f"no video: the best student, {run.name}, has its records but not its model (restored from the "
+            "results archive, which keeps no models)")
         return None
     name = f"best-{file_stem(r['env_id'])}-{r['method']}-s{r['seed']}.mp4"
     rec = record_video(r["env_id"], str(run / r["model"]), 1, str(out / name), seed=10**8,

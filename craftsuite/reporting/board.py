@@ -247,6 +247,23 @@ def build(students_root) -> Board:
     return board
 
 
+def best_run(board: Board, among=None) -> tuple[Path, Entry, int] | None:
+    """The best student run on the board (``among``: only these run directories): the highest
+    final greedy success, then the hardest rung, then the highest return; with its entry and
+    its index in the entry's seeds. None: no run."""
+    among = None if among is None else {Path(p).resolve() for p in among}
+    best = None
+    for e in board:
+        for i, run in enumerate(e.runs):
+            if among is not None and Path(run).resolve() not in among:
+                continue
+            ret = e.values["return"][i]
+            key = (e.values["success"][i], rung_order(e.task)[0], ret if math.isfinite(ret) else -math.inf)
+            if best is None or key > best[0]:
+                best = (key, Path(run), e, i)
+    return None if best is None else best[1:]
+
+
 def rung_order(task: str) -> tuple:
     """Tasks follow the task ladder, easiest rung first (unknown tasks last, by name)."""
     from ..task_registry import tasks
@@ -300,6 +317,56 @@ def _transfer_target(entry: Entry, baseline: Entry) -> str:
     if not math.isfinite(theirs) and baseline.budget >= entry.budget:
         return f"met: scratch never got there ({figures})"
     return f"not met ({figures})"
+
+
+# the smallest difference in final greedy success a comparison must be able to see: where
+# the interval of the difference lies within +-this, the two are said not to differ by it
+SMALLEST_DIFFERENCE = 0.2
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """A method against a baseline on one task and world, in final greedy success."""
+
+    difference: stats.Estimate  # its mean minus the baseline's, with Welch's t-interval
+    improvement: stats.Estimate  # P(a run of it beats a run of the baseline), stratified bootstrap
+    verdict: str  # "ahead", "behind", "no difference of 0.2 or more [(...)]", "undecided", "too few seeds"
+
+    @property
+    def decided(self) -> bool:
+        return self.verdict not in ("undecided", "too few seeds")
+
+    @property
+    def trivial(self) -> bool:
+        """Decided only because every seed of both sat at 0 (or at 1)."""
+        return self.verdict.endswith(")")
+
+
+def compare(entry: Entry, baseline: Entry) -> Comparison:
+    """``entry`` against ``baseline`` (same task and world) in final greedy success: *ahead*
+    or *behind* where their t-intervals are apart or the probability of improvement's
+    interval excludes one half; else *no difference of 0.2 or more* where the interval of
+    the difference lies within +-``SMALLEST_DIFFERENCE``; else *undecided*."""
+    mine, theirs = entry.values["success"], baseline.values["success"]
+    diff = stats.difference(mine, theirs)
+    try:
+        better = stats.probability_of_improvement([mine], [theirs])
+    except ValueError:  # fewer than 2 runs on a side
+        better = stats.Estimate(math.nan)
+    apart = verdict(entry, baseline, "success")
+    if not (diff.has_interval and better.has_interval):
+        said = "too few seeds"
+    elif apart == "ahead" or better.low > 0.5:
+        said = "ahead"
+    elif apart == "behind" or better.high < 0.5:
+        said = "behind"
+    elif -SMALLEST_DIFFERENCE < diff.low and diff.high < SMALLEST_DIFFERENCE:
+        said = f"no difference of {SMALLEST_DIFFERENCE:g} or more"
+        if {*mine, *theirs} in ({0.0}, {1.0}):  # said plainly: no comparison tells methods apart there
+            said += " (every seed of both at 0)" if mine[0] == 0 else " (every seed of both at 1)"
+    else:
+        said = "undecided"
+    return Comparison(diff, better, said)
 
 
 def distilled_against_scratch(rows: list[Entry]) -> list[tuple[Entry, Entry]]:

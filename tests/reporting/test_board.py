@@ -237,3 +237,43 @@ def test_a_damaged_record_is_named_by_its_file_and_never_pooled(runs, name, text
     [reason] = board.unreadable
     assert reason.startswith(str(damaged / name)) and problem in reason
     assert not board.unfinished
+
+
+def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_path):
+    from craftsuite.reporting.board import best_run, compare
+    from craftsuite.reporting.pages import comparisons_markdown
+
+    def seeds(method, values, task):
+        for seed, value in enumerate(values):
+            fake_run(tmp_path, method, seed, [(1000, value)], [(950, float(seed))], task=task, world="Cont")
+
+    seeds("td3", [0.9, 0.8, 1.0, 0.9, 0.85], "ToolHome")  # apart: the distilled student behind
+    seeds("td3-dynamic", [0.1, 0.0, 0.2, 0.1, 0.05], "ToolHome")
+    seeds("td3", [0.5, 0.52, 0.48, 0.5, 0.51], "FirstTool")  # close and tight: no difference of 0.2
+    seeds("td3-dynamic", [0.49, 0.5, 0.53, 0.5, 0.5], "FirstTool")
+    seeds("td3", [0.0, 1.0, 0.0, 1.0, 0.5], "TwoToolsHome")  # wide: undecided
+    seeds("td3-dynamic", [1.0, 0.0, 0.5, 0.0, 1.0], "TwoToolsHome")
+    seeds("td3", [0.0] * 5, "BlindCraftsman")  # nobody learned: decided, but said so
+    seeds("td3-dynamic", [0.0] * 5, "BlindCraftsman")
+    seeds("td3", [0.0, 0.0], "DungeonQuest")  # two seeds: no interval
+    seeds("td3-dynamic", [1.0, 1.0], "DungeonQuest")
+    board = build(tmp_path)
+    e = {(x.task, x.method): x for x in board}
+
+    def said(task):
+        return compare(e[task, "td3-dynamic"], e[task, "td3"])
+
+    assert said("ToolHome").verdict == "behind" and said("ToolHome").difference.high < 0
+    assert compare(e["ToolHome", "td3"], e["ToolHome", "td3-dynamic"]).verdict == "ahead"
+    assert said("FirstTool").verdict == "no difference of 0.2 or more" and not said("FirstTool").trivial
+    assert said("TwoToolsHome").verdict == "undecided" and not said("TwoToolsHome").decided
+    assert said("BlindCraftsman").verdict.endswith("(every seed of both at 0)") and said("BlindCraftsman").trivial
+    assert said("DungeonQuest").verdict == "too few seeds"
+    text = "\n".join(comparisons_markdown([board]))
+    assert "Decided (ahead, behind, or no difference of 0.2 or more) on 3 of 5 comparisons, 1 of them only" in text
+    assert "| ToolHome | Cont | `td3-dynamic` − `td3` | -0.80 [" in text
+    # the best run: the highest final success, then the hardest rung, then the return
+    run, entry, i = best_run(board)
+    assert (entry.task, entry.method, entry.values["success"][i]) == ("DungeonQuest", "td3-dynamic", 1.0)
+    assert best_run(board, among=[r for x in board if x.task == "ToolHome" for r in x.runs])[0].name.startswith(
+        "student-ToolHome-Cont-td3-s2")

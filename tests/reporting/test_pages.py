@@ -74,3 +74,30 @@ def test_a_world_with_nothing_to_aggregate_says_why(tmp_path):
     fake_run(root, "td3-dynamic", 0, [(1000, 1.0)], [(995, 1.0)])
     md = leaderboard_markdown(build(root))
     assert "### Cont\n\nNothing to aggregate: td3, td3-dynamic: fewer than 2 runs on some task" in md
+
+
+def test_a_page_of_archived_runs_says_it_has_no_video_and_its_size(tmp_path):
+    from craftsuite.archive import keep
+
+    for seed in range(3):
+        run = fake_run(tmp_path / "out", "td3", seed, [(1000, 0.5 + 0.1 * seed)], [(950, 1.0)])
+        keep(run, tmp_path / "results" / "standard", "students")
+    text = write_results_page([tmp_path / "results" / "standard"], tmp_path / "docs" / "results.md").read_text()
+    assert "No video: the best student here, `student-BlindCraftsman-Cont-td3-s2` (greedy success 0.70)" in text
+    assert "The records in `" in text and " MB." in text
+    # a directory that kept its video names it instead
+    (tmp_path / "results" / "standard" / "best-x.mp4").write_bytes(b"mp4")
+    text = write_results_page([tmp_path / "results" / "standard"], tmp_path / "docs" / "results.md").read_text()
+    assert "No video" not in text and "Video of the best student: [best-x.mp4]" in text
+
+
+def test_the_tasks_page_reads_scratch_success_from_the_archive(tmp_path):
+    from craftsuite.references import scratch_success
+
+    for seed in range(3):
+        fake_run(tmp_path / "results" / "standard" / "students", "td3", seed, [(800_000, 0.2 * seed)], [(1, 0.0)],
+                 task="ToolHome", budget=800_000)
+        fake_run(tmp_path / "results" / "standard" / "students", "td3-dynamic", seed, [(800_000, 1.0)], [(1, 0.0)],
+                 task="ToolHome", budget=800_000)
+    assert scratch_success(tmp_path / "results") == {"ToolHome": ["0.20 [0.00, 0.70] at 0.8M (3 seeds, standard)"]}
+    assert scratch_success(tmp_path / "nowhere") == {} and scratch_success(None) == {}

@@ -29,6 +29,8 @@ import json
 import shutil
 from pathlib import Path
 
+import numpy as np
+
 from .files import atomic_path, atomic_write
 from .runs import RunError, read_config, run_settings
 
@@ -101,7 +103,11 @@ def keep(run: Path, archive: Path, kind: str) -> Path:
     for name in RECORDS:
         if (run / name).exists() and name != "result.json":
             with atomic_path(dest / name) as tmp:
-                shutil.copyfile(run / name, tmp)
+                if name.endswith(".npz"):  # a teacher's table: mostly zeros, written uncompressed
+                    with np.load(run / name) as table:
+                        np.savez_compressed(tmp, **table)
+                else:
+                    shutil.copyfile(run / name, tmp)
     for name in COMPRESSED:
         if (run / name).exists():
             # mtime 0: the same log compresses to the same bytes, so a re-archived run is no change
@@ -178,8 +184,8 @@ def size(archive: Path) -> int:
 def add(source, archive: Path, suite: dict | None = None) -> tuple[dict[str, int], list[str]]:
     """Archive the finished runs under ``source`` (a transfer output, with ``students/`` and
     ``teachers/``, or a directory of student runs), with the sessions of its
-    ``provenance.json`` (and ``suite``, the suite's definition, as ``suite.json``): runs
-    made without the archive, or on another machine. Returns how
+    ``provenance.json`` and its ``suite.json`` (the suite as it ran; else ``suite``, the
+    suite's definition): runs made without the archive, or on another machine. Returns how
     many of each kind were kept and why each other run was skipped. (Runs of other budgets
     or settings than the suite's own are kept too, as ``--steps`` makes them: the
     leaderboard never pools them with the suite's.)
@@ -208,6 +214,11 @@ def add(source, archive: Path, suite: dict | None = None) -> tuple[dict[str, int
             if not _same(root / name, Path(archive) / kind / name):
                 keep(root / name, archive, kind)
                 kept[kind] += 1
+    if (source / "suite.json").exists():
+        try:
+            suite = json.loads((source / "suite.json").read_text())
+        except ValueError as err:
+            skipped.append(f"{source / 'suite.json'} is not valid JSON ({err}): the registered suite is recorded")
     keep_all(source, archive, {}, suite=suite)  # the sessions that made them, and the suite
     return kept, skipped
 

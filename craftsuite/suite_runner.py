@@ -27,7 +27,7 @@ from .configs import StudentConfig, TeacherConfig
 from .files import atomic_write
 from .ids import file_stem
 from .methods import METHODS, methods_for
-from .suites import SUITES, Suite
+from .suites import Suite
 from .task_registry import carried, resolve_task
 from .worker_pool import WorkerPool
 
@@ -209,8 +209,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     finally:  # what finished is kept, whatever stopped the rest
         if kept is not None:
             record_session(out, session, None)
-            # the suite as defined, not as this session narrowed it: an archive gathers many sessions' parts
-            keep_all(out, kept, names, suite=dataclasses.asdict(SUITES.get(suite.name, suite)))
+            keep_all(out, kept, names, suite=dataclasses.asdict(suite))  # as run: pages read its settings
     board = build(out / "students")
     board_md = write_leaderboard(board, out)
     plots = plot_curves(board, out)

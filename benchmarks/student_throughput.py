@@ -125,9 +125,9 @@ def suite_projection(name: str, rates: dict, sb3_rates: dict, cores: int = 2) ->
 
     return (f"The `{name}` suite's students ({len(configs)} runs, {total:,} transitions) at these rates on "
             f"{cores} cores: {hours(seconds['population'])} with the population engine (5 seeds a population), "
-            f"{hours(seconds['sb3'])} with one SB3 agent per run, its CRM counted at its DQN rate (a projection: "
-            f"teachers and evaluations not counted; the whole suite with SB3 students took 2 h 50 min when last "
-            f"run).")
+            f"{hours(seconds['sb3'])} with one SB3 agent per run, its CRM counted at its DQN rate (a projection "
+            "from one process alone: teachers and evaluations not counted, and two processes on these 2 cores "
+            "ran at about half these rates each).")
 
 
 def main():
@@ -158,7 +158,9 @@ def main():
             if members == 5:
                 rates[_kind(method, env_id)] = tps
     report("")
-    report(suite_projection("standard", rates, sb3_rates))
+    for suite in ("standard", "hard"):
+        report(suite_projection(suite, rates, sb3_rates))
+        report("")
     report.save(__file__, __doc__, args)
 
 

@@ -278,6 +278,7 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
         lines += ["", text.strip(), ""]
         for plot in plot_curves(board, images):
             lines += [f"![{plot.stem}]({plot.relative_to(path.parent).as_posix()})", ""]
+        lines += teachers_markdown(runs.path / "teachers")
         videos = sorted(runs.path.glob("best-*.mp4"))
         for video in videos:
             shutil.copy(video, images / video.name)
@@ -294,6 +295,29 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
             lines += [f"The records in `{runs.path.as_posix()}`: {archive_size(runs.path) / 1e6:.1f} MB.", ""]
     atomic_write(path, "\n".join(lines))
     return path
+
+
+def teachers_markdown(root: Path) -> list[str]:
+    """The finished teachers under ``root`` (product DQN on a grid, trained until their
+    target greedy success, then distilled): one row each. A damaged record is named."""
+    rows, problems = [], []
+    for run in sorted(root.glob("teacher-*")) if root.is_dir() else []:
+        try:
+            config = json.loads((run / "config.json").read_text())
+            result = json.loads((run / "result.json").read_text())
+            seed = config.get("layout_seed")
+            layout = "new every episode" if seed is None else f"fixed ({seed})"
+            rows.append((rung_order(config["task"]), f"| {config['task']} | `{result['env_id']}` | {layout} "
+                         f"| {result['steps']:,} / {result['updates']:,} | {result['success']:.2f} "
+                         f"| {'yes' if result['reached_target'] else 'no'} ({config['target_success']:.0%}) |"))
+        except (OSError, ValueError, KeyError, TypeError) as err:
+            problems.append(f"- not read: {run} ({type(err).__name__}: {err})")
+    if not rows and not problems:
+        return []
+    return ["Teachers (product DQN on the 7x7 grid, trained until their target greedy success over 50 episodes or "
+            "their budget, then distilled into their automaton's table):", "",
+            "| task | world | layout | transitions / updates | greedy success | reached target |",
+            "|---|---|---|---|---|---|", *[row for _, row in sorted(rows)], *problems, ""]
 
 
 def _suite_scope(suite: dict) -> str:

@@ -101,3 +101,20 @@ def test_the_tasks_page_reads_scratch_success_from_the_archive(tmp_path):
                  task="ToolHome", budget=800_000)
     assert scratch_success(tmp_path / "results") == {"ToolHome": ["0.20 [0.00, 0.70] at 0.8M (3 seeds, standard)"]}
     assert scratch_success(tmp_path / "nowhere") == {} and scratch_success(None) == {}
+
+
+def test_a_results_page_lists_its_teachers_and_names_a_damaged_one(tmp_path):
+    from craftsuite.reporting.pages import teachers_markdown
+
+    good = tmp_path / "teachers" / "teacher-GoldMine-Grid7-s0-abc"
+    good.mkdir(parents=True)
+    (good / "config.json").write_text(json.dumps({"task": "GoldMine", "layout_seed": 0, "target_success": 0.9}))
+    (good / "result.json").write_text(json.dumps({"env_id": "CraftSuite/GoldMine-Grid7-v0", "steps": 55000,
+                                                 "updates": 53999, "success": 1.0, "reached_target": True}))
+    torn = tmp_path / "teachers" / "teacher-Reach-Grid7-s0-def"
+    torn.mkdir()
+    (torn / "config.json").write_text("{torn")
+    text = "\n".join(teachers_markdown(tmp_path / "teachers"))
+    assert "| GoldMine | `CraftSuite/GoldMine-Grid7-v0` | fixed (0) | 55,000 / 53,999 | 1.00 | yes (90%) |" in text
+    assert f"- not read: {torn} (JSONDecodeError" in text
+    assert teachers_markdown(tmp_path / "nowhere") == []

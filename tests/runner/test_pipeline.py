@@ -201,8 +201,8 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
     from craftsuite.reporting.pages import write_results_page
     from craftsuite.suite_runner import transfer
 
-    tiny = dataclasses.replace(SUITES["quick"], tags=("calibration",), seeds=1, student_steps=300, eval_every=150,
-                               eval_episodes=1, teacher_max_steps=400, td3_n_envs=2,
+    tiny = dataclasses.replace(SUITES["quick"], tags=("calibration",), tasks=(), seeds=1, student_steps=300,
+                               eval_every=150, eval_episodes=1, teacher_max_steps=400, td3_n_envs=2,
                                td3_hyperparameters={"learning_starts": 100, "policy_kwargs": {"net_arch": [16]}})
     result = transfer(tiny, tmp_path / "out", workers=2, video=False, progress=False, log=lambda *_: None)
     [teacher] = result.teachers.values()
@@ -316,3 +316,32 @@ def test_a_failing_student_stops_the_others_at_once(tmp_path):
     assert pid is None or not _alive(pid)
     assert not (tmp_path / long.run_name() / "result.json").exists()
 
+
+
+@pytest.mark.slow  # two transfers in pools of spawned workers
+def test_a_suite_accumulates_in_the_archive_and_nothing_trains_twice(tmp_path):
+    from craftsuite.provenance import read
+    from craftsuite.suite_runner import transfer
+
+    tiny = dataclasses.replace(SUITES["quick"], tags=("calibration",), tasks=(), seeds=2, student_steps=300,
+                               eval_every=150, eval_episodes=1, teacher_max_steps=400, td3_n_envs=2,
+                               td3_hyperparameters={"learning_starts": 100, "policy_kwargs": {"net_arch": [16]}})
+    said = []
+    first = transfer(tiny, tmp_path / "here", workers=2, video=False, progress=False, log=said.append,
+                     archive=tmp_path / "results")
+    store = tmp_path / "results" / "quick"
+    kept = sorted(p.name for p in (store / "students").iterdir())
+    assert kept == sorted(p.name for p in first.students) and len(kept) == 4
+    assert not list(store.rglob("*.zip")) and not list(store.rglob("checkpoint*"))
+    assert len(list((store / "teachers").glob("*/table.npz"))) == 1
+    # another machine, an empty output directory: every run comes from the archive, none trains
+    said.clear()
+    second = transfer(tiny, tmp_path / "elsewhere", workers=2, video=True, progress=False, log=said.append,
+                      archive=tmp_path / "results")
+    assert "4 of 4 student runs and 1 of 1 teachers are there already" in " ".join(said)
+    assert all(not (p / "model.zip").exists() for p in second.students)
+    assert second.video is None and any(s.startswith("no video: the best student") for s in said)
+    assert [json.loads((p / "result.json").read_text()) for p in second.students] == \
+        [json.loads((p / "result.json").read_text()) for p in first.students]
+    # the archive's record of the sessions holds both, each once
+    assert len(read(store)) == 2 and all(s["seconds"] is not None for s in read(store))

@@ -1,8 +1,9 @@
 """n-step returns in the population engine: its replay samples them as the SB3 buffer does
 (by hand on tiny replays, and sample for sample against ``AutomatonReplayBuffer``), its
 distilled target mixes the teacher in at the first step's automaton pair as the SB3 agents
-do."""
+do, a population trains with them, and CRM refuses them."""
 
+import json
 
 import gymnasium as gym
 import numpy as np
@@ -11,12 +12,17 @@ import torch as th
 
 import craftsuite  # noqa: F401
 from craftsuite.agents import AutomatonQTable, DistilledTarget
+from craftsuite.agents.distillation import static_distillation
+from craftsuite.agents.factory import load_agent
 from craftsuite.agents.replay import AutomatonReplayBuffer
+from craftsuite.configs import StudentConfig
 from craftsuite.hyperparameters import algorithm_settings
+from craftsuite.population import EngineError, Population, train_population
 from craftsuite.population.dqn import PopulationDQN
-from craftsuite.population.replay import Batch, PopulationReplay
+from craftsuite.population.replay import Batch, CounterfactualView, PopulationReplay
 from craftsuite.population.targets import MemberTargets
 from craftsuite.population.td3 import PopulationTD3
+from craftsuite.runs import read_csv
 from craftsuite.task_registry import resolve_task
 
 
@@ -210,3 +216,63 @@ def test_one_step_replays_keep_no_episode_ends_and_sample_one_step():
     again = PopulationReplay(1, 20, 2, 1, (), np.int64, prioritized=False, n_steps=3, gamma=0.5)
     again.load_member(0, state)
     np.testing.assert_array_equal(again.ended, n_step.ended)
+
+
+def test_bad_n_steps_and_n_step_crm_are_refused():
+    spec = resolve_task("Reach")
+    view = CounterfactualView(spec.automaton, spec.completion_reward, 3 + spec.automaton.n_states)
+    for bad in (0, 2.5, True):
+        with pytest.raises(ValueError, match="n_steps must be a positive integer"):
+            PopulationReplay(1, 10, 1, 3, (), n_steps=bad)
+    with pytest.raises(ValueError, match="CRM stores one-step counterfactual experiences: n_steps must be 1"):
+        PopulationReplay(1, 10, 1, 3 + spec.automaton.n_states, (), crm=view, n_steps=2)
+    replay = PopulationReplay(1, 10, 1, 3, (), n_steps=2)
+    with pytest.raises(ValueError, match="needs to know where episodes ended"):
+        replay.add(*(np.zeros((1, 1, 3)),) * 2, *(np.zeros((1, 1)),) * 5)
+    settings = algorithm_settings("dqn", {"n_steps": 3})
+    for method in ("crm", "crm-edges"):
+        with pytest.raises(EngineError, match=f"method '{method}': CRM stores one-step counterfactual experiences: "
+                                              "n_steps must be 1, got 3 .neither engine"):
+            Population(method, settings, [0], 1, 3 + spec.automaton.n_states, gym.spaces.Discrete(4),
+                       spec.automaton, spec.completion_reward, 100)
+
+
+DQN = {"batch_size": 32, "learning_starts": 200, "policy_kwargs": {"net_arch": [16, 16]}, "gradient_steps": 2,
+       "n_steps": 3}
+
+
+@pytest.fixture(scope="module")
+def reach_table(tmp_path_factory):
+    """A teacher's table for Reach (the statically solved values, as a dynamic table)."""
+    spec = resolve_task("Reach")
+    solved = static_distillation(spec.automaton, completion_reward=spec.completion_reward)
+    table = AutomatonQTable(solved.q, solved.counts, solved.fingerprint, solved.propositions, "dynamic")
+    return str(table.save(tmp_path_factory.mktemp("teacher") / "table.npz"))
+
+
+@pytest.mark.parametrize("method", ["dqn", "dynamic"])
+def test_a_population_trains_with_n_step_returns(method, reach_table, tmp_path, monkeypatch):
+    sampled = []
+    sample = PopulationReplay.sample
+
+    def spy(self, batch_size):
+        batch = sample(self, batch_size)
+        sampled.append(batch.discounts)
+        return batch
+
+    monkeypatch.setattr(PopulationReplay, "sample", spy)
+    configs = [StudentConfig(task="Reach", method=method, world="Grid7", seed=s, steps=1_000, eval_every=500,
+                             eval_episodes=2, hyperparameters=DQN, n_envs=4, engine="population",
+                             table=reach_table if method == "dynamic" else None) for s in (0, 1)]
+    paths = train_population(configs, tmp_path, progress=False)
+    discounts = np.concatenate([d.ravel() for d in sampled])
+    k = np.log(discounts) / np.log(0.99)  # gamma ** k after k rewards
+    assert np.allclose(k, np.round(k), atol=1e-3) and set(np.round(k)) <= {1, 2, 3} and (np.round(k) == 3).any()
+    for config, path in zip(configs, paths):
+        result = json.loads((path / "result.json").read_text())
+        assert (result["engine"], result["seed"], result["steps"], result["updates"]) == \
+            ("population", config.seed, 1_000, 2 * (1_000 - 200) // 4)
+        assert json.loads((path / "config.json").read_text())["hyperparameters"]["n_steps"] == 3
+        assert [int(r["step"]) for r in read_csv(path / "evals.csv")] == [500, 1000]
+        agent = load_agent(path / "model.zip")
+        assert agent.n_steps == 3 and agent.replay_buffer.n_steps == 3

@@ -350,10 +350,15 @@ class PopulationReplay:
         return state
 
     def load_member(self, k: int, state: dict) -> None:
+        """Member ``k`` from its ``member_state``, to resume from: its envs start fresh
+        episodes, so an n-step replay ends each env's stored stream at its newest step."""
         n = len(state["rewards"])
         for name in self._arrays:
             getattr(self, name)[k, :n] = state[name]
         self.pos, self.full = int(state["pos"]), bool(state["full"])
+        if self.ended is not None and n:  # else a window would run on into the next, unrelated episode
+            newest = (self.pos - self.n_envs) % self.capacity
+            self.ended[k, newest:newest + self.n_envs] = True
         self.max_priority[k] = state["max_priority"]
         if self.trees is not None and "priorities" in state:
             priorities = state["priorities"]

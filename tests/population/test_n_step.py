@@ -215,7 +215,23 @@ def test_one_step_replays_keep_no_episode_ends_and_sample_one_step():
     np.testing.assert_array_equal(state["ended"], [True, False, False, False, False, False])
     again = PopulationReplay(1, 20, 2, 1, (), np.int64, prioritized=False, n_steps=3, gamma=0.5)
     again.load_member(0, state)
-    np.testing.assert_array_equal(again.ended, n_step.ended)
+    np.testing.assert_array_equal(again.ended[0, :4], n_step.ended[0, :4])
+    assert again.ended[0, 4:6].all()  # resumed: the newest step ends every env's stream
+
+
+def test_a_resumed_replay_cuts_each_envs_stream_at_its_newest_step():
+    """Resumed, the envs start fresh episodes: no window runs from the steps saved into them."""
+    saved = _replay(1, 10, 2, [[[1, 2, 4], [8, 16, 32]]], ended=[[set(), set()]], terminated=[[set(), set()]])
+    resumed = PopulationReplay(1, 20, 2, 1, (), np.int64, prioritized=False, seed=0, n_steps=3, gamma=0.5)
+    resumed.load_member(0, saved.member_state(0))
+    for t in (3, 4):  # the new episodes' first steps
+        obs = (10 * np.arange(2) + t)[None, :, None].astype(np.float32)
+        resumed.add(obs, obs + 0.5, np.zeros((1, 2)), np.array([[64, 128]]) * 4 ** (t - 3), np.zeros((1, 2)),
+                    np.full((1, 2), t), np.arange(2)[None], np.zeros((1, 2), dtype=bool))
+    got = _sampled(resumed, 0)
+    assert got[(1, 0)] == (2 + 0.5 * 4, 0.25, 0.0, 2.5)  # stops at the saved newest step, t = 2
+    assert got[(2, 1)] == (32, 0.5, 0.0, 12.5)
+    assert got[(3, 0)] == (64 + 0.5 * 256, 0.25, 0.0, 4.5)  # the new episode's own steps
 
 
 def test_bad_n_steps_and_n_step_crm_are_refused():

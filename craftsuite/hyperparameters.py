@@ -58,13 +58,16 @@ TD3_MORE = MappingProxyType(dict(_OFF_POLICY, tau=0.005, policy_delay=OneOf((2, 
 
 # The ranges of the numeric settings, (lowest, highest, whether the lowest itself is out):
 # a value outside is refused by name before anything runs. gradient_steps is left out:
-# SB3 reads -1 as "as many as the env steps collected".
+# SB3 reads -1 as "as many as the env steps collected". n_steps stops at N_STEPS_MAX: every
+# sample reads its n rows, and past it the return is the episode's rest in all but name
+# (gamma ** 100 = 0.37 at 0.99; an episode lasts 200 to 1,000 steps).
+N_STEPS_MAX = 100
 RANGES = MappingProxyType({
     "learning_rate": (0, None, True), "buffer_size": (1, None, False), "batch_size": (1, None, False),
     "learning_starts": (0, None, False), "gamma": (0, 1, False), "tau": (0, 1, True),
     "target_update_interval": (1, None, False), "exploration_fraction": (0, 1, False),
     "exploration_initial_eps": (0, 1, False), "exploration_final_eps": (0, 1, False),
-    "train_freq": (1, None, False), "n_steps": (1, None, False), "stats_window_size": (1, None, False),
+    "train_freq": (1, None, False), "n_steps": (1, N_STEPS_MAX, False), "stats_window_size": (1, None, False),
     "max_grad_norm": (0, None, True), "target_policy_noise": (0, None, False),
     "target_noise_clip": (0, None, False), "policy_delay": (1, None, False)})
 

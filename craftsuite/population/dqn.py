@@ -12,7 +12,7 @@ from stable_baselines3.common.utils import polyak_update  # elementwise: stacked
 
 from .nets import StackedMLP, activation_of, clip_grad_norm_per_member
 from .replay import Batch, SparseRows
-from .targets import MemberTargets
+from .targets import MemberTargets, discount
 
 
 class PopulationDQN:
@@ -80,8 +80,8 @@ class PopulationDQN:
                 next_q = next_q.max(dim=-1, keepdim=True)[0]
             rewards = th.as_tensor(batch.rewards, device=self.device).reshape(K, B, 1)
             terminals = th.as_tensor(batch.terminals, device=self.device).reshape(K, B, 1)
-            target = rewards + (1 - terminals) * self.gamma * next_q
-            if self.targets is not None:
+            target = rewards + (1 - terminals) * discount(batch, self.gamma, self.device) * next_q
+            if self.targets is not None:  # (w, sigma): the first step's, at n steps too (targets.py)
                 target = self.targets(batch.w, batch.sigma, target)
         return target
 

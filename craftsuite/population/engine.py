@@ -6,7 +6,8 @@ own n envs, stores in its own replay slice and takes its own gradient steps, in 
 with the others. What a member does per transition is what an SB3 agent of its run does
 (``agents.factory.make_agent``): the same warm-up of random actions, exploration noise or
 epsilon schedule, collection regime (``train_freq``, ``gradient_steps``), target-update
-interval, TD3 delay schedule and ``_td_target`` rule. Two differences, both deliberate:
+interval, TD3 delay schedule, n-step returns (``n_steps``) and ``_td_target`` rule. Two
+differences, both deliberate:
 DQN explores with a coin per env (SB3's ``predict`` tosses one for all envs of a step), and
 members share one random stream for sampling (their minibatches are still their own).
 """
@@ -56,8 +57,6 @@ def check_supported(method: str, settings: dict) -> None:
         why = f"the settings {unknown}"
     elif settings.get("optimize_memory_usage"):
         why = "optimize_memory_usage (its replay keeps next observations; a grid's as their nonzero entries)"
-    elif settings.get("n_steps", 1) != 1:
-        why = f"n-step returns (n_steps={settings['n_steps']})"
     elif settings.get("features_extractor", "flatten") != "flatten":
         why = f"features_extractor {settings['features_extractor']!r}"
     elif sorted(set(settings.get("policy_kwargs") or {}) - _POLICY_KWARGS):
@@ -73,6 +72,19 @@ def check_supported(method: str, settings: dict) -> None:
     if why is not None:
         raise EngineError(f"method {method!r}: the population engine does not support {why}; "
                           "run it with --engine sb3")
+    _check_n_steps(method, settings.get("n_steps", 1))
+
+
+def _check_n_steps(method: str, n_steps) -> None:
+    """Raise ``EngineError`` for a return length no engine runs: not a positive integer, or
+    more than one step with CRM, whose counterfactual experiences are one step each (the
+    SB3 engine refuses it too, ``agents.crm``, and a member's model is an SB3 agent)."""
+    if not isinstance(n_steps, int) or isinstance(n_steps, bool) or n_steps < 1:
+        raise EngineError(f"method {method!r}: n_steps must be a positive integer, got {n_steps!r}")
+    if n_steps > 1 and METHODS[method].crm:
+        raise EngineError(f"method {method!r}: CRM stores one-step counterfactual experiences: n_steps must be 1, "
+                          f"got {n_steps} (neither engine runs n-step CRM; run n_steps > 1 with a method "
+                          "without counterfactuals)")
 
 
 def _train_every(train_freq) -> int | None:
@@ -142,7 +154,7 @@ class Population:
         self.replay = PopulationReplay(self.K, int(settings["buffer_size"]), n_envs, obs_dim, action_shape,
                                        action_dtype, prioritized=bool(settings.get("prioritized", True)),
                                        crm=crm, seed=seeds[0] + 1, sparse_width=sparse_width if self.discrete else None,
-                                       **buffer)
+                                       n_steps=settings.get("n_steps", 1), gamma=float(settings["gamma"]), **buffer)
         self.batch_size = int(settings["batch_size"])
         self.learning_starts = int(settings["learning_starts"])
         self.gradient_steps = int(settings.get("gradient_steps", 1))
@@ -202,16 +214,18 @@ class Population:
         ended = terminated | truncated
         real_next, transitions, success = step_records(info, ended, next_obs)
         self.observe(shaped, real_next.reshape(K, n, -1), actions, rewards.reshape(K, n),
-                     terminated.reshape(K, n).astype(np.float32), transitions.reshape(K, n, 3))
+                     terminated.reshape(K, n).astype(np.float32), transitions.reshape(K, n, 3), ended.reshape(K, n))
         if ended.any():
             self.episodes_ended(ended.reshape(K, n))
         return next_obs, rewards, ended, success
 
     # -- learning ----------------------------------------------------------------------------------
-    def observe(self, obs, next_obs, actions, rewards, terminated, transitions) -> None:
-        """One vector step's transitions, ``(K, n, ...)`` each; then whatever learning the
-        regime does at this step (a target update, ``gradient_steps`` updates)."""
-        self.replay.add(obs, next_obs, actions, rewards, terminated, transitions[..., 0], transitions[..., 1])
+    def observe(self, obs, next_obs, actions, rewards, terminated, transitions, ended=None) -> None:
+        """One vector step's transitions, ``(K, n, ...)`` each (``ended``: terminated or
+        truncated, which n-step returns stop at); then whatever learning the regime does at
+        this step (a target update, ``gradient_steps`` updates)."""
+        self.replay.add(obs, next_obs, actions, rewards, terminated, transitions[..., 0], transitions[..., 1],
+                        ended)
         self.num_timesteps += self.n_envs
         self.n_calls += 1
         if self.discrete and self.learner.target_update_unit == "transitions":

@@ -7,6 +7,14 @@ fills ``n_envs`` consecutive positions. Sampling follows ``agents.replay``: unif
 stratified by priority p ** alpha with importance weights (N P(i)) ** -beta over their
 maximum, new transitions at the maximum priority seen.
 
+With ``n_steps`` > 1 a sample is an n-step return, as ``agents.replay._n_step``: the
+discounted rewards of up to n steps of the same env (the next step of env j sits
+``n_envs`` positions on), stopping at the episode's end (terminated or truncated) and at
+the newest step written (what lies after it is unwritten, or the oldest steps once the
+replay has wrapped), the next observation and terminal of the window's last step, and
+``gamma ** k`` after its k rewards in ``discounts``. The automaton pair (w, sigma), the
+priority and the importance weight stay the first step's, as the SB3 buffer's do.
+
 CRM (``crm=CounterfactualView(...)``) stores each real step once, with its automaton
 transition ``(w, sigma, w')``. A leaf of the sum tree is a (step, live automaton state u)
 pair; sampling leaf (i, u) rewrites step i as read from u: the observation's one-hot, u' =
@@ -36,6 +44,9 @@ class Batch(NamedTuple):
     leaves: np.ndarray  # (K, B) int64: what update_priorities takes back
     w: np.ndarray  # (K, B) automaton state the target reads (u for a counterfactual)
     sigma: np.ndarray  # (K, B) label of the step
+    # (K, B) float32: gamma ** k, the bootstrap's discount after an n-step sample's k
+    # rewards; None for one-step samples (the learner's gamma), as the SB3 buffer's
+    discounts: np.ndarray | None = None
 
 
 class SparseRows(NamedTuple):
@@ -161,16 +172,26 @@ class CounterfactualView:
         return obs, next_obs, rewards.astype(np.float32), self.ends[u_next], u
 
 
+def _check_n_steps(n_steps, crm) -> None:
+    """Raise ValueError naming a return length the replay cannot sample."""
+    if not isinstance(n_steps, int) or isinstance(n_steps, bool) or n_steps < 1:
+        raise ValueError(f"n_steps must be a positive integer, got {n_steps!r}")
+    if n_steps > 1 and crm is not None:  # as agents.crm.CRMReplayBuffer, which SB3's CRM runs
+        raise ValueError("CRM stores one-step counterfactual experiences: n_steps must be 1")
+
+
 class PopulationReplay:
     """Every member's replay, ``capacity`` transitions each (SB3's rounding: whole steps of
     ``n_envs``). ``actions`` are ``action_shape`` of ``action_dtype`` per transition. With
     ``sparse_width``, observations are stored and sampled as ``SparseRows`` of that width
-    (at least the most nonzero entries an observation of the world can have)."""
+    (at least the most nonzero entries an observation of the world can have). ``n_steps``
+    and ``gamma``: n-step returns (1: one-step samples, as before n-step returns existed)."""
 
     def __init__(self, members: int, capacity: int, n_envs: int, obs_dim: int, action_shape: tuple,
                  action_dtype=np.float32, *, prioritized: bool = True, alpha: float = 0.7, beta: float = 0.4,
                  epsilon: float = 0.1, crm: CounterfactualView | None = None, seed: int = 0,
-                 sparse_width: int | None = None):
+                 sparse_width: int | None = None, n_steps: int = 1, gamma: float = 0.99):
+        _check_n_steps(n_steps, crm)
         self.members, self.n_envs = members, n_envs
         self.capacity = max(capacity // n_envs, 1) * n_envs
         K, C = members, self.capacity
@@ -189,6 +210,11 @@ class PopulationReplay:
         self.terminals = np.zeros((K, C), dtype=np.float32)
         self.w = np.zeros((K, C), dtype=np.int64)
         self.sigma = np.zeros((K, C), dtype=np.int64)
+        self.n_steps, self.gamma = n_steps, float(gamma)
+        # where episodes ended, by the time limit too (terminals holds only the terminated):
+        # n-step windows stop there. Kept only for them, so that a one-step replay, its
+        # memory and its checkpoints stay as they were
+        self.ended = np.zeros((K, C), dtype=bool) if n_steps > 1 else None
         self.pos, self.full = 0, False
         self.crm = crm
         self.per_step = crm.n_live if crm is not None else 1  # leaves per stored transition
@@ -203,9 +229,16 @@ class PopulationReplay:
         """Transitions stored per member."""
         return self.capacity if self.full else self.pos
 
-    def add(self, obs, next_obs, actions, rewards, terminals, w, sigma) -> None:
-        """One step of every member's ``n_envs`` envs: arrays ``(K, n_envs, ...)``."""
+    def add(self, obs, next_obs, actions, rewards, terminals, w, sigma, ended=None) -> None:
+        """One step of every member's ``n_envs`` envs: arrays ``(K, n_envs, ...)``. ``ended``:
+        where the step ended an episode, terminated or truncated (an n-step replay needs it;
+        a one-step replay ignores it)."""
         at = slice(self.pos, self.pos + self.n_envs)
+        if self.ended is not None:
+            if ended is None:
+                raise ValueError("an n-step replay needs to know where episodes ended: pass ended "
+                                 "(terminated or truncated) to add")
+            self.ended[:, at] = ended
         if self.sparse_width is None:
             self.observations[:, at] = obs
             self.next_observations[:, at] = next_obs
@@ -243,21 +276,54 @@ class PopulationReplay:
             weights = (leaves_in_use * probs) ** (-self.beta)
             weights = (weights / weights.max(axis=1, keepdims=True)).astype(np.float32)
         index, j = np.divmod(leaves, self.per_step)
-        flat = (index + self._rows * self.capacity).ravel()  # one index into (K * C, ...): numpy's fast take
+        first = self._flat(index)
+        last, returns, discounts = first, None, None
+        if self.n_steps > 1:
+            window_last, returns, discounts = self._n_step(index)
+            last = self._flat(window_last)
 
-        def take(array):
-            return array.reshape(K * self.capacity, *array.shape[2:]).take(flat, axis=0).reshape(
+        def take(array, at=first):
+            return array.reshape(K * self.capacity, *array.shape[2:]).take(at, axis=0).reshape(
                 K, batch_size, *array.shape[2:])
 
         if self.sparse_width is None:
-            obs, next_obs = take(self.observations), take(self.next_observations)
+            obs, next_obs = take(self.observations), take(self.next_observations, last)
         else:
             obs = SparseRows(take(self.obs_index), take(self.obs_value))
-            next_obs = SparseRows(take(self.next_index), take(self.next_value))
-        rewards, terminals, w, sigma = take(self.rewards), take(self.terminals), take(self.w), take(self.sigma)
+            next_obs = SparseRows(take(self.next_index, last), take(self.next_value, last))
+        rewards = take(self.rewards) if returns is None else returns
+        terminals, w, sigma = take(self.terminals, last), take(self.w), take(self.sigma)
         if self.crm is not None:
             obs, next_obs, rewards, terminals, w = self.crm.relabel(obs, next_obs, rewards, sigma, j)
-        return Batch(obs, take(self.actions), next_obs, rewards, terminals, weights, leaves, w, sigma)
+        return Batch(obs, take(self.actions), next_obs, rewards, terminals, weights, leaves, w, sigma, discounts)
+
+    def _flat(self, index: np.ndarray) -> np.ndarray:
+        """Members' positions ``(K, ...)`` as one index into ``(K * C, ...)``: numpy's fast take."""
+        rows = self._rows.reshape(-1, *([1] * (index.ndim - 1)))
+        return (index + rows * self.capacity).ravel()
+
+    def _n_step(self, index: np.ndarray):
+        """For positions ``(K, B)``: the position that ends each one's n-step window, the
+        discounted rewards up to it and ``gamma ** k`` after its k rewards
+        (``agents.replay.AutomatonReplayBuffer._n_step``, on this replay's layout).
+
+        A position is (vector step, env): env j's next transition is ``n_envs`` positions on,
+        modulo the capacity. A window stops at its episode's end (terminated or truncated),
+        and at the newest vector step written: after it come unwritten positions, or, once
+        the replay has wrapped, the oldest steps, which are no one's future."""
+        n, n_envs = self.n_steps, self.n_envs
+        steps = self.capacity // n_envs
+        step, env = np.divmod(index, n_envs)
+        window = (step[..., None] + np.arange(n)) % steps  # (K, B, n) vector steps
+        positions = window * n_envs + env[..., None]
+        flat = self._flat(positions).reshape(positions.shape)
+        ends = self.ended.reshape(-1)[flat] | (window == (self.pos // n_envs - 1) % steps)
+        k = np.where(ends.any(axis=-1), ends.argmax(axis=-1), n - 1) + 1
+        inside = np.arange(n) < k[..., None]
+        # as the SB3 buffer sums them (float32 rewards times float64 discounts), then float32
+        returns = (self.rewards.reshape(-1)[flat] * inside * self.gamma ** np.arange(n)).sum(axis=-1)
+        last = np.take_along_axis(positions, k[..., None] - 1, axis=-1)[..., 0]
+        return last, returns.astype(np.float32), (self.gamma ** k).astype(np.float32)
 
     def update_priorities(self, leaves: np.ndarray, td_errors: np.ndarray) -> None:
         """New priorities |TD error| + epsilon for the sampled leaves, ``(K, B)`` each."""
@@ -272,7 +338,7 @@ class PopulationReplay:
 
     @property
     def _arrays(self) -> tuple[str, ...]:
-        return self._observation_arrays + self._ARRAYS
+        return self._observation_arrays + self._ARRAYS + (("ended",) if self.ended is not None else ())
 
     def member_state(self, k: int) -> dict:
         """Member ``k``'s filled rows, priorities and sampling position (for its checkpoint)."""
@@ -284,10 +350,15 @@ class PopulationReplay:
         return state
 
     def load_member(self, k: int, state: dict) -> None:
+        """Member ``k`` from its ``member_state``, to resume from: its envs start fresh
+        episodes, so an n-step replay ends each env's stored stream at its newest step."""
         n = len(state["rewards"])
         for name in self._arrays:
             getattr(self, name)[k, :n] = state[name]
         self.pos, self.full = int(state["pos"]), bool(state["full"])
+        if self.ended is not None and n:  # else a window would run on into the next, unrelated episode
+            newest = (self.pos - self.n_envs) % self.capacity
+            self.ended[k, newest:newest + self.n_envs] = True
         self.max_priority[k] = state["max_priority"]
         if self.trees is not None and "priorities" in state:
             priorities = state["priorities"]

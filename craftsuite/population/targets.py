@@ -1,6 +1,15 @@
 """The distilled target for K members: ``agents.distillation.DistilledTarget``'s rule with
 one count table per member (each member's own minibatches decide how far it trusts the
-teacher), the teacher's table shared."""
+teacher), the teacher's table shared; and the bootstrap's discount of a minibatch.
+
+With n-step returns the rule mixes the teacher in as the SB3 agents do
+(``AutomatonDQN._td_target``, ``AutomatonTD3._td_target``): after the n-step target
+r_0 + ... + gamma^(k-1) r_(k-1) + gamma^k Q(s_k) is made, with the (w, sigma) of the
+sample's first step, the one its action took (``AutomatonReplayBuffer._samples`` returns
+``w[batch]``, ``sigma[batch]`` at the window's start, not at its k-th step): the teacher's
+Q(w, sigma) is its value of that first transition, which the target estimates; the
+student's count of that pair is the one that goes up.
+"""
 
 from __future__ import annotations
 
@@ -43,3 +52,12 @@ class MemberTargets:
         rule = copy.deepcopy(self.rule)
         rule.student_counts[...] = self.counts[k].reshape(rule.student_counts.shape)
         return rule
+
+
+def discount(batch, gamma: float, device) -> float | th.Tensor:
+    """What the bootstrap of ``batch`` is discounted by: ``gamma`` for one-step samples
+    (the very float the one-step target always used), ``gamma ** k`` per sample ``(K, B, 1)``
+    after an n-step sample's k rewards."""
+    if batch.discounts is None:
+        return gamma
+    return th.as_tensor(batch.discounts, device=device).reshape(*batch.discounts.shape, 1)

@@ -13,7 +13,7 @@ from stable_baselines3.common.utils import polyak_update  # elementwise: stacked
 
 from .nets import StackedMLP, activation_of
 from .replay import Batch
-from .targets import MemberTargets
+from .targets import MemberTargets, discount
 
 
 def net_arch(policy_kwargs: dict, default) -> tuple[list[int], list[int]]:
@@ -82,8 +82,9 @@ class PopulationTD3:
             joint = th.cat([next_obs, next_actions], dim=2)
             next_q = th.min(th.cat([q(joint) for q in self.critics_target], dim=2), dim=2, keepdim=True)[0]
             target = (self._tensor(batch.rewards, (K, B, 1))
-                      + (1 - self._tensor(batch.terminals, (K, B, 1))) * self.gamma * next_q)
-            if self.targets is not None:
+                      + (1 - self._tensor(batch.terminals, (K, B, 1))) * discount(batch, self.gamma, self.device)
+                      * next_q)
+            if self.targets is not None:  # (w, sigma): the first step's, at n steps too (targets.py)
                 target = self.targets(batch.w, batch.sigma, target)
         return target
 

@@ -36,6 +36,8 @@ def test_a_value_of_the_wrong_type_is_named(overrides, message):
     ("td3", {"tau": 0}, "tau must be above 0 and at most 1 (default 0.005), got 0"),
     ("td3", {"policy_delay": 0}, "policy_delay must be at least 1 (e.g. 2), got 0"),
     ("td3", {"buffer_size": 0}, "buffer_size must be at least 1"),
+    ("dqn", {"n_steps": 0}, "n_steps must be between 1 and 100 (e.g. 1), got 0"),
+    ("td3", {"n_steps": 101}, "n_steps must be between 1 and 100 (e.g. 1), got 101"),
 ])
 def test_a_number_out_of_its_range_is_named(algorithm, overrides, message):
     with pytest.raises(HyperparameterError, match="^--hyper: " + message.replace("(", r"\(").replace(")", r"\)")):
@@ -43,7 +45,8 @@ def test_a_number_out_of_its_range_is_named(algorithm, overrides, message):
 
 
 def test_the_edges_of_the_ranges_pass():
-    edges = {"gamma": 1, "learning_starts": 0, "exploration_final_eps": 0.0, "batch_size": 1, "gradient_steps": -1}
+    edges = {"gamma": 1, "learning_starts": 0, "exploration_final_eps": 0.0, "batch_size": 1, "gradient_steps": -1,
+             "n_steps": 100}
     assert check_hyperparameters("dqn", edges) == edges
     assert (check_hyperparameters("td3", {"tau": 1.0, "target_policy_noise": 0})
             == {"tau": 1.0, "target_policy_noise": 0})

@@ -7,7 +7,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.craftsuite-setup
 
-.PHONY: setup demo test test-slow bench clean
+.PHONY: setup demo test test-slow bench docs clean
 
 $(STAMP): pyproject.toml constraints.txt scripts/setup.sh
 	VENV=$(VENV) bash scripts/setup.sh
@@ -26,6 +26,13 @@ test: $(STAMP)
 # this -m replaces the default run's -m 'not slow' (pyproject.toml's addopts)
 test-slow: $(STAMP)
 	$(PY) -m pytest -q -m slow --nbmake tests notebooks
+
+# The pages generated from data: the tasks page from the specs and the results archive,
+# the results and reproduction pages from the archive (results/)
+docs: $(STAMP)
+	$(PY) -m craftsuite tasks --markdown docs/tasks.md
+	$(PY) -m craftsuite leaderboard results/standard results/hard --page docs/results.md
+	$(PY) -m craftsuite leaderboard results/paper --reproduction docs/reproduction.md
 
 # Each benchmark prints its figures beside their targets and rewrites its own section of
 # docs/performance.md (about 15 minutes on 2 cores; run it on an idle machine)

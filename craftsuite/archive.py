@@ -112,6 +112,9 @@ def keep(run: Path, archive: Path, kind: str) -> Path:
         if (run / name).exists():
             # mtime 0: the same log compresses to the same bytes, so a re-archived run is no change
             atomic_write(dest / f"{name}.gz", gzip.compress((run / name).read_bytes(), compresslevel=9, mtime=0))
+        elif (run / f"{name}.gz").exists():  # a run from another archive
+            with atomic_path(dest / f"{name}.gz") as tmp:
+                shutil.copyfile(run / f"{name}.gz", tmp)
     with atomic_path(dest / "result.json") as tmp:  # last: its presence marks the record whole
         shutil.copyfile(run / "result.json", tmp)
     return dest

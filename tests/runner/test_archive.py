@@ -45,6 +45,9 @@ def test_a_kept_run_has_its_records_only_and_reads_the_same(tmp_path):
     packed = (kept / "episodes.csv.gz").read_bytes()
     archive.keep(run, tmp_path / "results" / "quick", "students")
     assert (kept / "episodes.csv.gz").read_bytes() == packed
+    # kept again from an archive (another machine's), the compressed log comes along
+    again = archive.keep(kept, tmp_path / "elsewhere", "students")
+    assert read_csv(again / "episodes.csv") == read_csv(run / "episodes.csv")
     unfinished = _run(tmp_path / "out" / "students", seed=1)
     (unfinished / "result.json").unlink()
     with pytest.raises(RuntimeError, match="not finished"):

@@ -183,15 +183,16 @@ SUITES = {s.name: s for s in (
           tasks=("Reach", "FirstTool"), worlds=("Cont",), methods=("td3", "td3-dynamic-edges"), seeds=2,
           budgets={"Cont": {"easy": 200_000, "medium": 800_000}}, archived=False, **TD3_REGIME),
     Suite("standard", "the easy, medium and middle rungs x the paper's methods and baselines, Grid10 and MuJoCo, "
-          "5 seeds (about 4 hours on 2 cores with the population engine; the paper's tasks are the hard suite)",
+          "5 seeds (on 2 cores: its grid half took 65 min, its MuJoCo half projects about 4 hours; the paper's "
+          "tasks are the hard suite)",
           tags=("easy", "medium"), worlds=("Grid10", "Cont"), methods=PAPER_METHODS, seeds=5,
           budgets={"Cont": {"easy": 250_000, "medium": 800_000, "TwoToolsHome": 1_200_000,
                             "KeySwordDragon": 400_000},
                    "Grid": {"easy": 30_000, "medium": 150_000}},
           **TD3_REGIME, **DQN_REGIME),
     Suite("hard", "the paper's tasks x the paper's methods and baselines at 1M transitions per run, Grid10 and "
-          "MuJoCo, 5 seeds (on 2 cores with the population engine about 5 hours per world: run each with "
-          "--worlds, on any machine; the results archive gathers them)",
+          "MuJoCo, 5 seeds (on 2 cores about 5 hours for MuJoCo and 7 for the grids: run it in parts, with "
+          "--worlds, --tasks or --methods, on any machines; the results archive gathers them)",
           tags=("hard",), worlds=("Grid10", "Cont"), methods=PAPER_METHODS, seeds=5,
           budgets={"Cont": {"hard": 1_000_000}, "Grid": {"hard": 1_000_000}}, **TD3_REGIME, **DQN_REGIME),
     Suite("paper", "the paper's protocol as the authors' code ran it: the paper's methods and baselines on its tasks "

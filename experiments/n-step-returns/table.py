@@ -6,16 +6,21 @@ archive) beside its n-step runs, in final greedy success, AUC and steps to 80%.
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import math
-import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).parent))
+from craftsuite.reporting.board import build
 
-from run import CELLS  # noqa: E402
 
-from craftsuite.reporting.board import build  # noqa: E402
+def _cells():
+    """The driver's cells (its own run.py, by path: every experiment has a run.py)."""
+    spec = importlib.util.spec_from_file_location("n_step_returns_run", Path(__file__).with_name("run.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.CELLS
+
 
 SOURCES = ("results/standard/students", "results/n-step-returns/students")
 
@@ -29,7 +34,7 @@ def main() -> None:
     entries = [e for root in SOURCES for e in build(root)]
     print("| rung | world | method | n | final success [95% t] | AUC | reached 80% | median over all seeds |")
     print("|---|---|---|---|---|---|---|---|")
-    for task, world, methods, _ in CELLS:
+    for task, world, methods, _ in _cells():
         for method in methods:
             here = sorted((e for e in entries if (e.task, e.world, e.method) == (task, world, method)), key=n_steps)
             for e in here:

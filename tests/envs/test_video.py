@@ -108,9 +108,11 @@ def test_videos_for_people_carry_the_status_panel(tmp_path, capsys):
     agent = make_agent("product-dqn", env_id, learning_starts=10, buffer_size=100)
     agent.learn(20)
     agent.save(run / "model.zip")
+    (run / "config.json").write_text(json.dumps({"task": "DungeonQuest", "world": "Grid7", "method": "product-dqn",
+                                                 "seed": 0, "steps": 20}))
     (run / "result.json").write_text(json.dumps({
-        "task": "DungeonQuest", "env_id": env_id, "method": "product-dqn", "seed": 0,
-        "model": "model.zip", "product": True, "env_kwargs": {}}))
+        "kind": "student", "steps": 20, "task": "DungeonQuest", "env_id": env_id, "method": "product-dqn",
+        "seed": 0, "model": "model.zip", "product": True, "env_kwargs": {}}))
     (run / "evals.csv").write_text("step,success,return\n20,0.0,-5.0\n")
     movie = _best_student_video([run], tmp_path)
     assert read_video(movie)[0]["size"] == (shown[1], shown[0])

@@ -22,12 +22,14 @@ BUILTIN_IDS = [i for i in craftsuite.registered_ids() if parse_id(i)[0] in BUILT
 def test_the_ladder_climbs_from_reach_to_the_paper_tasks():
     names = [s.name for s in ladder()]
     assert names[:3] == ["Reach", "FirstWood", "FirstTool"]
-    assert set(names[3:]) == {"BlindCraftsman", "BlindCraftsmanObstacles", "DungeonQuest", "DiamondMine", "GoldMine"}
+    assert set(names[3:6]) == {"KeySwordDragon", "ToolHome", "TwoToolsHome"}  # the middle rungs, level medium
+    assert {s.name for s in ladder("middle")} == set(names[3:6])
+    assert set(names[6:]) == {"BlindCraftsman", "BlindCraftsmanObstacles", "DungeonQuest", "DiamondMine", "GoldMine"}
     levels = [LEVELS.index(s.level) for s in ladder()]
     assert levels == sorted(levels)  # easiest first
     assert "calibration" in BUILTIN["Reach"].tags
-    assert {s.name for s in ladder("paper")} == set(names[3:])
-    assert [s.name for s in ladder("easy", "medium")] == ["Reach", "FirstWood", "FirstTool"]
+    assert {s.name for s in ladder("paper")} == set(names[6:])
+    assert [s.name for s in ladder("easy", "medium")] == names[:6]
 
 
 def test_every_rung_has_a_level_and_the_second_stage_is_in_its_automaton():
@@ -44,7 +46,7 @@ def test_every_rung_has_a_level_and_the_second_stage_is_in_its_automaton():
 
 def test_an_unknown_tag_is_named_with_the_tags_in_use(capsys):
     with pytest.raises(KeyError, match=r"no task spec has tag \['eassy'\] in its 'tags' field; tags in use: "
-                                       r"\['calibration', 'easy', 'hard', 'medium', 'paper'\]"):
+                                       r"\['calibration', 'easy', 'hard', 'medium', 'middle', 'paper'\]"):
         ladder("easy", "eassy")
     assert main(["tasks", "--tag", "eassy"]) == 2
     assert "tags in use" in capsys.readouterr().err

@@ -39,8 +39,8 @@ def write(tmp_path, text, name="treasure.toml"):
 
 def test_builtin_specs():
     specs = builtin_specs()
-    assert set(specs) == {"Reach", "FirstWood", "FirstTool", "BlindCraftsman", "BlindCraftsmanObstacles",
-                          "DungeonQuest", "DiamondMine", "GoldMine"}
+    assert set(specs) == {"Reach", "FirstWood", "FirstTool", "KeySwordDragon", "ToolHome", "TwoToolsHome",
+                          "BlindCraftsman", "BlindCraftsmanObstacles", "DungeonQuest", "DiamondMine", "GoldMine"}
     bc = specs["BlindCraftsman"]
     assert bc.proposition_names == ("wood", "factory", "tools3", "home")
     assert bc.inventory == ("wood", "tools")

@@ -4,6 +4,7 @@ runs in the results archive.
 
     python experiments/n-step-returns/run.py --out experiments/n-step-returns/results
     craftsuite archive experiments/n-step-returns/results --suite standard --archive results/n-step-returns
+    python experiments/n-step-returns/table.py
 
 Each run is the standard suite's config with ``n_steps`` added to its algorithm's settings
 (the students' only: the teachers, and so the distilled tables, are the suite's own, read

@@ -22,7 +22,7 @@ def _cells():
     return module.CELLS
 
 
-SOURCES = ("results/standard/students", "results/n-step-returns/students")
+SOURCES = ("results/standard/students", "results/n-step-returns/standard/students")
 
 
 def n_steps(entry) -> int:

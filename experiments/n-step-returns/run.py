@@ -28,6 +28,7 @@ CELLS = (
     ("ToolHome", "Grid10", ("dqn", "dynamic"), (3, 8)),
     ("KeySwordDragon", "Grid10", ("dqn", "dynamic"), (3, 8)),
     ("KeySwordDragon", "Cont", ("td3", "td3-dynamic"), (5,)),
+    ("ToolHome", "Cont", ("td3", "td3-dynamic"), (5,)),
 )
 
 

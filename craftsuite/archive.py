@@ -26,6 +26,7 @@ from __future__ import annotations
 import gzip
 import hashlib
 import json
+import secrets
 import shutil
 from pathlib import Path
 
@@ -78,7 +79,7 @@ def archived(archive: Path, kind: str) -> tuple[dict[str, Path], list[str]]:
     runs, skipped = {}, []
     root = Path(archive) / kind
     for run in sorted(root.iterdir()) if root.is_dir() else []:
-        if not run.is_dir():
+        if not run.is_dir() or run.name.startswith("."):  # (a record being swapped in)
             continue
         reason = check_record(run)
         if reason is None:
@@ -98,8 +99,11 @@ def keep(run: Path, archive: Path, kind: str) -> Path:
     run = Path(run)
     if not (run / "result.json").exists():
         raise RunError(f"{run} is not finished (no result.json): only finished runs are archived")
-    dest = Path(archive) / kind / run.name
-    dest.mkdir(parents=True, exist_ok=True)
+    final = Path(archive) / kind / run.name
+    # the whole record is built beside its place, then swapped in: a reader (or a kill)
+    # never meets one run's logs beside another's result, nor an older record's leftovers
+    dest = final.with_name(f".{run.name}.{secrets.token_hex(4)}.tmp")
+    dest.mkdir(parents=True)
     for name in RECORDS:
         if (run / name).exists() and name != "result.json":
             with atomic_path(dest / name) as tmp:
@@ -115,9 +119,13 @@ def keep(run: Path, archive: Path, kind: str) -> Path:
         elif (run / f"{name}.gz").exists():  # a run from another archive
             with atomic_path(dest / f"{name}.gz") as tmp:
                 shutil.copyfile(run / f"{name}.gz", tmp)
-    with atomic_path(dest / "result.json") as tmp:  # last: its presence marks the record whole
-        shutil.copyfile(run / "result.json", tmp)
-    return dest
+    shutil.copyfile(run / "result.json", dest / "result.json")
+    old = final.with_name(f".{run.name}.{secrets.token_hex(4)}.old")
+    if final.exists():
+        final.rename(old)
+    dest.rename(final)
+    shutil.rmtree(old, ignore_errors=True)
+    return final
 
 
 def restore(archive: Path, out: Path, names: dict[str, set[str]], log=print) -> dict[str, int]:
@@ -135,12 +143,33 @@ def restore(archive: Path, out: Path, names: dict[str, set[str]], log=print) -> 
             dest = Path(out) / kind / name
             if (dest / "result.json").exists():
                 continue
-            if dest.exists():  # an unfinished run of the same settings: the archive's finished one wins
+            if dest.exists():  # an unfinished run of the same settings: the archive's finished one wins,
+                if _in_use(dest):  # unless it is training now
+                    log(f"results archive: {dest} is in use by a live run; its archived record is not restored")
+                    continue
                 shutil.rmtree(dest)
             shutil.copytree(runs[name], dest)
             count += 1
         restored[kind] = count
     return restored
+
+
+def _in_use(run: Path) -> bool:
+    """Whether a live run holds the run directory's lock (``runs.RunDir``)."""
+    import fcntl
+    import os
+
+    lock = run / ".lock"
+    if not lock.exists():
+        return False
+    fd = os.open(lock, os.O_RDWR)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        return True
+    finally:
+        os.close(fd)  # (closing drops a lock taken here)
+    return False
 
 
 def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict | None = None) -> dict[str, int]:

@@ -340,7 +340,14 @@ def _transfer(args) -> int:
     out = args.out or f"runs/{args.suite}"
     if args.archive and args.no_archive:
         raise ValueError("--archive DIR keeps the runs in that archive, --no-archive keeps none: give one or neither")
-    archive = None if args.no_archive or not (args.archive or suite.archived) else (args.archive or "results")
+    # a run whose settings differ from the suite's (a budget, a setting) goes to the archive only
+    # when asked for: a smoke test would otherwise sit beside the suite's runs as a variant
+    settings = {"student_steps", "teacher_max_steps", "eval_every", "dqn_hyperparameters", "teacher_hyperparameters",
+                "cont_world_kwargs", "kinematic_world_kwargs", "td3_hyperparameters", "engine"}
+    own = suite.archived and not settings & set(changes)
+    archive = None if args.no_archive or not (args.archive or own) else (args.archive or "results")
+    if suite.archived and not own and archive is None and not args.no_archive:
+        print("(settings beyond the suite's: no results archive unless --archive DIR is given)")
     result = transfer(suite, out, workers=args.workers, ray=args.ray, video=not args.no_video, command=command_line(),
                       device=args.device, archive=archive)
     print(f"leaderboard: {result.leaderboard} (and .csv)")

@@ -208,8 +208,11 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
                                 teachers=teachers, teacher_root=out / "teachers", log=log, device=device)
     finally:  # what finished is kept, whatever stopped the rest
         if kept is not None:
-            record_session(out, session, None)
-            keep_all(out, kept, names, suite=dataclasses.asdict(suite))  # as run: pages read its settings
+            try:
+                record_session(out, session, None)
+                keep_all(out, kept, names, suite=dataclasses.asdict(suite))  # as run: pages read its settings
+            except Exception as err:  # never in place of what stopped the runs
+                log(f"results archive {kept}: not updated ({type(err).__name__}: {err})")
     board = build(out / "students")
     board_md = write_leaderboard(board, out)
     plots = plot_curves(board, out)

@@ -158,26 +158,28 @@ def comparisons_markdown(boards: list[Board]) -> list[str]:
     """Every distilled method against its algorithm from scratch, rung by rung, across
     ``boards``: the difference in final greedy success and the verdict (``board.compare``),
     and how many rungs decide it."""
-    rows, decided, trivial = [], set(), set()
+    rows, decided, trivial = [], 0, 0
     for board in boards:
         entries = list(board)
         for task, world in sorted({(e.task, e.world_label) for e in entries}, key=lambda k: (rung_order(k[0]), k[1])):
             here = [e for e in entries if (e.task, e.world_label) == (task, world)]
             for entry, base in distilled_against_scratch(here):
+                if entry.budget != base.budget:  # never set side by side as if they were one comparison
+                    rows.append(f"| {task} | {world} | `{entry.label}` − `{base.label}` | | | {entry.budget:,} "
+                                f"against {base.budget:,} | not compared: other budgets |")
+                    continue
                 c = compare(entry, base)
                 rows.append(f"| {task} | {world} | `{entry.label}` − `{base.label}` "
                             f"| {_fmt(c.difference, signed=True)} | {_fmt(c.improvement)} | {entry.budget:,} "
                             f"| {c.verdict} |")
-                if c.decided:
-                    decided.add((task, world, entry.method))
-                if c.trivial:
-                    trivial.add((task, world, entry.method))
+                decided += c.decided
+                trivial += c.trivial
     if not rows:
         return []
     return ["| rung | world | distilled − scratch | difference in success [95% Welch t] | P(distilled > scratch) "
             "[95% bootstrap] | transitions per run | verdict |", "|---|---|---|---|---|---|---|", *rows, "",
             f"Decided (ahead, behind, or no difference of {SMALLEST_DIFFERENCE:g} or more) on "
-            f"{len(decided)} of {len(rows)} comparisons, {len(trivial)} of them only because every seed of both sat "
+            f"{decided} of {len(rows)} comparisons, {trivial} of them only because every seed of both sat "
             "at 0 or at 1: *ahead*/*behind* where the two t-intervals are apart or the "
             "probability's interval excludes one half; *no difference* where the difference's interval lies within "
             f"±{SMALLEST_DIFFERENCE:g}.", ""]
@@ -289,8 +291,8 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
             run, entry, i = best
             lines += [f"No video: the best student here, `{run.name}` (greedy success "
                       f"{entry.values['success'][i]:.2f}), kept its records but not its model (the results archive "
-                      "keeps no models). `craftsuite video` needs one: train its cell again with "
-                      "`craftsuite transfer --no-archive`.", ""]
+                      "keeps no models). `craftsuite video` needs one: train its cell again into a new directory "
+                      "(`craftsuite transfer --no-archive --out DIR`).", ""]
         if (runs.path / "students").is_dir() and any((runs.path / "students").glob("*/episodes.csv.gz")):
             lines += [f"The records in `{runs.path.as_posix()}`: {archive_size(runs.path) / 1e6:.1f} MB.", ""]
     atomic_write(path, "\n".join(lines))

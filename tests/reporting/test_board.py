@@ -255,6 +255,8 @@ def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_pa
     seeds("td3-dynamic", [1.0, 0.0, 0.5, 0.0, 1.0], "TwoToolsHome")
     seeds("td3", [0.0] * 5, "BlindCraftsman")  # nobody learned: decided, but said so
     seeds("td3-dynamic", [0.0] * 5, "BlindCraftsman")
+    seeds("td3", [0.3, 0.35, 0.4], "Reach")  # apart, but 3 seeds a side: the probability alone does not decide
+    seeds("td3-dynamic", [0.1, 0.2, 0.25], "Reach")
     seeds("td3", [0.0, 0.0], "DungeonQuest")  # two seeds: no interval
     seeds("td3-dynamic", [1.0, 1.0], "DungeonQuest")
     board = build(tmp_path)
@@ -269,8 +271,9 @@ def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_pa
     assert said("TwoToolsHome").verdict == "undecided" and not said("TwoToolsHome").decided
     assert said("BlindCraftsman").verdict.endswith("(every seed of both at 0)") and said("BlindCraftsman").trivial
     assert said("DungeonQuest").verdict == "too few seeds"
+    assert said("Reach").improvement.low == 0.0 and said("Reach").verdict == "undecided"
     text = "\n".join(comparisons_markdown([board]))
-    assert "Decided (ahead, behind, or no difference of 0.2 or more) on 3 of 5 comparisons, 1 of them only" in text
+    assert "Decided (ahead, behind, or no difference of 0.2 or more) on 3 of 6 comparisons, 1 of them only" in text
     assert "| ToolHome | Cont | `td3-dynamic` − `td3` | -0.80 [" in text
     # the best run: the highest final success, then the hardest rung, then the return
     run, entry, i = best_run(board)

@@ -131,3 +131,6 @@ def test_transfer_flags_choose_the_archive(tmp_path, monkeypatch):
     assert main(args + ["--suite", "standard", "--archive", "elsewhere"]) == 0 and seen["standard"] == "elsewhere"
     assert main(args + ["--suite", "standard", "--no-archive"]) == 0 and seen["standard"] is None
     assert main(args + ["--suite", "standard", "--no-archive", "--archive", "x"]) == 2
+    # settings beyond the suite's (a smoke test's budget) stay out of the archive unless asked for
+    assert main(args + ["--suite", "standard", "--steps", "1000"]) == 0 and seen["standard"] is None
+    assert main(args + ["--suite", "standard", "--steps", "1000", "--archive", "x"]) == 0 and seen["standard"] == "x"

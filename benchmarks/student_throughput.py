@@ -126,8 +126,8 @@ def suite_projection(name: str, rates: dict, sb3_rates: dict, cores: int = 2) ->
     return (f"The `{name}` suite's students ({len(configs)} runs, {total:,} transitions) at these rates on "
             f"{cores} cores: {hours(seconds['population'])} with the population engine (5 seeds a population), "
             f"{hours(seconds['sb3'])} with one SB3 agent per run, its CRM counted at its DQN rate (a projection "
-            "from one process alone: teachers and evaluations not counted, and two processes on these 2 cores "
-            "ran at about half these rates each).")
+            "from one process alone, teachers and evaluations not counted; on these 2 cores two grid populations "
+            "kept about these rates, two MuJoCo populations about half each).")
 
 
 def main():

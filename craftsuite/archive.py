@@ -60,7 +60,8 @@ def check_record(run: Path, kind: str | None = None) -> str | None:
     if not result.exists():
         return f"{run} has no result.json: not a finished run's record"
     try:
-        kind_of = json.loads(result.read_text()).get("kind")
+        outcome = json.loads(result.read_text())
+        kind_of = outcome.get("kind")
     except (ValueError, AttributeError) as err:
         return f"{result} is not a run's result ({err}): the record is damaged"
     expected = kind or run.parent.name
@@ -70,6 +71,11 @@ def check_record(run: Path, kind: str | None = None) -> str | None:
     if not run.name.endswith(f"-{key}"):
         return (f"{run.name} is not the name of the run its config.json records (its key is {key}): "
                 "a record copied in from elsewhere, or edited")
+    # a student's result names its run too: one from another run, beside this config, is foreign
+    other = [f for f in ("task", "method", "seed") if f in outcome and f in record and outcome[f] != record[f]]
+    if other:
+        return (f"{result} is another run's result ({', '.join(f'{f} {outcome[f]!r}' for f in other)}, where "
+                f"config.json records {', '.join(repr(record[f]) for f in other)}): a record from elsewhere")
     return None
 
 

@@ -63,9 +63,12 @@ def test_damaged_and_foreign_records_are_named_and_skipped(tmp_path):
     renamed = renamed.rename(renamed.with_name("student-Reach-Cont-td3-s2-0123456789"))
     teacher = archive.keep(_run(tmp_path / "a" / "students", name="teacher-Reach", seed=3, kind="teacher"),
                            store, "students")
+    mixed = archive.keep(_run(tmp_path / "a" / "students", seed=4), store, "students")
+    (mixed / "result.json").write_text(json.dumps({"kind": "student", "steps": 1000, "seed": 9}))
     runs, skipped = archive.archived(store, "students")
     assert list(runs) == [good.name]
-    assert len(skipped) == 3
+    assert len(skipped) == 4
+    assert any(str(mixed / "result.json") in s and "another run's result (seed 9" in s for s in skipped)
     assert any(str(damaged / "result.json") in s and "damaged" in s for s in skipped)
     assert any(renamed.name in s and "not the name of the run its config.json records" in s for s in skipped)
     assert any(str(teacher / "result.json") in s and "teacher's result" in s for s in skipped)
@@ -73,7 +76,7 @@ def test_damaged_and_foreign_records_are_named_and_skipped(tmp_path):
     said = []
     names = {"students": {good.name, renamed.name, damaged.name}}
     assert archive.restore(store, tmp_path / "out", names, log=said.append) == {"teachers": 0, "students": 1}
-    assert len(said) == 3 and all(s.startswith("results archive: skipped ") for s in said)
+    assert len(said) == 4 and all(s.startswith("results archive: skipped ") for s in said)
     assert [p.name for p in (tmp_path / "out" / "students").iterdir()] == [good.name]
 
 

@@ -24,7 +24,6 @@ named and skipped, never pooled.
 from __future__ import annotations
 
 import gzip
-import hashlib
 import json
 import secrets
 import shutil
@@ -33,18 +32,11 @@ from pathlib import Path
 import numpy as np
 
 from .files import atomic_path, atomic_write
-from .runs import RunError, read_config, run_settings
+from .runs import RunError, in_use, read_config, record_key
 
 RECORDS = ("config.json", "result.json", "evals.csv", "table.npz")  # kept as they are (table.npz: teachers)
 COMPRESSED = ("episodes.csv",)  # kept as <name>.gz
 KINDS = ("teachers", "students")
-
-
-def record_key(record: dict) -> str:
-    """The run key of a ``config.json`` record: what ``runs.config_key`` hashed when the run
-    was made, read back from the settings it recorded (so a record of an older version's
-    defaults keeps its own key)."""
-    return hashlib.sha256(json.dumps(run_settings(record), sort_keys=True).encode()).hexdigest()[:10]
 
 
 def check_record(run: Path, kind: str | None = None) -> str | None:
@@ -150,7 +142,7 @@ def restore(archive: Path, out: Path, names: dict[str, set[str]], log=print) -> 
             if (dest / "result.json").exists():
                 continue
             if dest.exists():  # an unfinished run of the same settings: the archive's finished one wins,
-                if _in_use(dest):  # unless it is training now
+                if in_use(dest):  # unless it is training now
                     log(f"results archive: {dest} is in use by a live run; its archived record is not restored")
                     continue
                 shutil.rmtree(dest)
@@ -158,24 +150,6 @@ def restore(archive: Path, out: Path, names: dict[str, set[str]], log=print) -> 
             count += 1
         restored[kind] = count
     return restored
-
-
-def _in_use(run: Path) -> bool:
-    """Whether a live run holds the run directory's lock (``runs.RunDir``)."""
-    import fcntl
-    import os
-
-    lock = run / ".lock"
-    if not lock.exists():
-        return False
-    fd = os.open(lock, os.O_RDWR)
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        return True
-    finally:
-        os.close(fd)  # (closing drops a lock taken here)
-    return False
 
 
 def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict | None = None) -> dict[str, int]:
@@ -237,7 +211,7 @@ def add(source, archive: Path, suite: dict | None = None) -> tuple[dict[str, int
     roots = {kind: source / kind for kind in KINDS if (source / kind).is_dir()} or {"students": source}
     skipped, found = [], {kind: set() for kind in KINDS}
     for kind, root in roots.items():
-        for run in sorted(p for p in root.iterdir() if p.is_dir()):
+        for run in sorted(p for p in root.iterdir() if p.is_dir() and not p.name.startswith(".")):
             if not (run / "result.json").exists():
                 skipped.append(f"{run}: not finished (no result.json)")
                 continue

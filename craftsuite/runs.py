@@ -88,8 +88,14 @@ def settings(config) -> dict:
 def config_key(config) -> str:
     """A short stable hash of a config's settings (not of its file locations): equal
     settings share a run directory."""
-    text = json.dumps(run_settings(settings(config)), sort_keys=True)
-    return hashlib.sha256(text.encode()).hexdigest()[:10]
+    return record_key(settings(config))
+
+
+def record_key(record: dict) -> str:
+    """The run key of a ``config.json`` record (or of a config's ``settings``): the hash of
+    what it records beyond its format, provenance and file locations. Read back from a
+    record, it is the key the run was made with, whatever this version's defaults."""
+    return hashlib.sha256(json.dumps(run_settings(record), sort_keys=True).encode()).hexdigest()[:10]
 
 
 def read_config(run) -> dict:
@@ -154,6 +160,21 @@ def eval_seed(step: int) -> int:
     ones), the same rule for every kind of run and engine; evaluations fewer than
     ``eval_episodes`` steps apart share some of their seeds."""
     return EVAL_SEED + step
+
+
+def in_use(run) -> bool:
+    """Whether a live process holds the run directory's lock (``RunDir``)."""
+    lock = Path(run) / ".lock"
+    if not lock.exists():
+        return False
+    fd = os.open(lock, os.O_RDWR)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        return True
+    finally:
+        os.close(fd)  # (closing drops a lock taken here)
+    return False
 
 
 class RunDir:
@@ -320,12 +341,13 @@ def read_csv(path) -> list[dict]:
 
     path = Path(path)
     packed = path.with_name(path.name + ".gz")
-    if not path.exists() and packed.exists():
-        with gzip.open(packed, "rt", newline="") as f:
-            return [row for row in csv.DictReader(f) if None not in row.values()]
-    if not path.exists():
+    if path.exists():
+        opened = open(path, newline="")
+    elif packed.exists():
+        opened = gzip.open(packed, "rt", newline="")
+    else:
         return []
-    with open(path, newline="") as f:
+    with opened as f:
         return [row for row in csv.DictReader(f) if None not in row.values()]  # a torn last line
 
 

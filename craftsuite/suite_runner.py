@@ -208,8 +208,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
                                 teachers=teachers, teacher_root=out / "teachers", log=log, device=device)
     finally:  # what finished is kept, whatever stopped the rest
         if kept is not None:
-            try:
-                record_session(out, session, None)
+            try:  # (the session is on record in out since it started)
                 keep_all(out, kept, names, suite=dataclasses.asdict(suite))  # as run: pages read its settings
             except Exception as err:  # never in place of what stopped the runs
                 log(f"results archive {kept}: not updated ({type(err).__name__}: {err})")
@@ -223,7 +222,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         movie = _best_student_video(students, out, log)
     record_session(out, session, time.perf_counter() - clock)
     if kept is not None:
-        keep_all(out, kept, names)  # this session's duration
+        keep_all(out, kept, {})  # the runs are kept already: this session's duration
         log(f"results archive {kept}: {archive_size(kept) / 1e6:.1f} MB")
     return TransferResult(out, {task: out / "teachers" / t.run_name() for task, t in teachers.items()},
                           students, board_md, plots, movie)

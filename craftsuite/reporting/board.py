@@ -332,15 +332,11 @@ class Comparison:
     difference: stats.Estimate  # its mean minus the baseline's, with Welch's t-interval
     improvement: stats.Estimate  # P(a run of it beats a run of the baseline), stratified bootstrap
     verdict: str  # "ahead", "behind", "no difference of 0.2 or more [(...)]", "undecided", "too few seeds"
+    trivial: bool = False  # decided only because every seed of both sat at 0 (or at 1)
 
     @property
     def decided(self) -> bool:
-        return self.verdict not in ("undecided", "too few seeds")
-
-    @property
-    def trivial(self) -> bool:
-        """Decided only because every seed of both sat at 0 (or at 1)."""
-        return self.verdict.endswith("at 0)") or self.verdict.endswith("at 1)")
+        return self.verdict not in ("undecided", "too few seeds", "not measured")
 
 
 def compare(entry: Entry, baseline: Entry) -> Comparison:
@@ -372,6 +368,7 @@ def compare(entry: Entry, baseline: Entry) -> Comparison:
         said = f"no difference of {SMALLEST_DIFFERENCE:g} or more"
         if {*mine, *theirs} in ({0.0}, {1.0}):  # said plainly: no comparison tells methods apart there
             said += " (every seed of both at 0)" if mine[0] == 0 else " (every seed of both at 1)"
+            return Comparison(diff, better, said, trivial=True)
     else:
         said = "undecided"
     return Comparison(diff, better, said)

@@ -21,8 +21,9 @@ from craftsuite.ids import cont_id
 from craftsuite.rollouts import rollout
 from craftsuite.scripted import scripted_policy
 from craftsuite.suites import SUITES
+from craftsuite.task_registry import ladder
 
-RUNGS = ("KeySwordDragon", "ToolHome", "TwoToolsHome")  # the built-in tasks tagged "middle"
+RUNGS = tuple(spec.name for spec in ladder("middle"))  # KeySwordDragon, ToolHome, TwoToolsHome
 
 
 def check(episodes: int = 50) -> None:

@@ -11,7 +11,7 @@ import pytest
 from craftsuite import archive
 from craftsuite.cli import main
 from craftsuite.reporting.board import build
-from craftsuite.runs import EPISODE_FIELDS, EVAL_FIELDS, read_csv, settings, write_csv
+from craftsuite.runs import EPISODE_FIELDS, EVAL_FIELDS, read_csv, record_key, settings, write_csv
 from craftsuite.suites import SUITES
 
 
@@ -19,7 +19,7 @@ def _run(root, name="student-Reach-Cont-td3-s0", seed=0, kind="student", steps=1
     """A finished run directory whose name carries its record's key, as a real run's does."""
     record = {"task": "Reach", "world": "Cont", "method": "td3", "seed": seed, "steps": steps,
               "format": 2, "provenance": [{"commit": "abc"}]}
-    run = root / f"{name}-{archive.record_key(record)}"
+    run = root / f"{name}-{record_key(record)}"
     run.mkdir(parents=True)
     (run / "config.json").write_text(json.dumps(record))
     write_csv(run / "evals.csv", EVAL_FIELDS, [{"step": steps, "success": 0.5, "return": 1.0, "episodes": 4}])
@@ -137,3 +137,24 @@ def test_transfer_flags_choose_the_archive(tmp_path, monkeypatch):
     # settings beyond the suite's (a smoke test's budget) stay out of the archive unless asked for
     assert main(args + ["--suite", "standard", "--steps", "1000"]) == 0 and seen["standard"] is None
     assert main(args + ["--suite", "standard", "--steps", "1000", "--archive", "x"]) == 0 and seen["standard"] == "x"
+
+
+def test_restore_leaves_a_run_a_live_process_holds(tmp_path):
+    import fcntl
+    import os
+
+    store = tmp_path / "results" / "quick"
+    kept = archive.keep(_run(tmp_path / "a" / "students"), store, "students")
+    out = tmp_path / "out"
+    busy = _run(out / "students")
+    (busy / "result.json").unlink()  # unfinished, and training now: its lock is held
+    (busy / ".lock").write_text("")
+    fd = os.open(busy / ".lock", os.O_RDWR)
+    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    try:
+        said = []
+        assert archive.restore(store, out, {"students": {kept.name}}, log=said.append)["students"] == 0
+        assert (busy / "model.zip").exists() and any("in use by a live run" in s for s in said)
+    finally:
+        os.close(fd)
+    assert archive.restore(store, out, {"students": {kept.name}})["students"] == 1  # released: restored

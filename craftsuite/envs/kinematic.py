@@ -74,7 +74,11 @@ class KinematicWorldEnv(PlanarWorld):
     ## Episode End
     Terminated when a tile that ends the episode acts (for tasks without one: on
     acceptance or violation); truncated at 1000 steps by TimeLimit. ``is_success`` says
-    whether the automaton accepts.
+    whether the task was completed as the board defines it: a tile that ends the episode
+    acted and the automaton accepts (for tasks without such a tile: the automaton
+    accepts). The automaton may accept before: a place labelled by its cell (Blind
+    Craftsman's home, ``[0, 1)^2``) holds in the whole cell, where the tile acts only
+    within ``pickup_radius``; ``info["automaton_state"]`` shows that acceptance.
 
     ## Rendering
     ``rgb_array``: a top-down drawing of the board, ``(height, width, 3)`` uint8 (240 by
@@ -241,6 +245,10 @@ class KinematicWorldEnv(PlanarWorld):
         self._write_observation()
         bonus, done, info = self.tracker.advance(mask)
         if self.board.ends_by_tile:  # the tiles pay and end the episode, as the authors' do
+            # success is completion: a tile ended the episode with the objective met. The
+            # automaton alone accepts earlier where a place is labelled by its whole cell
+            # (Blind Craftsman's home), a step that pays nothing and ends nothing here
+            info["is_success"] = ended and info["is_success"]
             return self._obs.copy(), reward, ended, False, info
         return self._obs.copy(), reward + bonus, done or ended, False, info
 

@@ -195,6 +195,8 @@ class CraftVectorEnv(VectorEnv):
         if self._objective_ends:
             rewards += np.where(success, self._completion, 0.0)  # reward + bonus, as the single env adds them
             terminated |= success | violation
+        else:  # success is completion: the world ended the episode with the objective met
+            success &= terminated
         self._elapsed += active
         truncated = active & (self._elapsed >= self.max_episode_steps) if self.max_episode_steps \
             else np.zeros(n, dtype=bool)

@@ -126,8 +126,51 @@ def test_home_with_three_tools_pays_100_ends_the_episode_and_accepts():
     # inside home's cell but not within reach: at_home and tools3 hold, home does not act
     obs, reward, term, _, info = env.step(np.array([-0.1, -0.1], dtype=np.float32))
     assert not term and reward == pytest.approx(-0.1) and set(info["labels"]) >= {"home", "tools3"}
+    # the automaton accepts there, but the task is not complete: the board's home has not acted
+    assert env.automaton.accepting[info["automaton_state"]] and not info["is_success"]
     obs, reward, term, _, info = env.step(np.array([-0.15, -0.15], dtype=np.float32))  # to (0.15, 0.15)
     assert term and info["is_success"] and reward == pytest.approx(-0.1 + 100)
+
+
+def test_a_tile_that_ends_the_episode_with_the_objective_unmet_is_no_success():
+    """Gold Mine's home acts with ten silver even where the automaton was violated (the
+    agent crossed home's cell before the tenth silver): +100 and the end, but no success."""
+    env = gym.make("CraftSuite/GoldMine-Kinematic-v0").unwrapped
+    env.reset(seed=0)
+    clear_objects(env)
+    home = env._kinds.index(next(k for k, o in enumerate(env.task.objects) if o.name == "home"))
+    env._positions[home] = (0.0, 0.0)
+    env._position = np.array([0.9, 0.9])
+    _, _, term, _, info = env.step(np.array([-0.1, -0.1], dtype=np.float32))  # in home's cell, no silver
+    assert not term and info["violation"]
+    env.inventory_counts[env.rules.inventory_names.index("silver")] = 10
+    _, reward, term, _, info = env.step(np.array([-0.15, -0.15], dtype=np.float32))  # home acts
+    assert term and reward == pytest.approx(-0.1 + 100) and not info["is_success"]
+
+
+@pytest.mark.parametrize("mode", ["single", "vector"])
+def test_random_play_completes_blind_craftsman_as_often_as_the_authors_board(mode):
+    """Uniformly random actions end 11.9-12.4% of 1,000-step episodes at home on the authors'
+    own board (5,000 episodes); the automaton alone accepts in about 41%. Success here is
+    completion: each env's first episode, so that short episodes are not over-counted."""
+    n = 3000 if mode == "vector" else 300
+    rng = np.random.default_rng(0)
+    if mode == "vector":
+        env = gym.make_vec(BC, num_envs=n, vectorization_mode="vector_entry_point", autoreset_mode="SameStep")
+        env.reset(seed=0)
+        over, success = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+        while not over.all():
+            _, _, term, trunc, info = env.step(rng.uniform(-1, 1, (n, 2)))
+            ended = (term | trunc) & ~over
+            if ended.any():
+                success[ended] = info["final_info"]["is_success"][ended]
+            over |= ended
+    else:
+        env = gym.make(BC)
+        success = np.array([run_episode(env, lambda obs: rng.uniform(-1, 1, 2).astype(np.float32), seed=s)[2]
+                            ["is_success"] for s in range(n)])
+    half_width = 2.5 * np.sqrt(0.12 * 0.88 / n)  # 2.5 standard errors around the authors' figure
+    assert 0.119 - half_width <= success.mean() <= 0.124 + half_width, success.mean()
 
 
 def test_the_authors_observation_and_craftsuites():

@@ -8,7 +8,7 @@ from .rendering.gl import configure_gl
 configure_gl()  # before anything imports mujoco
 
 from .automata import Automaton, compile_ltlf  # noqa: E402
-from .registration import make_grid, register_builtin, register_task, registered_ids  # noqa: E402
+from .registration import make_grid, make_vec, register_builtin, register_task, registered_ids  # noqa: E402
 from .spec import SpecError, TaskSpec, load_spec  # noqa: E402
 from .task_registry import ladder, resolve_task, tasks  # noqa: E402
 from .wrappers import AutomatonObservation  # noqa: E402
@@ -16,7 +16,7 @@ from .wrappers import AutomatonObservation  # noqa: E402
 __version__ = "0.1.0"
 __all__ = [
     "Automaton", "AutomatonObservation", "SpecError", "TaskSpec", "compile_ltlf", "ladder", "load_spec",
-    "make_grid", "register_task", "registered_ids", "resolve_task", "tasks",
+    "make_grid", "make_vec", "register_task", "registered_ids", "resolve_task", "tasks",
 ]
 
 register_builtin()

@@ -168,11 +168,14 @@ def _scripted(args) -> int:
 def _video(args) -> int:
     from .ids import is_id, parse_id
     from .rollouts import record_video
+    from .task_registry import resolve_task
 
     if is_id(args.target):
         if args.world is not None:
             raise ValueError(f"--world picks the world of a task; {args.target} is an id, which names its own")
-        env_id = args.target
+        task, world = parse_id(args.target)
+        # an unregistered id: its task or its world named as elsewhere, not gymnasium's guess
+        env_id = _registered(resolve_task(task).name, world)
     else:
         env_id = _registered(_task(args.target), args.world or "Cont")
     env = _world_kwargs(args.env, parse_id(env_id)[1])
@@ -421,6 +424,16 @@ def _positive(text: str) -> int:
     return value
 
 
+def _positive_float(text: str) -> float:
+    value = float(text)
+    if not 0 < value < float("inf"):  # nan and inf are no rate either
+        raise argparse.ArgumentTypeError(f"must be a number above 0, got {text}")
+    return value
+
+
+_positive_float.__name__ = "number"  # argparse names a non-number "invalid number value"
+
+
 def _seed(text: str) -> int:
     value = int(text)
     if value < 0:
@@ -610,7 +623,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--episodes", type=_positive, default=1, help="episodes to record (default: 1)")
     p.add_argument("--out", default="rollout.mp4", help="output .mp4 (default: rollout.mp4)")
     p.add_argument("--seed", type=_seed, default=0, help="seed of the first episode (default: 0)")
-    p.add_argument("--fps", type=float, help="frames per second (default: the world's pace, the env's "
+    p.add_argument("--fps", type=_positive_float, help="frames per second (default: the world's pace, the env's "
                    "render_fps decisions a second; continuous worlds' motion is drawn between decisions)")
     p.add_argument("--product", action="store_true",
                    help="make the env with product=True (for checkpoints trained on the product MDP)")

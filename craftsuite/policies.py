@@ -32,8 +32,25 @@ def _load_checkpoint(path: Path, env):
         raise FileNotFoundError(
             f"no such checkpoint {str(path)!r}; a policy is 'random', 'scripted' or a checkpoint file")
     model = load_agent(path)
-    if model.observation_space.shape != env.observation_space.shape:
-        raise ValueError(
-            f"{path}: the policy expects observations of shape {model.observation_space.shape}, "
-            f"the env gives {env.observation_space.shape} (another task, or product=True missing?)")
+    _check_observations(path, model.observation_space.shape, env)
     return lambda obs: model.predict(np.asarray(obs), deterministic=True)[0]
+
+
+def _check_observations(path: Path, shape: tuple, env) -> None:
+    """Raise a ValueError when a checkpoint's observation ``shape`` is not ``env``'s, saying
+    whether the checkpoint was trained with the automaton state (product=True) or without it."""
+    if shape == env.observation_space.shape:
+        return
+    plain = env.unwrapped.observation_space.shape  # the world's own, under AutomatonObservation
+    automaton = getattr(env.unwrapped, "automaton", None)
+    product = (plain[0] + automaton.n_states,) if automaton is not None and len(plain) == 1 else None
+    if shape == plain:
+        raise ValueError(f"{path}: the policy's observation size {shape[0]} matches the plain observation "
+                         "(trained without the automaton state); drop --product")
+    if shape == product:
+        raise ValueError(f"{path}: the policy's observation size {shape[0]} matches the observation with the "
+                         "automaton state (trained with it); add --product")
+    name = env.spec.id if env.spec is not None else "the env"
+    sizes = f"{plain}" + (f" ({product} with the automaton state)" if product else "")
+    raise ValueError(f"{path}: the policy's observation shape {shape} is not {name}'s, {sizes}; "
+                     "use a policy trained on this task and world (with the --env of its training)")

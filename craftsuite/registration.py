@@ -2,7 +2,8 @@
 
 The tasks themselves live in ``task_registry`` (names, ladder, user specs), the id format in
 ``ids``; this module registers each task's ids with gymnasium and holds their entry points
-(``make_grid``, ``make_continuous``, ``make_kinematic``). Their names stay importable from here.
+(``make_grid``, ``make_continuous``, ``make_kinematic``; ``make_grid_vector``) and ``make_vec``,
+gymnasium's with ``num_envs`` checked in every mode. Their names stay importable from here.
 """
 
 from __future__ import annotations
@@ -13,13 +14,15 @@ from pathlib import Path
 
 import gymnasium as gym
 
-from .ids import CONT, NAMESPACE, WORLD_KINDS, cont_id, grid_id, kinematic_id, parse_id, world_kind  # noqa: F401  (re-exported)
+from .ids import CONT, NAMESPACE, WORLD_KINDS, cont_id, grid_id, grid_size, kinematic_id, parse_id, world_kind  # noqa: F401  (re-exported)
 from .ids import KINEMATIC as KINEMATIC_WORLD
 from .spec import KINEMATIC_CONFIG, TaskSpec
 from .task_registry import add_task, carried, ladder, resolve_task, tasks  # noqa: F401  (re-exported)
 
 # gymnasium.make's own keywords: it takes them itself, so a world's entry point never sees them
 MAKE_KEYWORDS = ("max_episode_steps", "disable_env_checker")
+# registered with every grid id: the id itself, so its entry points can refuse another size
+ID_KEYWORD = "env_id"
 _ENTRY_POINTS: dict[str, object] = {}  # world ("Grid", "Cont", "Kinematic") -> its entry point, unchecked
 _WORLD_NAMES = {"Grid": "grid", CONT: "MuJoCo", KINEMATIC_WORLD: "kinematic"}
 # keywords another world takes that a world refuses for a reason of its own, stated in the error
@@ -69,6 +72,32 @@ def _entry_key(world: str) -> str:
     return world if world in _ENTRY_POINTS else "Grid" if world_kind(world) == "Grid" else world
 
 
+def _check_grid_size(kwargs: dict) -> None:
+    """Raise a ValueError when a grid id is made with a ``size`` other than its own.
+
+    gymnasium merges a caller's keywords over the id's registered ones, so the entry point
+    cannot tell the id's ``size`` from a caller's; the id itself, registered under
+    ``ID_KEYWORD``, says which it is. Pops ``ID_KEYWORD`` (no world takes it).
+    """
+    name = kwargs.pop(ID_KEYWORD, None)
+    if name is None or "size" not in kwargs:
+        return
+    task, world = parse_id(name)
+    size, fixed = kwargs["size"], grid_size(world)
+    if size != fixed:
+        raise ValueError(f"size={size!r}: {name} is the {fixed}x{fixed} grid (its id fixes the size); "
+                         f"{_grid_fix(task, size)}")
+
+
+def _grid_fix(task: str, size) -> str:
+    """What to do instead of giving a grid id another ``size``: that size's id, or the task's grids."""
+    if isinstance(size, int) and size > 0 and grid_id(task, size) in gym.registry:
+        return f"use {grid_id(task, size)}"
+    grids = sorted((w for t, w in map(parse_id, registered_ids()) if t == task and world_kind(w) == "Grid"),
+                   key=grid_size)
+    return f"leave size out ({task}'s grids: {', '.join(grids)})"
+
+
 def _entry_point(world: str):
     """A world's entry point, its keywords checked first (``check_world_kwargs``): every
     gymnasium.make of a CraftSuite id goes through one."""
@@ -77,6 +106,7 @@ def _entry_point(world: str):
 
         @functools.wraps(make)
         def checked(*args, **kwargs):
+            _check_grid_size(kwargs)
             check_world_kwargs(world, kwargs)
             return make(*args, **kwargs)
         return checked
@@ -139,7 +169,35 @@ def make_kinematic(task: str | TaskSpec, product: bool = False, render_mode: str
 make_kinematic.metadata = {"render_modes": ["rgb_array"], "render_fps": 8}
 
 
-_VECTOR = {"grid": "craftsuite.envs.vector:make_grid_vector",
+def make_grid_vector(num_envs: int, **kwargs) -> gym.vector.VectorEnv:
+    """Vector entry point of the grid ids: ``craftsuite.envs.vector.make_grid_vector``, the
+    id's size checked first (as ``make_grid``'s)."""
+    from .envs.vector import make_grid_vector as make
+
+    _check_grid_size(kwargs)
+    return make(num_envs, **kwargs)
+
+
+def check_num_envs(num_envs) -> None:
+    """Raise a ValueError unless ``num_envs`` is a positive integer (every vectorization mode)."""
+    if not isinstance(num_envs, int) or isinstance(num_envs, bool) or num_envs < 1:
+        raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
+
+
+def make_vec(id: str | gym.envs.registration.EnvSpec, num_envs: int = 1, vectorization_mode=None,
+             **kwargs) -> gym.vector.VectorEnv:
+    """``gymnasium.make_vec``, ``num_envs`` checked first in every vectorization mode.
+
+    gymnasium's "sync" and "async" modes build ``num_envs`` single envs and read the first
+    one, so with none they fail with an IndexError before any CraftSuite code runs; their
+    make_vec has no hook for a check (the "vector_entry_point" mode checks in the vector env).
+    """
+    check_num_envs(num_envs)
+    return gym.make_vec(id, num_envs=num_envs, vectorization_mode=vectorization_mode, **kwargs)
+
+
+# the grid's passes through make_grid_vector above, which checks the id's size
+_VECTOR = {"grid": "craftsuite.registration:make_grid_vector",
            "kinematic": "craftsuite.envs.vector:make_kinematic_vector",
            # a module of its own: craftsuite.envs.vector stays free of MuJoCo
            "continuous": "craftsuite.envs.continuous_vector:make_continuous_vector"}
@@ -152,7 +210,8 @@ def _register(spec: TaskSpec) -> list[str]:
     # (id, entry point, vector entry point, kwargs, max steps); the vector entry points are
     # the natively vectorized worlds of craftsuite.envs.vector and, for the MuJoCo ids,
     # craftsuite.envs.continuous_vector (make_vec's "vector_entry_point"; strings, imported lazily)
-    worlds = [(grid_id(spec.name, size), "make_grid", _VECTOR["grid"], {"size": size}, spec.grid.max_steps)
+    worlds = [(grid_id(spec.name, size), "make_grid", _VECTOR["grid"],
+               {"size": size, ID_KEYWORD: grid_id(spec.name, size)}, spec.grid.max_steps)
               for size in spec.grid.sizes]
     worlds.append((cont_id(spec.name), "make_continuous", _VECTOR["continuous"], {}, spec.continuous.max_steps))
     worlds.append((kinematic_id(spec.name), "make_kinematic", _VECTOR["kinematic"], {}, KINEMATIC_CONFIG.max_steps))

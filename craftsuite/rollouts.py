@@ -110,7 +110,7 @@ def record_video(env_id: str, policy: str = "scripted", episodes: int = 1, out: 
         per_decision = 1
         if hasattr(world, "set_frames_per_decision"):
             per_decision = world.set_frames_per_decision(math.ceil(SMOOTH_FPS / decisions_per_second))
-        fps = fps or decisions_per_second * per_decision
+        fps = decisions_per_second * per_decision if fps is None else fps  # 0 is VideoWriter's to refuse
         with VideoWriter(out, fps) as video:
             def on_step(episode, reward, info):
                 for frame in world.motion_frames() if per_decision > 1 else [env.render()]:

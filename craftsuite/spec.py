@@ -57,6 +57,7 @@ Format (see ``tasks/blind_craftsman.toml`` for a full example)::
 
 from __future__ import annotations
 
+import math
 import re
 import tomllib
 from dataclasses import dataclass, field, fields, is_dataclass
@@ -721,12 +722,33 @@ def _continuous(r: _Reader, data: dict, n_objects: int) -> ContinuousConfig:
         continuous.frame_skip()
     except ValueError as err:
         r.fail("continuous.control_period", str(err))
-    spacing = 2 * continuous.pickup_radius
-    per_side = int((continuous.arena - spacing) // spacing)
-    if n_objects + 1 > per_side * per_side:
-        r.fail("continuous", f"{n_objects} objects and the agent cannot get non-overlapping pickup "
-                             f"zones in a {continuous.arena} arena (at most {per_side * per_side - 1})")
+    if not _zones_fit(continuous.arena, continuous.pickup_radius, n_objects):
+        r.fail("continuous.arena", _no_room(continuous.arena, continuous.pickup_radius, n_objects))
     return continuous
+
+
+def _zones_fit(arena: float, pickup_radius: float, n_objects: int) -> bool:
+    """Whether the objects and the agent get non-overlapping pickup zones (2 x pickup_radius
+    wide): ``(arena - spacing) // spacing`` of them a side, a conservative count."""
+    spacing = 2 * pickup_radius
+    per_side = max(0, int((arena - spacing) // spacing))  # an arena narrower than one zone holds none, not (-1)**2
+    return n_objects + 1 <= per_side * per_side
+
+
+def _no_room(arena: float, pickup_radius: float, n_objects: int) -> str:
+    """The problem and its fix when the pickup zones do not fit: the least arena that holds
+    them, or the largest pickup_radius this arena allows, as numbers ``_zones_fit`` accepts."""
+    side = math.isqrt(n_objects) + 1  # zones a side for n_objects + 1 of them
+    least = math.ceil(round(2 * pickup_radius * (side + 1) * 1000, 6)) / 1000  # 3 decimals, up
+    while not _zones_fit(least, pickup_radius, n_objects):  # float rounding
+        least = round(least + 0.001, 3)
+    most = math.floor(round(arena / (2 * (side + 1)) * 1000, 6)) / 1000
+    while most > 0 and not _zones_fit(arena, most, n_objects):
+        most = round(most - 0.001, 3)
+    instead = f" (or pickup_radius at most {most:g})" if most > 0 else ""
+    return (f"{n_objects} objects and the agent need {n_objects + 1} non-overlapping pickup zones "
+            f"{2 * pickup_radius:g} wide (2 x pickup_radius), which an arena of {arena:g} cannot hold; "
+            f"make arena at least {least:g}{instead}")
 
 
 def _tags(r: _Reader, data: dict) -> tuple[str, ...]:

@@ -62,8 +62,8 @@ def test_video_loads_craftsuite_agents(tmp_path, capsys):
                  str(tmp_path / "teacher.zip"), "--out", str(out)]) == 0
     assert out.stat().st_size > 0
     assert main(["video", "CraftSuite/DungeonQuest-Grid7-v0", "--policy",
-                 str(tmp_path / "teacher.zip"), "--out", str(out)]) == 2  # product=True missing
-    assert "product=True missing" in capsys.readouterr().err
+                 str(tmp_path / "teacher.zip"), "--out", str(out)]) == 2  # --product missing
+    assert "trained with it); add --product" in capsys.readouterr().err
 
 
 def test_an_output_path_that_cannot_be_written_is_one_line(tmp_path, capsys):

@@ -46,6 +46,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from ..registration import check_num_envs
 from ..spec import TaskSpec
 from ..wrappers import AutomatonObservation
 from .cells import EMPTY, MOVES
@@ -65,8 +66,7 @@ class CraftVectorEnv(VectorEnv):
 
     def __init__(self, template: gym.Env, num_envs: int, product: bool,
                  max_episode_steps: int | None, autoreset_mode: str | AutoresetMode):
-        if not isinstance(num_envs, int) or isinstance(num_envs, bool) or num_envs < 1:
-            raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
+        check_num_envs(num_envs)  # the one check of every vectorization mode (craftsuite.make_vec)
         if not isinstance(product, bool):
             raise ValueError(f"product must be True or False, got {product!r}")
         if max_episode_steps is not None and (not isinstance(max_episode_steps, int) or max_episode_steps < 1):

@@ -187,3 +187,15 @@ def test_an_objective_that_can_never_be_satisfied_is_refused_when_added(tmp_path
     assert "Never" not in task_registry.tasks() and not [i for i in gym.registry if "Never" in i]
     spec = load_spec(write(tmp_path, GOOD))  # a satisfiable one: the automaton reaches acceptance
     assert spec.automaton.satisfiable and spec.automaton.accepts([spec.automaton.mask({"coin"})])
+
+
+def test_an_arena_too_small_for_the_objects_names_the_least_that_holds_them(tmp_path):
+    small = GOOD + "\n[continuous]\narena = 1.0\npickup_radius = 0.5\n"
+    path = write(tmp_path, small)
+    with pytest.raises(SpecError) as err:
+        load_spec(path)
+    assert str(err.value) == (f"{path}: continuous.arena: 3 objects and the agent need 4 non-overlapping pickup "
+                              "zones 1 wide (2 x pickup_radius), which an arena of 1 cannot hold; make arena at "
+                              "least 3 (or pickup_radius at most 0.166)")
+    load_spec(write(tmp_path, small.replace("arena = 1.0", "arena = 3")))  # either fix it names loads
+    load_spec(write(tmp_path, small.replace("pickup_radius = 0.5", "pickup_radius = 0.166")))

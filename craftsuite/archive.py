@@ -16,9 +16,10 @@ restored from here says it has no model). ``episodes.csv``, one row per training
 and the largest record, is kept compressed (``runs.read_csv`` reads either form).
 
 A record is checked before it is used: its ``config.json`` and ``result.json`` must read
-as a finished run's and the directory's name must be the run key of the settings it
-records. One that does not (damaged, or copied in from elsewhere under another name) is
-named and skipped, never pooled.
+as a finished run's, its ``evals.csv`` must hold its evaluations and the directory's name
+must be the run key of the settings it records. One that does not (damaged, or copied in
+from elsewhere under another name) is named and skipped, never pooled. ``craftsuite
+archive`` also skips, by name, a run of a task, world or method its suite does not run.
 """
 
 from __future__ import annotations
@@ -27,12 +28,14 @@ import gzip
 import json
 import secrets
 import shutil
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from .completion import needs_reread, reread_in_place, reread_logs
 from .files import atomic_path, atomic_write
-from .runs import RunError, in_use, read_config, record_key
+from .runs import RunError, in_use, read_config, read_csv, record_key
 
 RECORDS = ("config.json", "result.json", "evals.csv", "table.npz")  # kept as they are (table.npz: teachers)
 COMPRESSED = ("episodes.csv",)  # kept as <name>.gz
@@ -41,9 +44,9 @@ KINDS = ("teachers", "students")
 
 def check_record(run: Path, kind: str | None = None) -> str | None:
     """Why the run at ``run`` cannot be archived or used from the archive (None: it can): a
-    missing or damaged record, an unfinished run, a result of another kind than ``kind``
-    (``teachers``, ``students``; by default the name of the run's parent directory), or a
-    directory name that is not its settings' run key."""
+    missing or damaged record (its evaluations too), an unfinished run, a result of another
+    kind than ``kind`` (``teachers``, ``students``; by default the name of the run's parent
+    directory), or a directory name that is not its settings' run key."""
     try:
         record = read_config(run)
     except RunError as err:
@@ -68,6 +71,32 @@ def check_record(run: Path, kind: str | None = None) -> str | None:
     if other:
         return (f"{result} is another run's result ({', '.join(f'{f} {outcome[f]!r}' for f in other)}, where "
                 f"config.json records {', '.join(repr(record[f]) for f in other)}): a record from elsewhere")
+    return _check_evals(run / "evals.csv") or _check_success(run, record)
+
+
+def _check_success(run: Path, record: dict) -> str | None:
+    """Why a record whose success counted acceptance cannot be re-read as completion
+    (``completion``; None: it can, or it needs no re-reading)."""
+    try:
+        if needs_reread(record):
+            reread_logs(run, record)
+    except RunError as err:
+        return f"{run}: {err}"
+    return None
+
+
+def _check_evals(evals: Path) -> str | None:
+    """Why a finished run's ``evals.csv`` is not a record of its evaluations (None: it is).
+    Every run, teacher or student, evaluates at its end: a record without one is damaged,
+    and the leaderboard could not read it."""
+    if not evals.is_file():  # (never kept compressed: the archive keeps this one as it is)
+        return f"{evals} is missing: a finished run's record has its evaluations (the last at its end)"
+    try:
+        rows = read_csv(evals, ("step", "success"))
+    except (ValueError, OSError) as err:
+        return f"{evals} does not read as a run's log ({err}): the record is damaged"
+    if not rows:
+        return f"{evals} holds no evaluation: a finished run's record has one at least (at its end)"
     return None
 
 
@@ -92,7 +121,8 @@ def keep(run: Path, archive: Path, kind: str) -> Path:
     there); returns that directory.
 
     Raises:
-        RunError: the run is not finished (it has no result.json).
+        RunError: the run is not finished (it has no result.json), or its success counted
+            the automaton's acceptance and its record cannot say what completed (``completion``).
     """
     run = Path(run)
     if not (run / "result.json").exists():
@@ -118,6 +148,11 @@ def keep(run: Path, archive: Path, kind: str) -> Path:
             with atomic_path(dest / f"{name}.gz") as tmp:
                 shutil.copyfile(run / f"{name}.gz", tmp)
     shutil.copyfile(run / "result.json", dest / "result.json")
+    try:
+        reread_in_place(dest)  # a record whose success counted acceptance is kept as completion
+    except BaseException:
+        shutil.rmtree(dest, ignore_errors=True)
+        raise
     old = final.with_name(f".{run.name}.{secrets.token_hex(4)}.old")
     if final.exists():
         final.rename(old)
@@ -152,10 +187,13 @@ def restore(archive: Path, out: Path, names: dict[str, set[str]], log=print) -> 
     return restored
 
 
-def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict | None = None) -> dict[str, int]:
+def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict | None = None,
+             log=print) -> dict[str, int]:
     """Archive the finished runs of ``out`` named in ``names`` (kind -> run names), the
     suite as run (``suite.json``) and every session that ran into ``out`` (merged into the
-    archive's ``provenance.json`` by session id). Returns how many of each kind were kept."""
+    archive's ``provenance.json`` by session id). A run that cannot be kept (a record whose
+    success cannot be re-read) is named through ``log``; the others are kept all the same.
+    Returns how many of each kind were kept."""
     from .provenance import FILE, read
 
     out, archive = Path(out), Path(archive)
@@ -165,7 +203,11 @@ def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict |
         for name in sorted(names.get(kind, set())):
             run = out / kind / name
             if (run / "result.json").exists() and not _same(run, archive / kind / name):
-                keep(run, archive, kind)
+                try:
+                    keep(run, archive, kind)
+                except RunError as err:
+                    log(f"results archive {archive}: not kept: {err}")
+                    continue
                 count += 1
         kept[kind] = count
     if suite is not None:
@@ -183,9 +225,23 @@ def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict |
 
 
 def _same(run: Path, archived_run: Path) -> bool:
-    """Whether the archive already holds this run's result (a run restored from it, or kept before)."""
+    """Whether the archive already holds this run's result as this version reads it (a run
+    restored from it, or kept before, its success re-read or not: ``completion``). An
+    archived record whose success still counts acceptance is not (keeping it re-reads it)."""
     theirs = archived_run / "result.json"
-    return theirs.exists() and theirs.read_bytes() == (run / "result.json").read_bytes()
+    if not theirs.exists():
+        return False
+    try:
+        mine, held = (json.loads((p / "result.json").read_text()) for p in (run, archived_run))
+        return (isinstance(mine, dict) and isinstance(held, dict) and _unmarked(mine) == _unmarked(held)
+                and not needs_reread(read_config(archived_run)))
+    except (ValueError, RunError):  # unreadable there: keeping it again is what mends it
+        return False
+
+
+def _unmarked(result: dict) -> dict:
+    """A result without the mark of a re-reading: the same run's either way."""
+    return {k: v for k, v in result.items() if k != "success_reread"}
 
 
 def size(archive: Path) -> int:
@@ -193,44 +249,124 @@ def size(archive: Path) -> int:
     return sum(p.stat().st_size for p in Path(archive).rglob("*") if p.is_file())
 
 
-def add(source, archive: Path, suite: dict | None = None) -> tuple[dict[str, int], list[str]]:
-    """Archive the finished runs under ``source`` (a transfer output, with ``students/`` and
-    ``teachers/``, or a directory of student runs), with the sessions of its
-    ``provenance.json`` and its ``suite.json`` (the suite as it ran; else ``suite``, the
-    suite's definition): runs made without the archive, or on another machine. Returns how
-    many of each kind were kept and why each other run was skipped. (Runs of other budgets
-    or settings than the suite's own are kept too, as ``--steps`` makes them: the
-    leaderboard never pools them with the suite's.)
+def outside(record: dict, kind: str, suite, rungs: list[str]) -> str | None:
+    """Why a run (``record``: its config.json) is not one of ``suite``'s (a ``suites.Suite``
+    whose rungs are ``rungs``): a task it does not run or, for a student, a world or method.
+    None: it is one. Its budget and other settings are not asked (see ``add``)."""
+    asked = [("task", rungs)] + ([("world", suite.worlds), ("method", suite.methods)] if kind == "students" else [])
+    for field, known in asked:
+        if record.get(field) not in known:
+            return (f"{field} {record.get(field)} is not one of suite {suite.name}'s {field}s ({', '.join(known)}): "
+                    "archive it with --suite set to the suite that ran it")
+    return None
+
+
+@dataclass
+class Source:
+    """A directory of runs read and checked for the archive (``scan``); nothing is kept yet."""
+
+    path: Path
+    runs: dict[str, list[Path]]  # kind -> the run directories to keep
+    skipped: list[str]  # why each other run is left out, naming it
+    suite: dict | None  # the suite to record: the source's suite.json, else the suite's definition
+
+
+def scan(source, suite=None) -> Source:
+    """The finished runs under ``source`` (a transfer output, with ``students/`` and
+    ``teachers/``, or a directory of student runs) that can be archived as runs of
+    ``suite`` (a ``suites.Suite``; None: of any), and why each other run cannot. Reads what
+    ``add`` uses (``suite.json``, ``provenance.json``) and writes nothing.
 
     Raises:
         FileNotFoundError: ``source`` is not a directory.
+        ValueError: no run under it (no directory holding a config.json or result.json),
+            or a damaged ``provenance.json``.
     """
+    from .provenance import read
+
     source = Path(source)
-    if not source.is_dir():
-        raise FileNotFoundError(f"no run directory at {source}")
-    roots = {kind: source / kind for kind in KINDS if (source / kind).is_dir()} or {"students": source}
-    skipped, found = [], {kind: set() for kind in KINDS}
-    for kind, root in roots.items():
-        for run in sorted(p for p in root.iterdir() if p.is_dir() and not p.name.startswith(".")):
+    found = _runs_under(source)
+    read(source)  # a damaged provenance.json, named before anything is kept (add merges it)
+    rungs = [spec.name for spec in suite.rungs()] if suite is not None else []
+    runs, skipped = {kind: [] for kind in KINDS}, []
+    for kind, candidates in found.items():
+        for run in candidates:
             if not (run / "result.json").exists():
                 skipped.append(f"{run}: not finished (no result.json)")
                 continue
             reason = check_record(run, kind)
+            if reason is None and suite is not None:
+                reason = outside(read_config(run), kind, suite, rungs)
+                reason = reason and f"{run}: {reason}"
             if reason is None:
-                found[kind].add(run.name)
+                runs[kind].append(run)
             else:
                 skipped.append(reason)
-    kept = {kind: 0 for kind in KINDS}
-    for kind, root in roots.items():
-        for name in sorted(found[kind]):
-            if not _same(root / name, Path(archive) / kind / name):
-                keep(root / name, archive, kind)
-                kept[kind] += 1
-    if (source / "suite.json").exists():
-        try:
-            suite = json.loads((source / "suite.json").read_text())
-        except ValueError as err:
-            skipped.append(f"{source / 'suite.json'} is not valid JSON ({err}): the registered suite is recorded")
-    keep_all(source, archive, {}, suite=suite)  # the sessions that made them, and the suite
-    return kept, skipped
+    return Source(source, runs, skipped, _suite_to_record(source, suite, skipped))
 
+
+def _runs_under(source: Path) -> dict[str, list[Path]]:
+    """The run directories under ``source`` by kind: those holding a run's record.
+
+    Raises:
+        FileNotFoundError: ``source`` is not a directory.
+        ValueError: it holds no run (or is one).
+    """
+    if not source.is_dir():
+        raise FileNotFoundError(f"no run directory at {source}")
+    roots = {kind: source / kind for kind in KINDS if (source / kind).is_dir()} or {"students": source}
+    found = {kind: sorted(p for p in root.iterdir() if p.is_dir() and not p.name.startswith(".")
+                          and ((p / "config.json").exists() or (p / "result.json").exists()))
+             for kind, root in roots.items()}
+    if any(found.values()):
+        return found
+    if (source / "config.json").exists():
+        raise ValueError(f"{source} is a run, not a directory of runs: give the directory that holds it "
+                         f"({source.parent})")
+    folders = sorted(p.name for root in roots.values() for p in root.iterdir() if p.is_dir())
+    raise ValueError(f"no runs found under {source}" + (f" (its folders {', '.join(folders[:3])}"
+                     f"{', ...' if len(folders) > 3 else ''} hold no run's record)" if folders else "")
+                     + ": give a transfer output or a directory of student runs")
+
+
+def _suite_to_record(source: Path, suite, skipped: list[str]) -> dict | None:
+    """The suite ``add`` records with the runs of ``source``: its ``suite.json`` (the suite as
+    it ran), else ``suite``'s definition; where its suite.json cannot be used, why, added
+    to ``skipped``."""
+    from dataclasses import asdict
+
+    registered = None if suite is None else asdict(suite)
+    path = source / "suite.json"
+    if not path.exists():
+        return registered
+    try:
+        ran = json.loads(path.read_text())
+    except ValueError as err:
+        skipped.append(f"{path} is not valid JSON ({err}): the registered suite is recorded")
+        return registered
+    if not isinstance(ran, dict):
+        skipped.append(f"{path} holds no suite (a JSON {type(ran).__name__}): the registered suite is recorded")
+        return registered
+    if suite is not None and ran.get("name") != suite.name:  # never another suite's over this one's
+        skipped.append(f"{path} is suite {ran.get('name')}'s, not {suite.name}'s: the registered suite is recorded")
+        return registered
+    return ran
+
+
+def add(source: Source, archive: Path) -> dict[str, int]:
+    """Archive the runs of ``source`` (``scan``), with the sessions of its
+    ``provenance.json`` and the suite it records: runs made without the archive, or on
+    another machine. Returns how many of each kind were kept: a run the archive holds
+    already is not kept again, and where none is kept, the archive's ``suite.json`` and
+    ``provenance.json`` are left as they are. (Runs of other budgets or settings than the
+    suite's own are kept too, as ``--steps`` makes them: the leaderboard never pools them
+    with the suite's.)"""
+    kept = {kind: 0 for kind in KINDS}
+    for kind, runs in source.runs.items():
+        for run in runs:
+            if not _same(run, Path(archive) / kind / run.name):
+                keep(run, archive, kind)
+                kept[kind] += 1
+    if any(kept.values()):
+        keep_all(source.path, archive, {}, suite=source.suite)  # the sessions that made them, and the suite
+    return kept

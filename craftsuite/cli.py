@@ -347,10 +347,15 @@ def _transfer(args) -> int:
     # when asked for: a smoke test would otherwise sit beside the suite's runs as a variant
     settings = {"student_steps", "teacher_max_steps", "eval_every", "dqn_hyperparameters", "teacher_hyperparameters",
                 "cont_world_kwargs", "kinematic_world_kwargs", "td3_hyperparameters", "engine"}
-    own = suite.archived and not settings & set(changes)
+    # and a rung, world or method the suite does not run would be filed under a suite it is not part of
+    registered = SUITES[args.suite]
+    beyond = ({s.name for s in suite.rungs()} - {s.name for s in registered.rungs()}
+              or set(suite.worlds) - set(registered.worlds) or set(suite.methods) - set(registered.methods))
+    own = suite.archived and not settings & set(changes) and not beyond
     archive = None if args.no_archive or not (args.archive or own) else (args.archive or "results")
     if suite.archived and not own and archive is None and not args.no_archive:
-        print("(settings beyond the suite's: no results archive unless --archive DIR is given)")
+        print(f"({'rungs, worlds or methods' if beyond else 'settings'} beyond the suite's: no results archive "
+              "unless --archive DIR is given)")
     result = transfer(suite, out, workers=args.workers, ray=args.ray, video=not args.no_video, command=command_line(),
                       device=args.device, archive=archive)
     print(f"leaderboard: {result.leaderboard} (and .csv)")
@@ -362,33 +367,42 @@ def _transfer(args) -> int:
 
 
 def _archive(args) -> int:
-    import dataclasses
-
-    from .archive import add, size
-    from .provenance import command_line, record_session, start_session
+    from .archive import add, scan, size
+    from .files import directory_to_write
+    from .provenance import command_line, read, record_session, start_session
     from .suites import SUITES
 
     if args.suite not in SUITES:
         raise KeyError(f"unknown suite {args.suite!r}; suites: {sorted(SUITES)}")
     session = start_session(command_line())
-    archive = Path(args.archive) / args.suite
-    kept, total = {"teachers": 0, "students": 0}, 0
-    for source in args.runs:
-        more, skipped = add(source, archive, suite=dataclasses.asdict(SUITES[args.suite]))
-        for reason in skipped:
+    directory_to_write(args.archive, "--archive")
+    archive = directory_to_write(Path(args.archive) / args.suite, "--archive")
+    read(archive)  # a damaged provenance.json there, named before anything is kept
+    # every source read and checked before anything is kept: a refused command leaves the archive as it was
+    sources = [scan(source, SUITES[args.suite]) for source in args.runs]
+    for source in sources:
+        for reason in source.skipped:
             print(f"skipped {reason}")
+    usable = sum(len(runs) for source in sources for runs in source.runs.values())
+    if not usable:
+        raise ValueError(f"no run under {', '.join(args.runs)} can be archived in suite {args.suite}: each is "
+                         "named above with why; give finished runs of that suite")
+    kept = {"teachers": 0, "students": 0}
+    for source in sources:
+        more = add(source, archive)
         kept = {k: kept[k] + more[k] for k in kept}
-        total += sum(more.values())
-    if total:
+    if any(kept.values()):
         record_session(archive, {**session, "archived": kept}, 0.0)
+    there = usable - sum(kept.values())
     print(f"kept {kept['students']} student runs and {kept['teachers']} teachers in {archive} "
-          f"({size(archive) / 1e6:.1f} MB in all)")
+          + (f"({there} held there already; " if there else "(") + f"{size(archive) / 1e6:.1f} MB in all)")
     return 0
 
 
 def _leaderboard(args) -> int:
+    from .files import directory_to_write, file_to_write
     from .reporting.pages import write_leaderboard, write_results_page
-    from .reporting.plots import plot_curves
+    from .reporting.plots import draw_curves, save_figures
     from .reporting.sources import read_runs
 
     if args.reproduction:
@@ -397,21 +411,26 @@ def _leaderboard(args) -> int:
                              "without --page or --out")
         from .reproduction import write_report
 
+        file_to_write(args.reproduction, "--reproduction", "reproduction.md")
         print(f"wrote {write_report(args.runs[0], args.reproduction)}")
         return 0
     if args.page:
         if args.out:
             raise ValueError("--page writes the page and its images beside PATH; --out is for one directory's "
                              "leaderboard: use one or the other")
+        file_to_write(args.page, "--page", "results.md")
         path = write_results_page(args.runs, args.page)
         print(f"wrote {path}")
         return 0
     if len(args.runs) > 1:
         raise ValueError("several run directories make one results page: add --page PATH")
+    if args.out:
+        directory_to_write(args.out, "--out")
     runs = read_runs(args.runs[0])
     out = Path(args.out or runs.path)
+    curves = draw_curves(runs.board)  # drawn before the leaderboard is written: a failure leaves no part of it
     path = write_leaderboard(runs.board, out)
-    plots = plot_curves(runs.board, out)
+    plots = save_figures(curves, out)
     print(path.read_text())
     print(f"wrote {path}, {out / 'leaderboard.csv'}" + "".join(f", {p}" for p in plots))
     return 0

@@ -9,6 +9,10 @@ run resumed after a kill, sees the old file or the new one, never a torn one.
 * ``atomic_path(path)``: a context manager yielding the temporary path, for writers that
   take a path (``np.savez``, an agent's ``save``, ``save_replay_buffer``, matplotlib's
   ``savefig``).
+
+A command checks where it will write before it computes anything: ``file_to_write(path,
+flag)`` and ``directory_to_write(path, flag)`` name the flag, the path, the problem and the
+fix in one line (a directory given for a file, a file on the way, no permission).
 """
 
 from __future__ import annotations
@@ -57,3 +61,65 @@ def atomic_write(path, data: str | bytes) -> None:
             tmp.write_bytes(data)
         else:
             tmp.write_text(data)
+
+
+def _nearest(path: Path) -> Path:
+    """``path``, or its nearest ancestor that exists."""
+    while not path.exists() and path != path.parent:
+        path = path.parent
+    return path
+
+
+def _check_writable_dir(path: Path, flag: str, given) -> None:
+    """Raise naming ``flag`` where ``path`` (a directory to write in, or to make) cannot be one."""
+    nearest = _nearest(path)
+    if not nearest.is_dir():
+        where = "is a file" if nearest == path else f"cannot be made: {nearest} is a file"
+        raise NotADirectoryError(f"{flag} {given}: {path} {where}, not a directory; give a path whose every "
+                                 "folder is a directory")
+    if not os.access(nearest, os.W_OK | os.X_OK):
+        raise PermissionError(f"{flag} {given}: {nearest} is not writable here; give a directory you can write in")
+
+
+def directory_to_write(path, flag: str) -> Path:
+    """``path`` as a directory a command writes into (made later, where missing), checked
+    before anything is computed or written; nothing is made here.
+
+    Args:
+        path: the directory, as given.
+        flag: the option or argument that gave it, e.g. ``--out``: every message names it.
+
+    Raises:
+        NotADirectoryError: ``path``, or a folder on its way, is a file.
+        PermissionError: it, or the folder it would be made in, cannot be written.
+    """
+    given = path
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise NotADirectoryError(f"{flag} {given} is a file, not a directory: give a directory to write in "
+                                 "(it is made if missing)")
+    _check_writable_dir(path, flag, given)
+    return path
+
+
+def file_to_write(path, flag: str, example: str) -> Path:
+    """``path`` as a file a command writes whole (its folders made later, where missing),
+    checked before anything is computed or written; nothing is made here.
+
+    Args:
+        path: the file, as given.
+        flag: the option or argument that gave it, e.g. ``--page``: every message names it.
+        example: a file name for the fix where a directory was given, e.g. ``results.md``.
+
+    Raises:
+        IsADirectoryError: ``path`` is a directory (or names one, ending in a separator).
+        NotADirectoryError: a folder on its way is a file.
+        PermissionError: the folder it goes in cannot be written.
+    """
+    given = path
+    path = Path(path)
+    if path.is_dir() or str(given).endswith(("/", os.sep)):
+        raise IsADirectoryError(f"{flag} {given} {'is' if path.is_dir() else 'names'} a directory, not a file: "
+                                f"give the file to write, e.g. {path / example}")
+    _check_writable_dir(path.parent, flag, given)
+    return path

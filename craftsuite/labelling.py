@@ -63,5 +63,13 @@ class Labeller:
         """The bits of the ``arrived`` propositions about place kind ``place``."""
         return sum(bit for bit, kind in self._arrived if kind == place)
 
+    def event_bits(self, slots=(), places=()) -> int:
+        """The bits of the events about inventory ``slots`` (``obtained``, ``reached``) and
+        place kinds ``places`` (``arrived``): the propositions only such a change sets."""
+        slots, places = set(slots), set(places)
+        return (sum(bit for bit, s in self._obtained if s in slots)
+                + sum(bit for bit, s, _ in self._reached if s in slots)
+                + sum(bit for bit, kind in self._arrived if kind in places))
+
     def names(self, mask: int) -> tuple[str, ...]:
         return tuple(p for i, p in enumerate(self.propositions) if mask >> i & 1)

@@ -218,5 +218,21 @@ def _what_ran(runs) -> list[str]:
                      f"({'reached' if r['reached_target'] else 'did not reach'} its target)")
     if board.unfinished:
         lines.append(f"- Unfinished, not counted: {len(board.unfinished)} runs")
+    lines += reread_note(runs.students)
     return [*lines, ""]
+
+
+def reread_note(students: Path) -> list[str]:
+    """A line for the records whose success was re-read as completion (``completion``), if any."""
+    reread = 0
+    for path in sorted(students.glob("*/result.json")):
+        try:
+            reread += "success_reread" in json.loads(path.read_text())
+        except ValueError:  # a damaged result: the board names it among the runs not read
+            continue
+    if not reread:
+        return []
+    return [f"- Success re-read: {reread} runs' records counted the automaton's acceptance as success on the "
+            "kinematic board; read again as completion, a training episode completed if accepted and ended before "
+            "its time limit, an evaluation where its record decides it (0, or every episode cut at the limit: 0)."]
 

@@ -52,10 +52,11 @@ class RunError(RuntimeError):
     """A run directory that cannot be used (locked by a live run, or holding another config)."""
 
 
-# config.json's layout: 2, the dataclass fields with ``effective`` and ``provenance``. A
+# config.json's layout: 3, the dataclass fields with ``effective`` and ``provenance``. A
 # record without ``format`` is read as layout 1, the fields alone: it loads, but it says
 # nothing of the effective settings, so a run directory holding one is never resumed.
-FORMAT = 2
+# Layout 2 is layout 3 whose kinematic success counted acceptance (``completion``).
+FORMAT = 3
 RECORD_KEYS = ("format", "provenance")  # in config.json, beside the settings: not hashed, not compared
 # fields that say where a file lives, not what the run computes from: recorded, but neither
 # hashed nor compared, so a moved or remounted runs directory keeps its keys (a student's
@@ -218,6 +219,11 @@ class RunDir:
                                "choose another output directory")
             if self.finished():
                 return
+            from .completion import needs_reread
+
+            if needs_reread(saved):  # its logs so far count another success than it would go on to
+                raise RunError(f"{self.path} holds a run whose success counted the automaton's acceptance (record "
+                               f"format {saved.get('format', 1)}); it is not resumed: choose another output directory")
             sessions = saved.get("provenance", [])
         record = {**mine, "format": FORMAT, "provenance": [*sessions, stamp()]}
         atomic_write(path, json.dumps(record, indent=2, sort_keys=True) + "\n")
@@ -334,9 +340,20 @@ class RunDir:
             os.fsync(f.fileno())
 
 
-def read_csv(path) -> list[dict]:
+def read_csv(path, fields: tuple[str, ...] = (), required: bool = False) -> list[dict]:
     """A run's CSV log as rows (none if it is missing); ``<name>.gz`` beside a missing
-    ``<name>`` is read instead (the results archive keeps ``episodes.csv`` compressed)."""
+    ``<name>`` is read instead (the results archive keeps ``episodes.csv`` compressed).
+
+    Args:
+        fields: the columns the caller reads; given, a log that cannot hold them is refused
+            (by default a log is read as it is, as a run being resumed reads its own).
+        required: a missing log is refused instead of read as no rows.
+
+    Raises:
+        FileNotFoundError: ``required``, and neither form of the log exists.
+        ValueError: with ``fields``, an empty log, a header without one of them, or a short
+            row before the last (a kill tears the last line only).
+    """
     import gzip
 
     path = Path(path)
@@ -345,17 +362,41 @@ def read_csv(path) -> list[dict]:
         opened = open(path, newline="")
     elif packed.exists():
         opened = gzip.open(packed, "rt", newline="")
+    elif required:
+        raise FileNotFoundError(f"{path} is missing")
     else:
         return []
     with opened as f:
-        return [row for row in csv.DictReader(f) if None not in row.values()]  # a torn last line
+        reader = csv.DictReader(f)
+        header, rows = reader.fieldnames, list(reader)  # (the header is read on demand: while open)
+    if fields:
+        _check_log(header, rows, fields)
+    return [row for row in rows if None not in row.values()]  # a torn last line
 
 
-def write_csv(path, fields, rows) -> None:
+def _check_log(header: list[str] | None, rows: list[dict], fields: tuple[str, ...]) -> None:
+    """Raise ValueError where a log's header and rows cannot be the log of ``fields``."""
+    if not header:
+        raise ValueError("the file is empty, without even its header")
+    lacking = [f for f in fields if f not in header]
+    if lacking:
+        raise ValueError(f"its header lacks {', '.join(lacking)}: it reads {','.join(header)[:60]!r}")
+    short = [i for i, row in enumerate(rows[:-1]) if None in row.values()]
+    if short:
+        raise ValueError(f"its line {short[0] + 2} has fewer fields than its header; only a last line, torn by a "
+                         "kill, may")
+
+
+def csv_text(fields, rows) -> str:
+    """Rows as a CSV log's text, its header first."""
     import io
 
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=fields)
     writer.writeheader()
     writer.writerows(rows)
-    atomic_write(Path(path), buf.getvalue())
+    return buf.getvalue()
+
+
+def write_csv(path, fields, rows) -> None:
+    atomic_write(Path(path), csv_text(fields, rows))

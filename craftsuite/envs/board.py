@@ -22,6 +22,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..spec import TaskSpec
 
 
@@ -90,6 +92,30 @@ class BoardRules:
         self._anywhere = [([(slot[n], k) for n, k in r.consume.items()], [(slot[n], k) for n, k in r.produce.items()],
                            r.repeat) for r in spec.recipes if r.at is None]
         self.ends_by_tile = any(t.ends_episode for t in self.tiles)
+
+    def acceptance_completes(self, automaton, labeller) -> bool:
+        """Whether the automaton can accept only on a step where a tile ends the episode, so
+        that acceptance and completion are one event (Dungeon Quest: only the dragon acting
+        labels ``dragon``). Where entering acceptance needs no label that only such a tile
+        sets (Blind Craftsman: ``home`` holds in home's whole cell), the automaton may
+        accept on a step that completes nothing. Without such tiles, acceptance ends the
+        episode: the two are one event too."""
+        if not self.ends_by_tile:
+            return True
+        ending = [t for t in self.tiles if t.ends_episode]
+        others = [t for t in self.tiles if not t.ends_episode]
+        raised_elsewhere = {s for t in others for s, d in t.change if d > 0}
+        raised_elsewhere |= {s for _, produce, _ in self._anywhere for s, _ in produce}
+        only_ending = labeller.event_bits(
+            slots={s for t in ending for s, d in t.change if d > 0} - raised_elsewhere,
+            places={t.kind for t in ending if not t.by_cell})
+        accepting = automaton.accepting.astype(bool)
+        if accepting[automaton.initial]:
+            return False
+        delta = automaton.delta
+        masks = np.arange(delta.shape[1])
+        entering = accepting[delta] & ~accepting[:, None]  # (state, mask): a step into acceptance
+        return bool(((masks & only_ending) != 0)[np.nonzero(entering)[1]].all())
 
     def act(self, inv: list[int], kind: int) -> Act | None:
         """The tile of ``kind`` acts on ``inv`` (changed in place) if the inventory meets its

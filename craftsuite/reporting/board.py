@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import stats
+from ..completion import needs_reread
 from ..runs import RunError, flatten, read_config, read_csv, run_settings
 
 # metrics with a mean and an interval per task and method; a rate lies in [0, 1]
@@ -65,14 +66,18 @@ def world_label(world: str, kwargs: dict) -> str:
     return f"{world}: " + ", ".join(f"{k}={json.dumps(v)}" for k, v in sorted(kwargs.items()))
 
 
-def _log(path: Path, row) -> list[tuple]:
-    """A run's CSV log, each row as ``row`` reads it.
+def _log(path: Path, fields: tuple[str, ...], row, required: bool = False) -> list[tuple]:
+    """A run's CSV log, each row as ``row`` reads it (``fields``: the columns it reads);
+    ``required``: a log every finished run has.
 
     Raises:
-        RunError: a row that does not read as the log's, naming the file.
+        RunError: a log that is missing (``required``) or does not read as the log's, naming the file.
     """
     try:
-        return [row(r) for r in read_csv(path)]
+        return [row(r) for r in read_csv(path, fields, required)]
+    except FileNotFoundError:  # before OSError: not damaged bytes, but no file
+        raise RunError(f"{path} is missing: the run's record is damaged (a finished run has evaluated at least "
+                       "once, at its end)") from None
     except (KeyError, ValueError, OSError, EOFError) as err:  # OSError, EOFError: a damaged .gz
         raise RunError(f"{path} does not read as a run's log ({type(err).__name__}: {err}): "
                        "the run's record is damaged") from None
@@ -109,10 +114,17 @@ def run_metrics(run: Path) -> dict | None:
     result = _result(run)
     if result["kind"] != "student":
         return None  # a teacher run
+    if needs_reread(config):  # its logs say another thing than success: the archive reads them again
+        raise RunError(f"{run}: its success counted the automaton's acceptance on the kinematic board (record "
+                       f"format {config.get('format', 1)}); keep it in a results archive (craftsuite archive "
+                       "RUNS --suite S), which re-reads it as completion")
     budget = int(config["steps"])
     # (step, return, won) per training episode; (step, greedy success) per evaluation
-    episodes = _log(run / "episodes.csv", lambda e: (int(e["step"]), float(e["return"]), int(e["success"])))
-    evals = _log(run / "evals.csv", lambda e: (int(e["step"]), float(e["success"])))
+    episodes = _log(run / "episodes.csv", ("step", "return", "success"),
+                    lambda e: (int(e["step"]), float(e["return"]), int(e["success"])))
+    # no episodes.csv is no episode yet (a budget shorter than an episode); no evals.csv, damage
+    evals = _log(run / "evals.csv", ("step", "success"), lambda e: (int(e["step"]), float(e["success"])),
+                 required=True)
     tail = [e for e in episodes if e[0] > 0.9 * budget]
     if not tail and episodes:  # fewer episodes than the window: the last one
         tail = episodes[-1:]

@@ -28,7 +28,7 @@ from .board import (
     rung_order,
     verdict,
 )
-from .plots import file_part, plot_curves, plot_profiles
+from .plots import draw_curves, draw_profiles, file_part, save_figures
 from .sources import read_runs, session_line
 
 # The authors' shipped continuous results, one run each, mean episode reward over the last
@@ -235,12 +235,15 @@ def leaderboard_csv(board: Board) -> str:
 
 def write_leaderboard(board: Board, out) -> Path:
     """``leaderboard.md``, ``leaderboard.csv`` and the performance profiles in ``out``;
-    returns the Markdown path."""
+    returns the Markdown path. All is drawn and rendered before the first file is written."""
     out = Path(out)
     aggs = aggregates(list(board))
-    profiles = {p.world_label: p.path.relative_to(out) for p in plot_profiles(board, out, aggs)}
-    atomic_write(out / "leaderboard.csv", leaderboard_csv(board))
-    atomic_write(out / "leaderboard.md", leaderboard_markdown(board, profiles=profiles, aggs=aggs))
+    drawn = draw_profiles(board, aggs)
+    profiles = {d.world_label: Path(f"{d.stem}.png") for d in drawn}
+    table, text = leaderboard_csv(board), leaderboard_markdown(board, profiles=profiles, aggs=aggs)
+    save_figures(drawn, out)
+    atomic_write(out / "leaderboard.csv", table)
+    atomic_write(out / "leaderboard.md", text)
     return out / "leaderboard.md"
 
 
@@ -251,7 +254,7 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
 
     Raises:
         FileNotFoundError, ValueError: a directory that is missing or holds no finished run,
-            named; the page is then not written.
+            named; then nothing is written (the page and its images are written once all is drawn).
     """
     path = Path(path)
     lines = [f"# {title}", "",
@@ -263,6 +266,7 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
         lines += ["## Distilled against scratch", "",
                   "Each distilled method against its algorithm from scratch on each rung, in final greedy success "
                   "(the rows come from the leaderboards below).", "", *compared]
+    figures, videos = [], []  # (images directory, its figures), (video, its copy): written once all is drawn
     for runs in directories:
         suite, board = runs.suite, runs.board
         name = suite.get("name", runs.path.name)
@@ -273,21 +277,23 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
             lines.append(f"- runs in `{runs.path}` (no provenance.json: not made by `craftsuite transfer`)")
         # named after the directory, not the suite: two directories of one suite keep their own plots
         images = path.parent / "images" / file_part(f"results-{runs.path.name}")
-        images.mkdir(parents=True, exist_ok=True)
         aggs = aggregates(list(board))
-        profiles = {p.world_label: p.path.relative_to(path.parent) for p in plot_profiles(board, images, aggs)}
-        text = leaderboard_markdown(board, title=None, profiles=profiles, aggs=aggs, level=3)
+        profiles, curves = draw_profiles(board, aggs), draw_curves(board)
+        figures.append((images, profiles + curves))
+        text = leaderboard_markdown(board, title=None, profiles={
+            d.world_label: (images / f"{d.stem}.png").relative_to(path.parent) for d in profiles},
+            aggs=aggs, level=3)
         lines += ["", text.strip(), ""]
-        for plot in plot_curves(board, images):
-            lines += [f"![{plot.stem}]({plot.relative_to(path.parent).as_posix()})", ""]
+        for plot in curves:
+            lines += [f"![{plot.stem}]({(images / f'{plot.stem}.png').relative_to(path.parent).as_posix()})", ""]
         lines += teachers_markdown(runs.path / "teachers")
-        videos = sorted(runs.path.glob("best-*.mp4"))
-        for video in videos:
-            shutil.copy(video, images / video.name)
+        shown = sorted(runs.path.glob("best-*.mp4"))
+        for video in shown:
+            videos.append((video, images / video.name))
             lines += [f"Video of the best student: [{video.name}]"
                       f"({(images / video.name).relative_to(path.parent).as_posix()})", ""]
         best = best_run(board)
-        if not videos and best is not None and not (best[0] / "model.zip").exists():
+        if not shown and best is not None and not (best[0] / "model.zip").exists():
             run, entry, i = best
             lines += [f"No video: the best student here, `{run.name}` (greedy success "
                       f"{entry.values['success'][i]:.2f}), kept its records but not its model (the results archive "
@@ -295,6 +301,11 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
                       "(`craftsuite transfer --no-archive --out DIR`).", ""]
         if (runs.path / "students").is_dir() and any((runs.path / "students").glob("*/episodes.csv.gz")):
             lines += [f"The records in `{runs.path.as_posix()}`: {archive_size(runs.path) / 1e6:.1f} MB.", ""]
+    for images, drawn in figures:
+        images.mkdir(parents=True, exist_ok=True)
+        save_figures(drawn, images)
+    for video, copy in videos:
+        shutil.copy(video, copy)
     atomic_write(path, "\n".join(lines))
     return path
 

@@ -23,13 +23,40 @@ def file_part(label: str) -> str:
 
 def _curve(values_at, grid):
     """Step function of (step, value) pairs sampled on ``grid`` (NaN before the first)."""
+    if not values_at:  # a run never evaluated: no value anywhere (as ``smoothed`` without episodes)
+        return np.full(len(grid), np.nan)
     steps = np.array([s for s, _ in values_at], dtype=float)
     vals = np.array([v for _, v in values_at], dtype=float)
     idx = np.searchsorted(steps, grid, side="right") - 1
     return np.where(idx >= 0, vals[np.maximum(idx, 0)], np.nan)
 
 
+@dataclass
+class Drawn:
+    """A figure drawn but not written yet: its file's stem and, for a profile, its world."""
+
+    stem: str
+    figure: object  # a matplotlib Figure
+    world_label: str = ""
+
+
+def save_figures(drawn: list[Drawn], out) -> list[Path]:
+    """Write each figure to ``out/<stem>.png`` (made if missing); returns the paths."""
+    paths = []
+    for d in drawn:
+        path = Path(out) / f"{d.stem}.png"
+        with atomic_path(path) as tmp:
+            d.figure.savefig(tmp, dpi=110)
+        paths.append(path)
+    return paths
+
+
 def plot_curves(board: Board, out) -> list[Path]:
+    """``draw_curves``, written to ``out``."""
+    return save_figures(draw_curves(board), out)
+
+
+def draw_curves(board: Board) -> list[Drawn]:
     """Figure-5-style learning curves per task and world, one line per row of the board:
     training return, greedy and training success (mean over seeds, with the t-interval band
     from 3 seeds), and the share of seeds that have reached 80% greedy success."""
@@ -41,7 +68,7 @@ def plot_curves(board: Board, out) -> list[Path]:
         for run in e.runs:
             runs.setdefault((e.task, e.world_label), []).append(
                 (e.label, read_csv(run / "episodes.csv"), read_csv(run / "evals.csv"), e.budget))
-    paths = []
+    drawn = []
     for (task, world), group in sorted(runs.items()):
         budget = max(g[3] for g in group)
         grid = np.linspace(budget / 50, budget, 50)
@@ -85,13 +112,10 @@ def plot_curves(board: Board, out) -> list[Path]:
             ax.xaxis.set_major_formatter(EngFormatter(sep=""))
         fig.tight_layout()
         name = f"curves-{task}-{file_part(world)}"
-        if any(p.stem == name for p in paths):  # two settings that read alike once in a file name
+        if any(d.stem == name for d in drawn):  # two settings that read alike once in a file name
             name += "-" + hashlib.sha256(world.encode()).hexdigest()[:6]
-        path = Path(out) / f"{name}.png"
-        with atomic_path(path) as tmp:
-            fig.savefig(tmp, dpi=110)
-        paths.append(path)
-    return paths
+        drawn.append(Drawn(name, fig))
+    return drawn
 
 
 def smoothed(values_at, grid, window: float = 0.1):
@@ -116,13 +140,20 @@ class Profile:
 
 
 def plot_profiles(board: Board, out, aggs: list[Aggregate] | None = None) -> list[Profile]:
-    """Per world with an aggregate, the performance profile of final greedy success: the
-    share of runs (averaged over tasks) above each threshold, with its stratified-bootstrap
-    band (Agarwal et al. 2021, Figure 5); ``profile-<world>.png`` in ``out``."""
+    """``draw_profiles``, written to ``out``."""
+    drawn = draw_profiles(board, aggs)
+    return [Profile(d.world_label, path) for d, path in zip(drawn, save_figures(drawn, out), strict=True)]
+
+
+def draw_profiles(board: Board, aggs: list[Aggregate] | None = None) -> list[Drawn]:
+    """Per world with an aggregate (``aggs``: the board's, if already computed), the
+    performance profile of final greedy success: the share of runs (averaged over tasks)
+    above each threshold, with its stratified-bootstrap band (Agarwal et al. 2021, Figure
+    5), as ``profile-<world>``."""
     from matplotlib.figure import Figure
 
     taus = np.linspace(0, 1, 51)
-    out_paths = []
+    drawn = []
     for agg in aggregates(list(board)) if aggs is None else aggs:
         if not agg.scores:
             continue
@@ -138,9 +169,5 @@ def plot_profiles(board: Board, out, aggs: list[Aggregate] | None = None) -> lis
                ylabel="share of runs with success \u2265 \u03c4", ylim=(-0.02, 1.02))
         ax.legend(fontsize=8)
         fig.tight_layout()
-        path = Path(out) / f"profile-{file_part(agg.world_label)}.png"
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_path(path) as tmp:
-            fig.savefig(tmp, dpi=110)
-        out_paths.append(Profile(agg.world_label, path))
-    return out_paths
+        drawn.append(Drawn(f"profile-{file_part(agg.world_label)}", fig, agg.world_label))
+    return drawn

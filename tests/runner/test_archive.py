@@ -137,6 +137,12 @@ def test_transfer_flags_choose_the_archive(tmp_path, monkeypatch):
     # settings beyond the suite's (a smoke test's budget) stay out of the archive unless asked for
     assert main(args + ["--suite", "standard", "--steps", "1000"]) == 0 and seen["standard"] is None
     assert main(args + ["--suite", "standard", "--steps", "1000", "--archive", "x"]) == 0 and seen["standard"] == "x"
+    # and so do rungs, worlds and methods the suite does not run: they are not its runs
+    for beyond in (["--tasks", "Reach"], ["--worlds", "Kinematic", "--methods", "td3"], ["--methods", "crm-edges"]):
+        assert main(["transfer", "--suite", "hard", "--worlds", "Grid10", "--tasks", "DungeonQuest", "--methods",
+                     "dqn", *beyond]) == 0 and seen["hard"] is None, beyond
+    assert main(["transfer", "--suite", "hard", "--worlds", "Grid10", "--tasks", "DungeonQuest", "--methods",
+                 "dqn"]) == 0 and seen["hard"] == "results"  # a part of the suite is the suite's
 
 
 def test_restore_leaves_a_run_a_live_process_holds(tmp_path):

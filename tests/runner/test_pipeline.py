@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from craftsuite.cli import main
-from craftsuite.runs import read_csv
+from craftsuite.runs import FORMAT, read_csv
 from craftsuite.suite_runner import run_students
 from craftsuite.suites import SUITES
 from craftsuite.training import StudentConfig
@@ -224,7 +224,7 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
     assert "As last run: rungs tagged calibration; worlds Cont; methods td3, td3-dynamic-edges; 1 seed." in text
     # the runs record their settings and the code that trained them
     record = json.loads((result.students[0] / "config.json").read_text())
-    assert record["format"] == 2 and record["effective"]["hyperparameters"]["policy_kwargs"]["net_arch"] == [16]
+    assert record["format"] == FORMAT and record["effective"]["hyperparameters"]["policy_kwargs"]["net_arch"] == [16]
     assert record["provenance"][0]["versions"]["craftsuite"]
     assert "images/results-out/curves-Reach-Cont.png" in text  # named after the directory
     assert (tmp_path / "docs" / "images" / "results-out" / "curves-Reach-Cont.png").is_file()

@@ -116,10 +116,10 @@ def _scripted(args) -> int:
     import cv2
     import gymnasium as gym
     import numpy as np
-    from tqdm import tqdm
 
     from .automata import write_image
     from .ids import CONT, file_stem, parse_id
+    from .progress import progress_iter
     from .registration import registered_ids
     from .rollouts import rollout
     from .scripted import scripted_policy
@@ -129,7 +129,7 @@ def _scripted(args) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     rows = []
-    for env_id in tqdm(ids, desc="scripted rollouts", unit="env"):
+    for env_id in progress_iter(ids, "scripted rollouts", "env"):
         env = gym.make(env_id, render_mode="rgb_array", status_panel=True)  # pictures for people: inventory shown
         policy = scripted_policy(env)
         frames = []  # the first episode's start and end
@@ -596,7 +596,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seeds", type=_positive, help="override the number of seeds")
     p.add_argument("--steps", type=_positive, help="one student budget for every rung (transitions)")
     p.add_argument("--teacher-steps", type=_positive, help="override the teacher's step limit")
-    p.add_argument("--eval-every", type=_positive, help="override the evaluation interval")
+    p.add_argument("--eval-every", type=_positive, help="override the students' evaluation interval (transitions; "
+                   "default: the suite's, or a 20th of each budget)")
     p.add_argument("--env", help="JSON gymnasium.make keywords of the MuJoCo students' world (replaces the suite's), "
                    "e.g. '{\"frame_skip\": 2, \"max_episode_steps\": 1000}'; the leaderboard names them")
     p.add_argument("--board-size", type=int, choices=(7, 10), help="the kinematic board's side (default 7; the "
@@ -614,12 +615,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-archive", action="store_true", help="neither read nor write a results archive")
     p.add_argument("--engine", choices=ENGINES, help="what trains the students: population (each cell's seeds in "
                    "one process) or sb3 (one SB3 agent per run); default: the suite's")
-    p.add_argument("--device", default="cpu", help="the population engine's torch device: cpu (default) or cuda")
+    p.add_argument("--device", help="the population engine's torch device: cpu (default) or cuda (the sb3 engine "
+                   "takes none: its agents use a GPU where there is one)")
     p.set_defaults(run=_transfer)
 
     p = sub.add_parser("archive", help="keep finished runs' records in the results archive (results/<suite>)")
     p.add_argument("runs", nargs="+", help="transfer output directories, or directories of student runs")
-    p.add_argument("--suite", required=True, help="the suite they are runs of: they are kept in its archive")
+    p.add_argument("--suite", required=True, help="the suite they are runs of: they are kept in its archive (a run "
+                   "of a task, world or method it does not run is skipped, named)")
     p.add_argument("--archive", default="results", help="the archive (default: results)")
     p.set_defaults(run=_archive)
 

@@ -95,15 +95,14 @@ def tasks_page(episodes: int = 100, progress: bool = True, results="results") ->
     """The tasks page in Markdown: the ladder's rungs, easiest first, with their references
     and, where the results archive (``results``; None: none) holds it, TD3 from scratch's
     success in MuJoCo."""
-    from tqdm import tqdm
-
+    from .progress import progress_iter
     from .task_registry import ladder
 
     specs = ladder()
     ids = [(spec, env_id) for spec in specs for env_id in _ids_of(spec.name)]
     periods = ", ".join(sorted({f"{s.continuous.control_period:g} s" for s in specs}))
     refs = {}
-    for _spec, env_id in tqdm(ids, desc="references", unit="id", disable=not progress):
+    for _spec, env_id in progress_iter(ids, "references", "id", enabled=progress):
         for policy in POLICIES:
             refs[env_id, policy] = reference(env_id, policy, episodes)
     lines = [

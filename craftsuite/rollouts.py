@@ -13,8 +13,8 @@ from typing import NamedTuple
 
 import gymnasium as gym
 import numpy as np
-from tqdm import tqdm
 
+from .progress import progress_bar
 from .rendering.video import VideoWriter
 
 
@@ -120,7 +120,7 @@ def record_video(env_id: str, policy: str = "scripted", episodes: int = 1, out: 
                 bar.update(episode - bar.n)  # the episodes before this one are done
                 video.write(env.render())
 
-            with tqdm(total=episodes, desc=f"{env_id} ({policy})", unit="episode", disable=not progress) as bar:
+            with progress_bar(episodes, f"{env_id} ({policy})", unit="episode", enabled=progress) as bar:
                 played = rollout(env, act, episodes, seed, on_reset=on_reset, on_step=on_step)
                 bar.update(episodes - bar.n)
     finally:

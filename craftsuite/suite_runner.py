@@ -16,8 +16,10 @@ seeds of a cell as one job (``cells``). Runs that already finished are reused.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
+import os
 import time
 from concurrent.futures import Future
 from dataclasses import dataclass
@@ -27,6 +29,7 @@ from .configs import StudentConfig, TeacherConfig
 from .files import atomic_write
 from .ids import file_stem
 from .methods import METHODS, methods_for
+from .progress import progress_bar
 from .suites import Suite
 from .task_registry import carried, resolve_task
 from .worker_pool import WorkerPool
@@ -37,8 +40,9 @@ def _population_job(configs: list[dict], root: str, task: str | dict | None = No
     _start_worker(task)
     from .population import train_population
 
-    return [str(p) for p in train_population([StudentConfig(**c) for c in configs], root, progress=False,
-                                             device=device)]
+    with _quiet():
+        return [str(p) for p in train_population([StudentConfig(**c) for c in configs], root, progress=False,
+                                                 device=device)]
 
 
 def cells(configs: list[StudentConfig]) -> list[list[StudentConfig]]:
@@ -57,7 +61,8 @@ def _student_job(config: dict, root: str, task: str | dict | None = None) -> str
     _start_worker(task)
     from .training import train_student  # torch: only where runs train, not to list the suites
 
-    return str(train_student(StudentConfig(**config), root, progress=False))
+    with _quiet():
+        return str(train_student(StudentConfig(**config), root, progress=False))
 
 
 def _teacher_job(config: dict, root: str, task: str | dict | None = None) -> str:
@@ -65,7 +70,17 @@ def _teacher_job(config: dict, root: str, task: str | dict | None = None) -> str
     _start_worker(task)
     from .training import train_teacher
 
-    return str(train_teacher(TeacherConfig(**config), root, progress=False))
+    with _quiet():
+        return str(train_teacher(TeacherConfig(**config), root, progress=False))
+
+
+@contextlib.contextmanager
+def _quiet():
+    """A worker's stdout dropped while it trains: the driver announces what a run would
+    print (its resume) on lines of their own, where a worker's line lands inside the
+    driver's progress bar (a Ray worker's stdout never reaches the driver either)."""
+    with open(os.devnull, "w") as devnull, contextlib.redirect_stdout(devnull):
+        yield
 
 
 def _start_worker(task: str | dict | None) -> None:
@@ -86,14 +101,15 @@ def _carried(task: str) -> str | dict:
 
 def run_students(configs: list[StudentConfig], root, workers: int | None = None, ray: str | None = None,
                  progress: bool = True, teachers: dict[str, TeacherConfig] | None = None, teacher_root=None,
-                 log=print, device: str = "cpu") -> list[Path]:
+                 log=print, device: str = "cpu", pool: WorkerPool | None = None) -> list[Path]:
     """Run students in parallel (processes or Ray) with one progress bar over all their
     transitions: one job per SB3 run, one per population (the seeds of a cell, ``cells``).
     With ``teachers`` (by task, trained under ``teacher_root``), each teacher runs first in
     the same pool and its task's distilled students start when it is done; the other
-    students start at once. ``device`` is the populations' torch device."""
-    from tqdm import tqdm
-
+    students start at once. ``device`` is the populations' torch device. ``pool``: the
+    pool to run them in (``transfer`` makes it before it writes anything), closed here;
+    else one of ``workers`` processes or on ``ray``. Reused and resumed runs are announced
+    (``log``) before the bar starts, which counts their earlier steps as done before."""
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     teachers = teachers or {}
@@ -102,10 +118,14 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                for task in teachers}
     ready = [job for job in jobs if not (job[0].task in teachers and METHODS[job[0].method].needs_table)]
     total = sum(c.steps for c in configs)
-    workers_ = WorkerPool(len(jobs) + len(teachers), workers, ray)
-    with tqdm(total=total, desc=f"{len(configs)} student runs", unit="step", disable=not progress,
-              dynamic_ncols=True) as bar:
-        runs = [(c, root / c.run_name()) for c in configs]  # named once: a name hashes the run's settings
+    workers_ = pool or WorkerPool(len(jobs) + len(teachers), workers, ray)
+    runs = [(c, root / c.run_name()) for c in configs]  # named once: a name hashes the run's settings
+    if teachers:
+        _announce(log, "teacher", [(Path(teacher_root) / t.run_name(), t.max_steps) for t in teachers.values()],
+                  teacher_root)
+    start = _announce(log, "student", [(run, c.steps) for c, run in runs], root)
+    with progress_bar(total, f"{len(configs)} student runs", initial=sum(start.values()), enabled=progress) as bar:
+        seen = {run: _stamp(run / "progress.json") for _, run in runs}  # a killed run's, until it writes anew
 
         def submit(job: list[StudentConfig]) -> Future:
             if job[0].engine == "population":
@@ -118,11 +138,10 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
             for c, run in runs:
                 if (run / "result.json").exists():
                     done += c.steps
-                elif (run / "progress.json").exists():
-                    try:
-                        done += json.loads((run / "progress.json").read_text())["step"]
-                    except (ValueError, KeyError, OSError):
-                        pass
+                elif _stamp(run / "progress.json") != seen[run]:  # written by this session's worker
+                    done += max(_progress_step(run), start.get(run, 0))
+                else:  # a resumed run replays from its checkpoint, not from the progress it had logged
+                    done += start.get(run, 0)
             bar.update(done - bar.n)
 
         try:
@@ -158,6 +177,52 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
     return [Path(paths[c.run_name()]) for c in configs]
 
 
+def _announce(log, kind: str, runs: list[tuple[Path, int]], root) -> dict[Path, int]:
+    """Say, each on a line of its own, how many of ``runs`` (directories, each with its
+    budget) are finished already (reused) and which resume from a checkpoint (and from
+    which step); return the steps each of those had done before this session."""
+    done = {run: budget for run, budget in runs if (run / "result.json").exists()}
+    resumed = {run: step for run, _ in runs if run not in done and (step := checkpoint_step(run)) is not None}
+    if done:
+        log(f"reused {len(done)} finished {kind} run{'s' * (len(done) > 1)} from {root}")
+    for run, step in resumed.items():
+        log(f"resuming {run.name} from step {step:,} (its checkpoint)")
+    return {**done, **resumed}
+
+
+def checkpoint_step(run: Path) -> int | None:
+    """The step a killed run resumes from: its newest complete checkpoint's (None: it has none)."""
+    import zipfile
+
+    from .runs import RunDir
+
+    for folder in (run / name for name in RunDir.CHECKPOINTS):  # newest first
+        try:
+            if (folder / "step.json").is_file() and (folder / "population.pt").is_file():  # a population member's
+                return int(json.loads((folder / "step.json").read_text())["num_timesteps"])
+            if (folder / "model.zip").is_file() and (folder / "replay.pkl").is_file():  # an SB3 agent's, as saved
+                with zipfile.ZipFile(folder / "model.zip") as saved:
+                    return int(json.loads(saved.read("data"))["num_timesteps"])
+        except (OSError, ValueError, KeyError, TypeError, zipfile.BadZipFile):
+            continue  # unreadable: the worker falls back to the one before, as this does
+    return None
+
+
+def _stamp(path: Path) -> int | None:
+    """When ``path`` was last written (None: it is not there)."""
+    try:
+        return path.stat().st_mtime_ns
+    except OSError:
+        return None
+
+
+def _progress_step(run: Path) -> int:
+    try:
+        return int(json.loads((run / "progress.json").read_text())["step"])
+    except (ValueError, KeyError, TypeError, OSError):  # torn, or gone meanwhile
+        return 0
+
+
 @dataclass(frozen=True)
 class TransferResult:
     out: Path
@@ -169,18 +234,23 @@ class TransferResult:
 
 
 def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None = None, video: bool = True,
-             progress: bool = True, log=print, command: list[str] | None = None, device: str = "cpu",
+             progress: bool = True, log=print, command: list[str] | None = None, device: str | None = None,
              archive=None) -> TransferResult:
     """The suite end to end: teachers and distillation, students, leaderboard, plots, video.
 
-    ``device``: the torch device of the population engine's students (``cpu``, ``cuda``).
-    ``command``: how this run was asked for, as ``provenance.json`` records it (the CLI
-    passes its command line); by default, this Python call. ``archive``: a results archive
-    (``craftsuite.archive``; e.g. ``results``): the runs it holds under ``<archive>/<suite>``
-    are not trained again, and every run that finishes here is kept there, even if a later
-    one fails."""
+    ``device``: the torch device of the population engine's students (``cpu``, the
+    default, or ``cuda``); the sb3 engine takes none. ``command``: how this run was asked
+    for, as ``provenance.json`` records it (the CLI passes its command line); by default,
+    this Python call. ``archive``: a results archive (``craftsuite.archive``; e.g.
+    ``results``): the runs it holds under ``<archive>/<suite>`` are not trained again, and
+    every run that finishes here is kept there, even if a later one fails.
+
+    Bad input (a budget too small to train, a device this machine lacks, an output
+    directory or archive that cannot be one, a Ray cluster out of reach) is refused
+    before anything is written."""
     from .archive import keep_all, restore
     from .archive import size as archive_size
+    from .completion import reread_in_place
     from .provenance import read, record_session, start_session
     from .reporting.board import build
     from .reporting.pages import write_leaderboard
@@ -191,25 +261,43 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     session, clock = start_session(command), time.perf_counter()
     out = Path(out)
     configs = suite.student_configs(out / "teachers")
+    teachers = suite.teachers()
+    check_budgets(configs, teachers)
+    kept = _check_places(out, archive, suite.name)
     _check_students(configs, device)  # fail before any training
     read(out)  # a damaged provenance record, too
-    out.mkdir(parents=True, exist_ok=True)
-    atomic_write(out / "suite.json", json.dumps(dataclasses.asdict(suite), indent=2) + "\n")
-    record_session(out, session, None)  # if this session is killed, its command and commit stay on record
-    teachers = suite.teachers()
-    names = {"teachers": {t.run_name() for t in teachers.values()}, "students": {c.run_name() for c in configs}}
-    kept = None if archive is None else Path(archive) / suite.name
-    if kept is not None:
-        restored = restore(kept, out, names, log=log)
-        log(f"results archive {kept}: {restored['students']} of {len(configs)} student runs and "
-            f"{restored['teachers']} of {len(teachers)} teachers are there already (not trained again)")
+    _counting_acceptance([out / "students" / c.run_name() for c in configs])  # none unfinished
+    # the pool, and a Ray cluster with it, before anything is written: one out of reach leaves no output behind
+    pool = WorkerPool(len(cells(configs)) + len(teachers), workers, ray)
+    if suite.eval_every is None and suite.student_steps is not None:  # the interval follows a budget given: say so
+        every = sorted({c.eval_every for c in configs})
+        log(f"(students evaluated every {' or '.join(f'{e:,}' for e in every)} transitions, a 20th of their "
+            f"budget of {suite.student_steps:,}; --eval-every N sets another)")
     try:
-        students = run_students(configs, out / "students", workers=workers, ray=ray, progress=progress,
-                                teachers=teachers, teacher_root=out / "teachers", log=log, device=device)
+        out.mkdir(parents=True, exist_ok=True)
+        atomic_write(out / "suite.json", json.dumps(dataclasses.asdict(suite), indent=2) + "\n")
+        record_session(out, session, None)  # if this session is killed, its command and commit stay on record
+        names = {"teachers": {t.run_name() for t in teachers.values()}, "students": {c.run_name() for c in configs}}
+        if kept is not None:
+            restored = restore(kept, out, names, log=log)
+            log(f"results archive {kept}: {restored['students']} of {len(configs)} student runs and "
+                f"{restored['teachers']} of {len(teachers)} teachers are there already (not trained again)")
+        for run in _counting_acceptance([out / "students" / name for name in sorted(names["students"])]):
+            reread_in_place(run)  # (restored ones too)
+            log(f"re-read {run.name}: its success counted the automaton's acceptance; now completion")
+    except BaseException:
+        pool.close(abort=True)
+        raise
+    try:
+        students = run_students(configs, out / "students", progress=progress, teachers=teachers,
+                                teacher_root=out / "teachers", log=log, device=device or "cpu", pool=pool)
+    except BaseException:
+        pool.close(abort=True)  # (run_students closes it too, but not if it failed before its jobs; twice is harmless)
+        raise
     finally:  # what finished is kept, whatever stopped the rest
         if kept is not None:
             try:  # (the session is on record in out since it started)
-                keep_all(out, kept, names, suite=dataclasses.asdict(suite))  # as run: pages read its settings
+                keep_all(out, kept, names, suite=dataclasses.asdict(suite), log=log)  # as run: pages read its settings
             except Exception as err:  # never in place of what stopped the runs
                 log(f"results archive {kept}: not updated ({type(err).__name__}: {err})")
     board = build(out / "students")
@@ -228,20 +316,48 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
                           students, board_md, plots, movie)
 
 
-def _check_students(configs: list[StudentConfig], device: str = "cpu") -> None:
+def _counting_acceptance(runs: list[Path]) -> list[Path]:
+    """The finished runs among ``runs`` whose success counted the automaton's acceptance
+    (``completion``), to be re-read before they are reused.
+
+    Raises:
+        RunError: such a run unfinished (resumed, it would log two kinds of success), or one
+            whose record cannot say what completed.
+    """
+    from .completion import needs_reread, reread_logs
+    from .runs import RunError, read_config
+
+    found = []
+    for run in runs:
+        config = read_config(run) if (run / "config.json").exists() else {}
+        if config and needs_reread(config):
+            if not (run / "result.json").exists():
+                raise RunError(f"{run} is an unfinished run whose success counted the automaton's acceptance "
+                               "(record format 2): it cannot be resumed; move it aside, and it trains anew")
+            reread_logs(run, config)  # decidable, or named now
+            found.append(run)
+    return found
+
+
+def _check_students(configs: list[StudentConfig], device: str | None = None) -> None:
     """Build each kind of student once, untrained, from scratch (the teachers' tables do not
     exist yet): a misspelt world setting or algorithm setting (``--env``, ``--td3-hyper``),
-    or a run the population engine cannot train, is named now, not in a worker after the
-    teachers have trained."""
+    a run the population engine cannot train, or a device it cannot train on, is named now,
+    not in a worker after the teachers have trained."""
     import craftsuite  # noqa: F401  (registers the ids)
 
     from .agents.factory import make_agent
 
+    if device is not None and not any(c.engine == "population" for c in configs):
+        # the sb3 engine's agents take their device from their settings: --device would be ignored
+        raise ValueError(f"--device {device}: these students train on the sb3 engine, which takes no --device (its "
+                         "agents use a GPU where there is one; --td3-hyper/--dqn-hyper '{\"device\": \"cpu\"}' sets "
+                         "theirs); leave out --device, or use --engine population")
     if any(c.engine == "population" for c in configs):
         from .population import check_supported
         from .population.train import check_device
 
-        check_device(device)
+        check_device(device or "cpu")
         for c in configs:
             if c.engine == "population":
                 check_supported(c.method, c.effective()["hyperparameters"])
@@ -253,6 +369,61 @@ def _check_students(configs: list[StudentConfig], device: str = "cpu") -> None:
         agent = make_agent(plain, env_id, n_envs=n_envs, env_kwargs=json.loads(env_kwargs),
                            **{**json.loads(hyper), "buffer_size": 16})
         agent.get_env().close()
+
+
+def check_budgets(configs: list[StudentConfig], teachers: dict[str, TeacherConfig]) -> None:
+    """Refuse, before anything runs, a budget too small to train (no gradient update within
+    it) and an evaluation interval longer than a student's budget (one evaluation, at its
+    end) or shorter than one step of its envs; each message names the flag and the value
+    that works. A teacher's interval is its own (``TeacherConfig.eval_every``): one longer
+    than its budget only means it is evaluated, and may stop, at its end."""
+    for task, t in teachers.items():
+        settings = t.effective()["hyperparameters"]
+        need = smallest_budget(settings, t.n_envs)
+        if t.max_steps < need:
+            raise ValueError(f"--teacher-steps {t.max_steps}: too small to train the {task} teacher, which takes no "
+                             f"gradient update in its first {settings['learning_starts']:,} transitions "
+                             f"(learning_starts); use --teacher-steps {need} or more")
+    for c in configs:
+        settings = c.effective()["hyperparameters"]
+        who = f"{c.task}'s {c.method} students ({c.world})"
+        need = smallest_budget(settings, c.n_envs)
+        if c.steps < need:
+            raise ValueError(f"--steps {c.steps}: too small to train {who}, which take no gradient update in their "
+                             f"first {settings['learning_starts']:,} transitions (learning_starts); use --steps "
+                             f"{need} or more")
+        if c.eval_every > c.steps:
+            raise ValueError(f"an evaluation every {c.eval_every:,} transitions (--eval-every, or the suite's) is "
+                             f"longer than the {c.steps:,}-transition budget of {who}, which would be evaluated only "
+                             f"at their end; use --eval-every {c.steps} or less, or a larger --steps")
+        if c.eval_every < c.n_envs:
+            raise ValueError(f"--eval-every {c.eval_every}: shorter than one step of the {c.n_envs} envs of {who}, "
+                             f"the least between two evaluations; use --eval-every {c.n_envs} or more")
+
+
+def smallest_budget(settings: dict, n_envs: int) -> int:
+    """The fewest transitions in which a run of these (effective) settings takes a gradient
+    update: it collects ``n_envs`` a step and updates on the steps that are multiples of
+    ``train_freq`` once more than ``learning_starts`` are collected (the population engine
+    ends its budget on the step that reaches it; SB3 on the ``train_freq`` boundary after)."""
+    freq = settings.get("train_freq", 1)
+    if isinstance(freq, (list, tuple)):  # [4, "step"]; in episodes, unknown ahead: as if every step
+        freq = freq[0] if len(freq) == 2 and freq[1] == "step" else 1
+    every = freq if isinstance(freq, int) and freq >= 1 else 1
+    first = -(-(settings["learning_starts"] // n_envs + 1) // every) * every  # the step of the first update
+    return (first - 1) * n_envs + 1
+
+
+def _check_places(out: Path, archive, suite: str) -> Path | None:
+    """``out`` and the results archive (None: none) as directories to write in, else one
+    line naming the flag, the path and the fix; returns the suite's place in the archive."""
+    from .files import directory_to_write
+
+    directory_to_write(out, "--out")
+    if archive is None:
+        return None
+    directory_to_write(archive, "--archive")
+    return directory_to_write(Path(archive) / suite, "--archive")  # a file there, too
 
 
 def _best_student_video(students: list[Path], out: Path, log=print) -> Path | None:

@@ -41,7 +41,7 @@ class Suite:
     teacher_layout_seed: int | None = 0
     teacher_n_envs: int = 1
     teacher_hyperparameters: dict = field(default_factory=dict)
-    eval_every: int | None = None  # None: 20 evaluations per run
+    eval_every: int | None = None  # None: 20 evaluations per run (eval_interval)
     eval_episodes: int = 20
     # each world's collection regime: envs stepped side by side per agent step, and
     # overrides of its algorithm's defaults (craftsuite.hyperparameters): MuJoCo students
@@ -89,6 +89,16 @@ class Suite:
                              "budget (--steps N, Suite.student_steps) or tag the task with a level the suite has")
         return self.budgets[kind][spec.level]
 
+    def n_envs(self, world: str) -> int:
+        """The envs a student steps side by side in ``world`` (its collection regime)."""
+        return self.td3_n_envs if world_kind(world) == CONT else self.dqn_n_envs
+
+    def eval_interval(self, steps: int, world: str) -> int:
+        """The transitions between a student's evaluations: the suite's ``eval_every``, else
+        a 20th of its budget (every run's curve has the same resolution, whatever its budget),
+        but never less than one step of its envs, the least between two evaluations."""
+        return self.eval_every or max(self.n_envs(world), steps // 20)
+
     def teachers(self) -> dict[str, TeacherConfig]:
         """One grid teacher per rung whose students need a teacher's table."""
         if not any(METHODS[m].needs_table for w in self.worlds for m in methods_for(w) if m in self.methods):
@@ -118,13 +128,13 @@ class Suite:
                     for seed in range(self.seeds):
                         out.append(StudentConfig(
                             task=spec.name, method=method, world=world, seed=seed, steps=steps, table=table,
-                            eval_every=self.eval_every or max(1, steps // 20), eval_episodes=self.eval_episodes,
+                            eval_every=self.eval_interval(steps, world), eval_episodes=self.eval_episodes,
                             hyperparameters=dict(self.td3_hyperparameters if cont else self.dqn_hyperparameters),
                             layout_seed=None if cont else self.grid_layout_seed,
                             # each continuous world its own keywords (MuJoCo's frame_skip, the board's size)
                             world_kwargs=dict(self.cont_world_kwargs if world == CONT else
                                               self.kinematic_world_kwargs if world == KINEMATIC else {}),
-                            n_envs=self.td3_n_envs if cont else self.dqn_n_envs,
+                            n_envs=self.n_envs(world),
                             # hidden from distilled students where the suite says so, but for
                             # those whose counterfactual replay relabels it (crm-edges)
                             automaton_state=None if self.students_see_automaton or not METHODS[method].distill

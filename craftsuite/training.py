@@ -241,10 +241,10 @@ def _learn(run: RunDir, fresh, total: int, eval_every: int, eval_episodes: int, 
 
 
 def _learn_loop(run, agent, total, eval_every, eval_episodes, evaluate_fn, stop_at, progress, desc):
-    from tqdm import tqdm
+    from .progress import progress_bar
 
-    with tqdm(total=total, desc=desc, unit="step", disable=not progress, dynamic_ncols=True,
-              mininterval=1.0) as bar:
+    # a resumed run's steps are counted from the start, not as this session's: its rate stays true
+    with progress_bar(total, desc, initial=agent.num_timesteps, enabled=progress) as bar:
         callback = RunCallback(run, total, eval_every, eval_episodes, evaluate_fn, stop_at, bar)
         if agent.num_timesteps < total and not _stopped(run, stop_at):
             agent.learn(total - agent.num_timesteps, callback=callback, reset_num_timesteps=False,

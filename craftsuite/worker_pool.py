@@ -38,6 +38,51 @@ def _report_and_watch(driver: int, started, stopping) -> None:
     _exit_with(driver)
 
 
+def connect_ray(address: str):
+    """Ray, joined to the cluster at ``address`` (``"local"``: one started in this process;
+    one already joined is kept); returns the module and whether this call joined it.
+
+    Raises:
+        RuntimeError: one line naming ``--ray`` and ``address``, where Ray is not installed,
+            nothing answers at the address, or Ray cannot join the cluster there.
+    """
+    try:
+        import ray
+    except ImportError:
+        raise RuntimeError(f"--ray {address}: Ray is not installed here; pip install 'craftsuite[ray]', or leave "
+                           "out --ray to run on local processes") from None
+    if ray.is_initialized():
+        return ray, False
+    if address != "local":
+        _check_reachable(address)
+    try:
+        ray.init(address=None if address == "local" else address, include_dashboard=False, log_to_driver=False,
+                 ignore_reinit_error=True)
+    except Exception as err:  # ConnectionError, or Ray's own errors of an address that holds no cluster
+        raise RuntimeError(f"--ray {address}: no Ray cluster could be joined there ({type(err).__name__}: "
+                           f"{str(err).strip().splitlines()[0] if str(err).strip() else 'no reason given'}); "
+                           "give the address of a running head node, or --ray local") from None
+    return ray, True
+
+
+def _check_reachable(address: str, timeout: float = 5.0) -> None:
+    """Raise unless something accepts a connection at ``address``'s host and port (``host:port``
+    or ``ray://host:port``; other forms, e.g. ``auto``, are left to Ray): Ray itself retries
+    an unreachable cluster for about 20 s, and logs a warning a second while it does."""
+    import socket
+
+    host, _, port = address.removeprefix("ray://").rpartition(":")
+    if not host or not port.isdigit():
+        return
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=timeout).close()
+    except OSError as err:
+        why = "no answer" if isinstance(err, TimeoutError) else (err.strerror or type(err).__name__).lower()
+        raise RuntimeError(f"--ray {address}: nothing answers there ({why}); start a head node there "
+                           f"(ray start --head --port {port}), give the address of a running one, or use "
+                           "--ray local") from None
+
+
 class WorkerPool:
     """``workers`` local processes (None: one per job, up to the cores), or with ``ray`` a
     Ray cluster (``"local"`` starts one in this process, an address joins one)."""
@@ -45,14 +90,7 @@ class WorkerPool:
     def __init__(self, jobs: int, workers: int | None = None, ray: str | None = None):
         self.ray, self.started, self.remote = None, False, {}
         if ray is not None:
-            try:
-                import ray as ray_module
-            except ImportError:
-                raise RuntimeError("--ray needs Ray: pip install 'craftsuite[ray]'") from None
-            self.ray, self.started = ray_module, not ray_module.is_initialized()
-            if self.started:
-                ray_module.init(address=None if ray == "local" else ray, include_dashboard=False,
-                                log_to_driver=False, ignore_reinit_error=True)
+            self.ray, self.started = connect_ray(ray)
         else:
             context = mp.get_context("spawn")
             # the workers' pids, as each reports them: what an abort stops

@@ -54,10 +54,14 @@ def check_device(device: str) -> th.device:
         dev = th.device(device)
     except (RuntimeError, TypeError):
         raise EngineError(f"--device {device!r} is not a torch device: use cpu or cuda") from None
-    if dev.type == "cuda" and not th.cuda.is_available():
-        raise EngineError(f"--device {device}: this machine has no CUDA GPU; use --device cpu")
     if dev.type not in ("cpu", "cuda"):
         raise EngineError(f"--device {device}: the population engine runs on cpu or cuda")
+    if dev.type == "cuda" and not th.cuda.is_available():
+        raise EngineError(f"--device {device}: this machine has no CUDA GPU; use --device cpu, or run on a "
+                          "machine with one")
+    if dev.type == "cuda" and (dev.index or 0) >= th.cuda.device_count():  # else it fails once runs are made
+        raise EngineError(f"--device {device}: this machine has {th.cuda.device_count()} CUDA GPU(s), "
+                          f"cuda:0 to cuda:{th.cuda.device_count() - 1}; use one of them, or --device cuda")
     return dev
 
 
@@ -91,7 +95,7 @@ def train_population(configs: list[StudentConfig], root, progress: bool = True, 
 
 
 def _train(todo, settings, table, spec, device, progress, desc) -> None:
-    from tqdm import tqdm
+    from ..progress import progress_bar
 
     configs, runs = [c for c, _ in todo], [r for _, r in todo]
     config = configs[0]
@@ -112,8 +116,7 @@ def _train(todo, settings, table, spec, device, progress, desc) -> None:
         total = config.steps
         eval_envs = make_envs(config.env_id, K * config.eval_episodes, config.env_kwargs, config.product)
         stack.callback(eval_envs.close)
-        with tqdm(total=K * total, initial=K * pop.num_timesteps, desc=desc, unit="step", disable=not progress,
-                  dynamic_ncols=True, mininterval=1.0) as bar:
+        with progress_bar(K * total, desc, initial=K * pop.num_timesteps, enabled=progress) as bar:
             _loop(pop, envs, eval_envs, configs, runs, bar)
         for k, (c, run) in enumerate(todo):
             _finish(pop, k, c, run, table, time.perf_counter() - start, str(device))

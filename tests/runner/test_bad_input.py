@@ -1,7 +1,9 @@
-"""Bad input of training named before a run directory exists; damaged checkpoints on resume."""
+"""Bad input of training named before a run directory exists; damaged checkpoints on resume;
+bad input to ``craftsuite transfer`` refused before it writes anything."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import warnings
 
@@ -177,3 +179,165 @@ def test_when_no_checkpoint_loads_the_error_says_what_to_move_aside(interrupted)
         (run / d).rename(run / f"{d}-aside")
     assert train_student(CONFIG, run.parent, progress=False) == run
     assert [int(r["step"]) for r in read_csv(run / "evals.csv")] == [100, 200, 300]
+
+
+# -- craftsuite transfer: bad input refused before anything is written ----------------------------
+QUICK_REACH = ["transfer", "--suite", "quick", "--tasks", "Reach", "--seeds", "1", "--no-video"]
+
+
+def _refused(tmp_path, capsys, *flags, out=None) -> str:
+    """Run ``transfer`` with ``flags``; assert it exits 2 with one line and wrote nothing; return the line."""
+    before = sorted(tmp_path.rglob("*"))
+    assert main([*QUICK_REACH, *flags, "--out", str(out or tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("craftsuite transfer: error: ") and err.count("\n") == 1
+    assert sorted(tmp_path.rglob("*")) == before
+    return err.removeprefix("craftsuite transfer: error: ").strip()
+
+
+@pytest.mark.parametrize("flags,message", [
+    (["--steps", "100"], "--steps 100: too small to train Reach's td3 students (Cont), which take no gradient update "
+     "in their first 1,000 transitions (learning_starts); use --steps 1001 or more"),
+    (["--steps", "2000", "--teacher-steps", "1000"], "--teacher-steps 1000: too small to train the Reach teacher, "
+     "which takes no gradient update in its first 1,000 transitions (learning_starts); use --teacher-steps 1001 or "
+     "more"),
+    (["--steps", "2000", "--eval-every", "5000"], "an evaluation every 5,000 transitions (--eval-every, or the "
+     "suite's) is longer than the 2,000-transition budget of Reach's td3 students (Cont), which would be evaluated "
+     "only at their end; use --eval-every 2000 or less, or a larger --steps"),
+    (["--steps", "2000", "--eval-every", "5"], "--eval-every 5: shorter than one step of the 10 envs of Reach's td3 "
+     "students (Cont), the least between two evaluations; use --eval-every 10 or more"),
+])
+def test_transfer_refuses_a_budget_too_small_to_train(tmp_path, capsys, flags, message):
+    assert _refused(tmp_path, capsys, *flags) == message
+
+
+@pytest.mark.parametrize("engine", ["population", "sb3"])
+def test_the_smallest_budget_named_is_the_first_that_trains(tmp_path, engine):
+    from craftsuite.suite_runner import smallest_budget
+
+    hyper = {**TINY, "buffer_size": 500, "batch_size": 8}
+    need = smallest_budget({"learning_starts": 50, "train_freq": 1}, 4)
+    assert need == 49  # 13 steps of 4 envs: 52 transitions, past 50
+    for steps, trains in ((need - 1, False), (need, True)):
+        config = StudentConfig(method="dqn", world="Grid7", steps=steps, eval_every=steps, eval_episodes=1,
+                               n_envs=4, hyperparameters=hyper, engine=engine)
+        result = json.loads((train_student(config, tmp_path / str(steps), progress=False) / "result.json").read_text())
+        assert (result["updates"] > 0) == trains, (steps, result["updates"])
+
+
+def test_smallest_budget_waits_for_a_training_step():
+    from craftsuite.suite_runner import smallest_budget
+
+    assert smallest_budget({"learning_starts": 1_000}, 1) == 1_001
+    assert smallest_budget({"learning_starts": 1_000}, 10) == 1_001
+    assert smallest_budget({"learning_starts": 1_000, "train_freq": [4, "step"]}, 1) == 1_004  # updates at 1,004
+    assert smallest_budget({"learning_starts": 0}, 10) == 1
+
+
+class _Pool:
+    def __init__(self, *args):
+        self.closed = []
+
+    def close(self, abort=False):
+        self.closed.append(abort)
+
+
+def test_a_budget_given_announces_the_evaluation_interval_it_sets(tmp_path, monkeypatch):
+    import craftsuite.suite_runner as suite_runner
+    from craftsuite.suites import SUITES
+
+    said, pools = [], []
+    monkeypatch.setattr(suite_runner, "_check_students", lambda *a: None)
+    monkeypatch.setattr(suite_runner, "WorkerPool", lambda *a: pools.append(_Pool()) or pools[-1])
+    monkeypatch.setattr(suite_runner, "run_students", lambda *a, **k: (_ for _ in ()).throw(KeyboardInterrupt))
+    suite = dataclasses.replace(SUITES["quick"], tasks=("Reach",), seeds=1, student_steps=4_000)
+    with pytest.raises(KeyboardInterrupt):
+        suite_runner.transfer(suite, tmp_path / "out", log=said.append)
+    assert said == ["(students evaluated every 200 transitions, a 20th of their budget of 4,000; --eval-every N sets "
+                    "another)"]
+    assert [p.closed for p in pools] == [[True]]  # an interrupted transfer stops its pool
+
+
+def test_transfer_refuses_device_the_engine_ignores_or_the_machine_lacks(tmp_path, capsys, monkeypatch):
+    import torch
+
+    base = ["--steps", "2000"]
+    assert _refused(tmp_path, capsys, *base, "--engine", "sb3", "--device", "cuda") == (
+        "--device cuda: these students train on the sb3 engine, which takes no --device (its agents use a GPU where "
+        "there is one; --td3-hyper/--dqn-hyper '{\"device\": \"cpu\"}' sets theirs); leave out --device, or use "
+        "--engine population")
+    assert _refused(tmp_path, capsys, *base, "--device", "nonsense") == (
+        "--device 'nonsense' is not a torch device: use cpu or cuda")
+    assert _refused(tmp_path, capsys, *base, "--device", "mps") == (
+        "--device mps: the population engine runs on cpu or cuda")
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
+    assert _refused(tmp_path, capsys, *base, "--device", "cuda") == (
+        "--device cuda: this machine has no CUDA GPU; use --device cpu, or run on a machine with one")
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: True)
+    monkeypatch.setattr(torch.cuda, "device_count", lambda: 1)
+    assert _refused(tmp_path, capsys, *base, "--device", "cuda:3") == (
+        "--device cuda:3: this machine has 1 CUDA GPU(s), cuda:0 to cuda:0; use one of them, or --device cuda")
+
+
+def test_transfer_refuses_a_file_where_its_directories_must_be(tmp_path, capsys):
+    file = tmp_path / "file"
+    file.write_text("kept\n")
+    assert _refused(tmp_path, capsys, "--steps", "2000", out=file) == (
+        f"--out {file} is a file, not a directory: give a directory to write in (it is made if missing)")
+    assert _refused(tmp_path, capsys, "--steps", "2000", out=file / "runs") == (
+        f"--out {file / 'runs'}: {file / 'runs'} cannot be made: {file} is a file, not a directory; give a path "
+        "whose every folder is a directory")
+    assert _refused(tmp_path, capsys, "--steps", "2000", "--archive", str(file)) == (
+        f"--archive {file} is a file, not a directory: give a directory to write in (it is made if missing)")
+    (tmp_path / "results").mkdir()
+    (tmp_path / "results" / "quick").write_text("")  # the suite's place in the archive
+    assert "--archive" in _refused(tmp_path, capsys, "--steps", "2000", "--archive", str(tmp_path / "results"))
+    assert file.read_text() == "kept\n"
+
+
+def _closed_port() -> int:
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class _FakeRay:
+    """Stands in for Ray (the default run needs none): ``init`` fails as Ray's does."""
+
+    def __init__(self):
+        self.inits = []
+
+    def is_initialized(self):
+        return False
+
+    def init(self, address=None, **_):
+        self.inits.append(address)
+        raise ConnectionError(f"Failed to connect to Ray cluster at {address}")
+
+
+def test_transfer_refuses_ray_out_of_reach_before_writing_anything(tmp_path, capsys, monkeypatch):
+    import socket
+    import sys
+
+    import craftsuite.suite_runner as suite_runner
+
+    monkeypatch.setattr(suite_runner, "_check_students", lambda *a: None)  # (building the agents: seconds)
+    base = ["--steps", "2000"]
+    monkeypatch.setitem(sys.modules, "ray", None)  # not installed
+    assert _refused(tmp_path, capsys, *base, "--ray", "10.255.255.1:6379") == (
+        "--ray 10.255.255.1:6379: Ray is not installed here; pip install 'craftsuite[ray]', or leave out --ray to run "
+        "on local processes")
+    fake = _FakeRay()
+    monkeypatch.setitem(sys.modules, "ray", fake)
+    port = _closed_port()
+    assert _refused(tmp_path, capsys, *base, "--ray", f"127.0.0.1:{port}") == (
+        f"--ray 127.0.0.1:{port}: nothing answers there (connection refused); start a head node there (ray start "
+        f"--head --port {port}), give the address of a running one, or use --ray local")
+    assert fake.inits == []  # refused before Ray retries it for 20 s
+    with socket.create_server(("127.0.0.1", 0)) as listening:  # something answers, but not Ray
+        address = f"127.0.0.1:{listening.getsockname()[1]}"
+        assert _refused(tmp_path, capsys, *base, "--ray", address) == (
+            f"--ray {address}: no Ray cluster could be joined there (ConnectionError: Failed to connect to Ray "
+            f"cluster at {address}); give the address of a running head node, or --ray local")

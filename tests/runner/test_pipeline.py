@@ -203,6 +203,7 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
 
     tiny = dataclasses.replace(SUITES["quick"], tags=("calibration",), tasks=(), seeds=1, student_steps=300,
                                eval_every=150, eval_episodes=1, teacher_max_steps=400, td3_n_envs=2,
+                               teacher_hyperparameters={"learning_starts": 100},  # (it must train in 400)
                                td3_hyperparameters={"learning_starts": 100, "policy_kwargs": {"net_arch": [16]}})
     result = transfer(tiny, tmp_path / "out", workers=2, video=False, progress=False, log=lambda *_: None)
     [teacher] = result.teachers.values()
@@ -325,6 +326,7 @@ def test_a_suite_accumulates_in_the_archive_and_nothing_trains_twice(tmp_path):
 
     tiny = dataclasses.replace(SUITES["quick"], tags=("calibration",), tasks=(), seeds=2, student_steps=300,
                                eval_every=150, eval_episodes=1, teacher_max_steps=400, td3_n_envs=2,
+                               teacher_hyperparameters={"learning_starts": 100},  # (it must train in 400)
                                td3_hyperparameters={"learning_starts": 100, "policy_kwargs": {"net_arch": [16]}})
     said = []
     first = transfer(tiny, tmp_path / "here", workers=2, video=False, progress=False, log=said.append,

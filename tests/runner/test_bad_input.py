@@ -13,8 +13,8 @@ from craftsuite.cli import main
 from craftsuite.hyperparameters import HyperparameterError
 from craftsuite.runs import RunDir, read_csv
 from craftsuite.training import CheckpointError, StudentConfig, TeacherConfig, train_student, train_teacher
+from .killed import CONFIG, TINY, killed_run
 
-TINY = {"learning_starts": 50, "buffer_size": 2_000, "policy_kwargs": {"net_arch": [16]}}
 
 
 @pytest.mark.parametrize("hyper,message", [({"batch_size": "big"}, "batch_size must be an integer"),
@@ -99,19 +99,10 @@ def test_a_run_that_fails_in_its_directory_removes_the_folders_it_made(tmp_path)
 
 
 # -- damaged checkpoints ----------------------------------------------------------------------------
-CONFIG = StudentConfig(method="dqn", world="Grid7", steps=300, eval_every=100, eval_episodes=1, hyperparameters=TINY)
-
-
 @pytest.fixture
 def interrupted(tmp_path, monkeypatch):
     """A run killed after its last checkpoint (at 300), with the one before it (at 200)."""
-    monkeypatch.setattr(RunDir, "write_result", lambda self, result: (_ for _ in ()).throw(KeyboardInterrupt))
-    with pytest.raises(KeyboardInterrupt):
-        train_student(CONFIG, tmp_path, progress=False)
-    monkeypatch.undo()
-    [run] = tmp_path.iterdir()
-    assert (run / "checkpoint" / "replay.pkl").is_file() and (run / "checkpoint-old" / "model.zip").is_file()
-    return run
+    return killed_run(tmp_path, monkeypatch)
 
 
 def _truncate(path):

@@ -15,6 +15,8 @@ from craftsuite.progress import LineProgress, progress_bar
 from craftsuite.runs import RunDir
 from craftsuite.training import StudentConfig, train_student
 
+from .killed import CONFIG, TINY, killed_run
+
 
 class _Terminal(io.StringIO):
     def isatty(self):
@@ -73,19 +75,13 @@ def test_a_message_gets_a_line_of_its_own(capsys):
     assert capsys.readouterr().out == "teacher Reach: done\n"
 
 
-TINY = {"learning_starts": 50, "buffer_size": 2_000, "policy_kwargs": {"net_arch": [16]}}
-CONFIG = StudentConfig(method="dqn", world="Grid7", steps=300, eval_every=100, eval_episodes=1, hyperparameters=TINY)
-
-
 @pytest.fixture
 def killed(tmp_path, monkeypatch):
-    """An SB3 run killed after its checkpoint at 300, the one before at 200."""
-    monkeypatch.setattr(RunDir, "write_result", lambda self, result: (_ for _ in ()).throw(KeyboardInterrupt))
-    with pytest.raises(KeyboardInterrupt):
-        train_student(CONFIG, tmp_path, progress=False)
-    monkeypatch.undo()
-    (tmp_path / CONFIG.run_name() / "checkpoint").rename(tmp_path / CONFIG.run_name() / "checkpoint-aside")
-    return tmp_path / CONFIG.run_name()  # resumes from 200
+    """An SB3 run killed after its checkpoint at 300, the one before at 200, the newer set
+    aside: it resumes from 200."""
+    run = killed_run(tmp_path, monkeypatch)
+    (run / "checkpoint").rename(run / "checkpoint-aside")
+    return run
 
 
 def _bars(monkeypatch) -> list[dict]:

@@ -1,0 +1,90 @@
+"""The learner-regime experiment's runs: TD3 (MuJoCo) and DQN (Grid10) from scratch on the
+middle rungs and Dungeon Quest, one factor at a time (the plan: this folder's README).
+
+    python experiments/learner-regime/run.py --wave 1 --out experiments/learner-regime/results
+    python experiments/learner-regime/run.py --wave 2 --n 5 3 --out experiments/learner-regime/results
+
+Each run is its suite's config (standard: the middle rungs; hard: Dungeon Quest) with the
+setting's overrides added to its algorithm's settings. The runs the results archive holds
+are restored first and not trained again; the rest train as the suites train them (each
+cell's seeds as one population). Runs land in ``<out>/<suite>/students``, ready for
+``craftsuite archive <out>/<suite> --suite <suite> --archive results/learner-regime``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+from pathlib import Path
+
+import craftsuite  # noqa: F401  (registers the ids)
+from craftsuite.suites import SUITES
+
+RUNGS = {"standard": ("KeySwordDragon", "ToolHome", "TwoToolsHome"), "hard": ("DungeonQuest",)}
+SCRATCH = {"Cont": "td3", "Grid10": "dqn"}
+ARCHIVES = ("results/{suite}", "results/n-step-returns/{suite}", "results/learner-regime/{suite}")
+# Cheaper settings first, the suites' current one where two cost the same (the README's rule).
+# {} is the suites' own regime: its runs are the suites' records.
+N_STEPS = {"n1": {}, "n3": {"n_steps": 3}, "n5": {"n_steps": 5}}
+
+
+def wave_2(world: str, n: int) -> dict[str, dict]:
+    """Wave 2's settings in ``world`` at wave 1's ``n``: each factor varied alone."""
+    base = {} if n == 1 else {"n_steps": n}
+    td3 = SUITES["standard"].td3_hyperparameters
+    settings = {f"n{n}": base, f"n{n}-layernorm": {**base, "layer_norm": True},
+                f"n{n}-w256": {**base, "policy_kwargs": {"net_arch": [256, 256]}}}
+    if world == "Cont":
+        settings[f"n{n}-gaussian"] = {**base, "action_noise": {"type": "normal", "sigma": 0.3}}
+        settings[f"n{n}-w256"]["policy_kwargs"] = {**td3["policy_kwargs"], "net_arch": [256, 256]}
+    else:
+        settings[f"n{n}-updates0.25"] = {**base, "gradient_steps": 1}
+    return settings
+
+
+def settings_for(wave: int, world: str, n: int | None) -> dict[str, dict]:
+    if wave == 1:
+        return dict(N_STEPS)
+    if n is None:
+        raise SystemExit("--wave 2 needs --n: wave 1's winners, TD3's then DQN's (table.py says them)")
+    return wave_2(world, n)
+
+
+def configs(suite: str, wave: int, ns: dict[str, int | None]) -> list:
+    """The wave's runs of ``suite``'s rungs, cheapest setting first within each cell."""
+    out = []
+    for c in SUITES[suite].student_configs(Path("unused-teachers")):  # scratch methods read no table
+        if c.task in RUNGS[suite] and SCRATCH.get(c.world) == c.method:
+            for overrides in settings_for(wave, c.world, ns[c.world]).values():
+                out.append(dataclasses.replace(c, hyperparameters={**c.hyperparameters, **overrides}))
+    # MuJoCo first (the question the suites most need answered), the shorter budgets first
+    return sorted(out, key=lambda c: (c.world != "Cont", c.steps))
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--wave", type=int, choices=(1, 2), required=True)
+    parser.add_argument("--n", type=int, nargs=2, metavar=("TD3_N", "DQN_N"), help="wave 1's winners (wave 2)")
+    parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results")
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--dry-run", action="store_true", help="say what would train, and train nothing")
+    args = parser.parse_args(argv)
+    from craftsuite.archive import restore
+    from craftsuite.suite_runner import cells, run_students
+
+    ns = {"Cont": args.n[0], "Grid10": args.n[1]} if args.n else {"Cont": None, "Grid10": None}
+    for suite in RUNGS:
+        wanted = configs(suite, args.wave, ns)
+        out = args.out / suite
+        names = {"students": {c.run_name() for c in wanted}}
+        for archive in ARCHIVES:
+            restore(Path(archive.format(suite=suite)), out, names, log=print)
+        todo = [c for c in wanted if not (out / "students" / c.run_name() / "result.json").exists()]
+        print(f"{suite}: {len(wanted)} runs, {len(wanted) - len(todo)} restored from the archive, "
+              f"{len(cells(todo))} cells to train ({sum(c.steps for c in todo):,} transitions)")
+        if not args.dry_run and todo:
+            run_students(todo, out / "students", workers=args.workers)
+
+
+if __name__ == "__main__":
+    main()

@@ -50,15 +50,15 @@ def settings_for(wave: int, world: str, n: int | None) -> dict[str, dict]:
     return wave_2(world, n)
 
 
-def configs(suite: str, wave: int, ns: dict[str, int | None]) -> list:
-    """The wave's runs of ``suite``'s rungs, cheapest setting first within each cell."""
+def configs(suite: str, wave: int, ns: dict[str, int | None]) -> list[tuple[str, object]]:
+    """The wave's runs of ``suite``'s rungs as (setting, config), MuJoCo first (the
+    question the suites most need answered), then the shorter budgets."""
     out = []
     for c in SUITES[suite].student_configs(Path("unused-teachers")):  # scratch methods read no table
         if c.task in RUNGS[suite] and SCRATCH.get(c.world) == c.method:
-            for overrides in settings_for(wave, c.world, ns[c.world]).values():
-                out.append(dataclasses.replace(c, hyperparameters={**c.hyperparameters, **overrides}))
-    # MuJoCo first (the question the suites most need answered), the shorter budgets first
-    return sorted(out, key=lambda c: (c.world != "Cont", c.steps))
+            for name, overrides in settings_for(wave, c.world, ns[c.world]).items():
+                out.append((name, dataclasses.replace(c, hyperparameters={**c.hyperparameters, **overrides})))
+    return sorted(out, key=lambda pair: (pair[1].world != "Cont", pair[1].steps))
 
 
 def main(argv=None) -> None:
@@ -74,7 +74,7 @@ def main(argv=None) -> None:
 
     ns = {"Cont": args.n[0], "Grid10": args.n[1]} if args.n else {"Cont": None, "Grid10": None}
     for suite in RUNGS:
-        wanted = configs(suite, args.wave, ns)
+        wanted = [c for _, c in configs(suite, args.wave, ns)]
         out = args.out / suite
         names = {"students": {c.run_name() for c in wanted}}
         for archive in ARCHIVES:

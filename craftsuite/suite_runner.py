@@ -361,6 +361,11 @@ def _check_students(configs: list[StudentConfig], device: str | None = None) -> 
         for c in configs:
             if c.engine == "population":
                 check_supported(c.method, c.effective()["hyperparameters"])
+    from .training import check_sb3_engine
+
+    for c in configs:
+        if c.engine != "population":
+            check_sb3_engine(c)
 
     kinds = {(c.env_id, c.world, c.n_envs, json.dumps(c.env_kwargs, sort_keys=True),
               json.dumps(c.hyperparameters, sort_keys=True)) for c in configs}

@@ -321,6 +321,18 @@ def student_result(config: StudentConfig, algorithm: str, steps: int, updates: i
             **more, "seconds_this_session": round(seconds, 1)}
 
 
+def check_sb3_engine(config: StudentConfig) -> None:
+    """Raise ValueError, naming the engine that trains it, for a run the sb3 engine does
+    not: n-step CRM (the SB3 agents' CRM replay holds one-step counterfactuals; the
+    population engine carries each counterfactual automaton state through a window)."""
+    from .methods import METHODS
+
+    n_steps = config.effective()["hyperparameters"].get("n_steps", 1)
+    if METHODS[config.method].crm and n_steps != 1:
+        raise ValueError(f"method {config.method!r} with n_steps {n_steps}: n-step CRM is trained by the population "
+                         "engine only; use --engine population")
+
+
 def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
     """A student (or baseline) run under ``root``; returns its directory."""
     from .agents import AutomatonQTable
@@ -333,6 +345,7 @@ def train_student(config: StudentConfig, root, progress: bool = True) -> Path:
         from .population import train_population
 
         return train_population([config], root, progress=progress)[0]
+    check_sb3_engine(config)
     method = METHODS[config.method]
     # bad input is named before a run directory exists: the settings (run_name checks the
     # hyperparameters), and the teacher's table, which must be made for this task's automaton

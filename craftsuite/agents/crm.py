@@ -48,8 +48,10 @@ class CRMReplayBuffer(AutomatonReplayBuffer):
 
     def __init__(self, buffer_size, observation_space, action_space, device="auto", n_envs: int = 1, *,
                  automaton: Automaton, completion_reward: float, **kwargs):
-        if kwargs.get("n_steps", 1) != 1:  # its columns are counterfactual states, not trajectories
-            raise ValueError("CRM stores one-step counterfactual experiences: n_steps must be 1")
+        # its columns are counterfactual states, not trajectories: it samples one-step
+        # experiences only. An n-step CRM model (the population engine trains it) is built
+        # with one to be saved, and refuses to sample
+        self.n_steps_trained = kwargs.pop("n_steps", 1)
         self.automaton, self.completion_reward = automaton, completion_reward
         self.n_real_envs = n_envs
         self.n_live = int((~(automaton.accepting | automaton.rejecting)).sum())
@@ -57,6 +59,12 @@ class CRMReplayBuffer(AutomatonReplayBuffer):
             raise ValueError("CRM needs the product observation (make the env with product=True)")
         super().__init__(buffer_size * self.n_live, observation_space, action_space, device,
                          n_envs=n_envs * self.n_live, **kwargs)
+
+    def sample(self, *args, **kwargs):
+        if self.n_steps_trained != 1:
+            raise ValueError(f"n-step CRM (n_steps {self.n_steps_trained}) samples windows in the population "
+                             "engine only: train it with --engine population")
+        return super().sample(*args, **kwargs)
 
     def add(self, obs, next_obs, action, reward, done, infos) -> None:
         rows = [[] for _ in range(8)]

@@ -76,15 +76,9 @@ def check_supported(method: str, settings: dict) -> None:
 
 
 def _check_n_steps(method: str, n_steps) -> None:
-    """Raise ``EngineError`` for a return length no engine runs: not a positive integer, or
-    more than one step with CRM, whose counterfactual experiences are one step each (the
-    SB3 engine refuses it too, ``agents.crm``, and a member's model is an SB3 agent)."""
+    """Raise ``EngineError`` for a return length no engine runs: not a positive integer."""
     if not isinstance(n_steps, int) or isinstance(n_steps, bool) or n_steps < 1:
         raise EngineError(f"method {method!r}: n_steps must be a positive integer, got {n_steps!r}")
-    if n_steps > 1 and METHODS[method].crm:
-        raise EngineError(f"method {method!r}: CRM stores one-step counterfactual experiences: n_steps must be 1, "
-                          f"got {n_steps} (neither engine runs n-step CRM; run n_steps > 1 with a method "
-                          "without counterfactuals)")
 
 
 def _train_every(train_freq) -> int | None:

@@ -20,7 +20,11 @@ transition ``(w, sigma, w')``. A leaf of the sum tree is a (step, live automaton
 pair; sampling leaf (i, u) rewrites step i as read from u: the observation's one-hot, u' =
 delta(u, sigma), the reward with u's completion bonus for the real one, an end where u'
 accepts or is rejecting (``agents.crm.counterfactuals``, to which this is equal). Memory
-grows with the steps, not with the steps times the automaton's states.
+grows with the steps, not with the steps times the automaton's states. With ``n_steps`` > 1
+(n-step CRM), u is carried through the window's stored labels: each step pays the world's
+reward and u's completion bonus, and the window stops where the automaton from u accepts or
+is rejecting (then terminal), as one-step CRM ends a step, or where the real stream stops
+(an episode's end or the newest step: then u's own end decides, as for one step).
 """
 
 from __future__ import annotations
@@ -162,22 +166,49 @@ class CounterfactualView:
         ``live[j]``: (obs, next_obs, rewards, terminals, u)."""
         u = self.live[j]
         u_next = self.delta[u, sigma]
-        if isinstance(obs, SparseRows):
-            first = self.obs_dim - self.n_states
-            obs, next_obs = one_hot_at(obs, first + u), one_hot_at(next_obs, first + u_next)
-        else:
-            obs[..., -self.n_states:] = self._eye[u]
-            next_obs[..., -self.n_states:] = self._eye[u_next]
+        obs, next_obs = self.with_states(obs, next_obs, u, u_next)
         rewards = world_rewards.astype(np.float64) + self.completion * self.accepting[u_next]
         return obs, next_obs, rewards.astype(np.float32), self.ends[u_next], u
 
+    def window(self, world_rewards, sigma, real_ends, j, gamma: float):
+        """An n-step window of stored steps ``(K, B, n)`` (world rewards, labels, and where
+        the real stream stops: an episode's end or the newest step) as read from live state
+        ``live[j]``: the automaton carried from u through the window's labels pays each
+        step's completion bonus and ends the window where it accepts or is rejecting, as
+        one-step CRM ends a step. Returns (k: the steps taken, the discounted return,
+        terminals, u, the automaton state after the k-th step)."""
+        u = u_after = self.live[j]
+        n = sigma.shape[-1]
+        k = np.full(u.shape, n)
+        returns = np.zeros(u.shape)
+        terminals = np.zeros(u.shape, dtype=np.float32)
+        going = np.ones(u.shape, dtype=bool)
+        state = u
+        for t in range(n):
+            state = self.delta[state, sigma[..., t]]
+            returns += going * gamma ** t * (world_rewards[..., t] + self.completion * self.accepting[state])
+            u_after = np.where(going, state, u_after)
+            ends_here = self.ends[state] > 0
+            stop = going & (ends_here | real_ends[..., t])
+            k = np.where(stop, t + 1, k)
+            terminals = np.where(stop, ends_here, terminals).astype(np.float32)
+            going &= ~stop
+        return k, returns.astype(np.float32), terminals, u, u_after
 
-def _check_n_steps(n_steps, crm) -> None:
+    def with_states(self, obs, next_obs, u, u_next):
+        """Observations whose automaton one-hot reads ``u`` (and ``u_next`` after the step)."""
+        if isinstance(obs, SparseRows):
+            first = self.obs_dim - self.n_states
+            return one_hot_at(obs, first + u), one_hot_at(next_obs, first + u_next)
+        obs[..., -self.n_states:] = self._eye[u]
+        next_obs[..., -self.n_states:] = self._eye[u_next]
+        return obs, next_obs
+
+
+def _check_n_steps(n_steps) -> None:
     """Raise ValueError naming a return length the replay cannot sample."""
     if not isinstance(n_steps, int) or isinstance(n_steps, bool) or n_steps < 1:
         raise ValueError(f"n_steps must be a positive integer, got {n_steps!r}")
-    if n_steps > 1 and crm is not None:  # as agents.crm.CRMReplayBuffer, which SB3's CRM runs
-        raise ValueError("CRM stores one-step counterfactual experiences: n_steps must be 1")
 
 
 class PopulationReplay:
@@ -191,7 +222,7 @@ class PopulationReplay:
                  action_dtype=np.float32, *, prioritized: bool = True, alpha: float = 0.7, beta: float = 0.4,
                  epsilon: float = 0.1, crm: CounterfactualView | None = None, seed: int = 0,
                  sparse_width: int | None = None, n_steps: int = 1, gamma: float = 0.99):
-        _check_n_steps(n_steps, crm)
+        _check_n_steps(n_steps)
         self.members, self.n_envs = members, n_envs
         self.capacity = max(capacity // n_envs, 1) * n_envs
         K, C = members, self.capacity
@@ -277,8 +308,12 @@ class PopulationReplay:
             weights = (weights / weights.max(axis=1, keepdims=True)).astype(np.float32)
         index, j = np.divmod(leaves, self.per_step)
         first = self._flat(index)
-        last, returns, discounts = first, None, None
-        if self.n_steps > 1:
+        last, returns, discounts, window = first, None, None, None
+        if self.n_steps > 1 and self.crm is not None:
+            window_last, window = self._n_step_counterfactual(index, j)
+            returns, discounts = window[1], (self.gamma ** window[0]).astype(np.float32)
+            last = self._flat(window_last)
+        elif self.n_steps > 1:
             window_last, returns, discounts = self._n_step(index)
             last = self._flat(window_last)
 
@@ -293,7 +328,10 @@ class PopulationReplay:
             next_obs = SparseRows(take(self.next_index, last), take(self.next_value, last))
         rewards = take(self.rewards) if returns is None else returns
         terminals, w, sigma = take(self.terminals, last), take(self.w), take(self.sigma)
-        if self.crm is not None:
+        if window is not None:
+            _, _, terminals, w, u_after = window
+            obs, next_obs = self.crm.with_states(obs, next_obs, w, u_after)
+        elif self.crm is not None:
             obs, next_obs, rewards, terminals, w = self.crm.relabel(obs, next_obs, rewards, sigma, j)
         return Batch(obs, take(self.actions), next_obs, rewards, terminals, weights, leaves, w, sigma, discounts)
 
@@ -301,6 +339,28 @@ class PopulationReplay:
         """Members' positions ``(K, ...)`` as one index into ``(K * C, ...)``: numpy's fast take."""
         rows = self._rows.reshape(-1, *([1] * (index.ndim - 1)))
         return (index + rows * self.capacity).ravel()
+
+    def _window(self, index: np.ndarray):
+        """For positions ``(K, B)``: each one's n-step window ``(K, B, n)`` of positions, as
+        flat indices, and where the real stream stops in it (see ``_n_step``)."""
+        n, n_envs = self.n_steps, self.n_envs
+        steps = self.capacity // n_envs
+        step, env = np.divmod(index, n_envs)
+        window = (step[..., None] + np.arange(n)) % steps  # (K, B, n) vector steps
+        positions = window * n_envs + env[..., None]
+        flat = self._flat(positions).reshape(positions.shape)
+        ends = self.ended.reshape(-1)[flat] | (window == (self.pos // n_envs - 1) % steps)
+        return positions, flat, ends
+
+    def _n_step_counterfactual(self, index: np.ndarray, j: np.ndarray):
+        """For positions ``(K, B)`` read from live states ``j``: the position that ends each
+        one's window as its automaton reads it, and ``CounterfactualView.window``'s
+        (k, returns, terminals, u, u after)."""
+        positions, flat, ends = self._window(index)
+        window = self.crm.window(self.rewards.reshape(-1)[flat].astype(np.float64), self.sigma.reshape(-1)[flat],
+                                 ends, j, self.gamma)
+        last = np.take_along_axis(positions, window[0][..., None] - 1, axis=-1)[..., 0]
+        return last, window
 
     def _n_step(self, index: np.ndarray):
         """For positions ``(K, B)``: the position that ends each one's n-step window, the
@@ -311,13 +371,8 @@ class PopulationReplay:
         modulo the capacity. A window stops at its episode's end (terminated or truncated),
         and at the newest vector step written: after it come unwritten positions, or, once
         the replay has wrapped, the oldest steps, which are no one's future."""
-        n, n_envs = self.n_steps, self.n_envs
-        steps = self.capacity // n_envs
-        step, env = np.divmod(index, n_envs)
-        window = (step[..., None] + np.arange(n)) % steps  # (K, B, n) vector steps
-        positions = window * n_envs + env[..., None]
-        flat = self._flat(positions).reshape(positions.shape)
-        ends = self.ended.reshape(-1)[flat] | (window == (self.pos // n_envs - 1) % steps)
+        n = self.n_steps
+        positions, flat, ends = self._window(index)
         k = np.where(ends.any(axis=-1), ends.argmax(axis=-1), n - 1) + 1
         inside = np.arange(n) < k[..., None]
         # as the SB3 buffer sums them (float32 rewards times float64 discounts), then float32

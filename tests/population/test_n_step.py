@@ -1,7 +1,7 @@
 """n-step returns in the population engine: its replay samples them as the SB3 buffer does
 (by hand on tiny replays, and sample for sample against ``AutomatonReplayBuffer``), its
 distilled target mixes the teacher in at the first step's automaton pair as the SB3 agents
-do, a population trains with them, and CRM refuses them."""
+do, a population trains with them, and with CRM (n-step CRM) too."""
 
 import json
 
@@ -17,7 +17,7 @@ from craftsuite.agents.factory import load_agent
 from craftsuite.agents.replay import AutomatonReplayBuffer
 from craftsuite.configs import StudentConfig
 from craftsuite.hyperparameters import algorithm_settings
-from craftsuite.population import EngineError, Population, train_population
+from craftsuite.population import Population, train_population
 from craftsuite.population.dqn import PopulationDQN
 from craftsuite.population.replay import Batch, CounterfactualView, PopulationReplay
 from craftsuite.population.targets import MemberTargets
@@ -234,23 +234,83 @@ def test_a_resumed_replay_cuts_each_envs_stream_at_its_newest_step():
     assert got[(3, 0)] == (64 + 0.5 * 256, 0.25, 0.0, 4.5)  # the new episode's own steps
 
 
-def test_bad_n_steps_and_n_step_crm_are_refused():
-    spec = resolve_task("Reach")
-    view = CounterfactualView(spec.automaton, spec.completion_reward, 3 + spec.automaton.n_states)
+def test_bad_n_steps_are_refused():
     for bad in (0, 2.5, True):
         with pytest.raises(ValueError, match="n_steps must be a positive integer"):
             PopulationReplay(1, 10, 1, 3, (), n_steps=bad)
-    with pytest.raises(ValueError, match="CRM stores one-step counterfactual experiences: n_steps must be 1"):
-        PopulationReplay(1, 10, 1, 3 + spec.automaton.n_states, (), crm=view, n_steps=2)
     replay = PopulationReplay(1, 10, 1, 3, (), n_steps=2)
     with pytest.raises(ValueError, match="needs to know where episodes ended"):
         replay.add(*(np.zeros((1, 1, 3)),) * 2, *(np.zeros((1, 1)),) * 5)
+
+
+def _crm_reference(automaton, completion, rewards, sigma, real_end, u, n, gamma):
+    """One n-step CRM sample by hand: the automaton from ``u`` through the stored labels."""
+    ret, state = 0.0, u
+    for t in range(n):
+        state = int(automaton.delta[state, sigma[t]])
+        ret += gamma ** t * (rewards[t] + completion * automaton.accepting[state])
+        ends = bool(automaton.accepting[state] or automaton.rejecting[state])
+        if ends or real_end[t] or t == n - 1:
+            return ret, gamma ** (t + 1), float(ends), state, t
+
+
+@pytest.mark.parametrize("n_steps", [1, 3])
+def test_n_step_crm_carries_each_counterfactual_state_through_the_window(n_steps):
+    """Every sample of an n-step CRM replay equals the automaton run by hand from its live
+    state through the stored labels: rewards with that state's completion bonuses, the end
+    where it accepts or is rejecting (or where the real stream stops), the one-hots of u and
+    of the state after the window; n = 1 is one-step CRM's relabelling."""
+    spec = resolve_task("KeySwordDragon")  # live states 0, 1, 3; 4 accepts, 2 rejects
+    a, n_envs, steps, gamma = spec.automaton, 2, 12, 0.5
+    base = 2
+    view = CounterfactualView(a, spec.completion_reward, base + a.n_states)
+    replay = PopulationReplay(1, steps * n_envs, n_envs, base + a.n_states, (), np.int64, prioritized=False,
+                              crm=view, seed=0, n_steps=n_steps, gamma=gamma)
+    rng = np.random.default_rng(3)
+    labels = rng.integers(0, a.delta.shape[1], (steps, n_envs))
+    world = rng.normal(size=(steps, n_envs)).round(2)
+    ended = rng.random((steps, n_envs)) < 0.2
+    for t in range(steps - 2):  # not full: the newest step stops windows too
+        obs = np.zeros((1, n_envs, base + a.n_states), dtype=np.float32)
+        obs[0, :, 0], obs[0, :, 1] = t, np.arange(n_envs)
+        w = np.zeros((1, n_envs), dtype=np.int64)  # the real automaton's pair: its bonus is taken out on add
+        replay.add(obs, obs.copy(), np.zeros((1, n_envs)), world[t][None] + spec.completion_reward * a.accepting[
+            a.delta[w, labels[t][None]]], np.zeros((1, n_envs)), w, labels[t][None], ended[t][None])
+    batch = replay.sample(400)
+    newest = steps - 3
+    for b in range(400):
+        t, env = int(batch.observations[0, b, 0]), int(batch.observations[0, b, 1])
+        u = int(batch.w[0, b])
+        span = range(t, min(t + n_steps, newest + 1))
+        real_end = [bool(ended[s, env]) or s == newest for s in span]
+        ret, disc, term, after, last = _crm_reference(a, spec.completion_reward, world[list(span), env],
+                                                      labels[list(span), env], real_end, u, len(span), gamma)
+        assert batch.rewards[0, b] == pytest.approx(ret, abs=1e-4)
+        assert batch.discounts is None if n_steps == 1 else batch.discounts[0, b] == pytest.approx(disc)
+        assert batch.terminals[0, b] == term
+        assert int(batch.next_observations[0, b, 0]) == t + last  # the window's last step's
+        assert batch.observations[0, b, base + u] == 1 and batch.next_observations[0, b, base + after] == 1
+        assert batch.sigma[0, b] == labels[t, env]
+    assert {int(u) for u in batch.w[0]} == set(view.live.tolist())  # every live state read
+
+
+def test_n_step_crm_trains_in_the_population_engine_and_the_sb3_engine_refuses_it(tmp_path):
+    from craftsuite.cli import main
+
     settings = algorithm_settings("dqn", {"n_steps": 3})
-    for method in ("crm", "crm-edges"):
-        with pytest.raises(EngineError, match=f"method '{method}': CRM stores one-step counterfactual experiences: "
-                                              "n_steps must be 1, got 3 .neither engine"):
-            Population(method, settings, [0], 1, 3 + spec.automaton.n_states, gym.spaces.Discrete(4),
-                       spec.automaton, spec.completion_reward, 100)
+    spec = resolve_task("Reach")
+    Population("crm", settings, [0], 1, spec.automaton.n_states + 300, gym.spaces.Discrete(4), spec.automaton,
+               spec.completion_reward, 100)  # accepted by the engine
+    [run] = train_population([StudentConfig(task="FirstTool", method="crm", world="Grid7", steps=400, eval_every=200,
+                                            eval_episodes=1, engine="population", hyperparameters={
+                                                **DQN, "learning_starts": 100})], tmp_path, progress=False)
+    agent = load_agent(run / "model.zip")  # saved as an SB3 agent, whose replay will not sample n-step CRM
+    assert agent.n_steps == 3
+    with pytest.raises(ValueError, match="samples windows in the population engine only"):
+        agent.replay_buffer.sample(4)
+    assert main(["student", "Reach", "--world", "Grid7", "--method", "crm", "--hyper", '{"n_steps": 3}',
+                 "--out", str(tmp_path / "sb3")]) == 2
+    assert not (tmp_path / "sb3").exists()
 
 
 DQN = {"batch_size": 32, "learning_starts": 200, "policy_kwargs": {"net_arch": [16, 16]}, "gradient_steps": 2,

@@ -157,9 +157,6 @@ def test_bad_input_leaves_nothing_behind(tmp_path):
     with pytest.raises(EngineError, match="features_extractor 'residual-cnn'.*--engine sb3"):
         train_population([StudentConfig(task="Reach", method="dqn", world="Grid7", steps=100, engine="population",
                                         hyperparameters={"features_extractor": "residual-cnn"})], tmp_path)
-    with pytest.raises(EngineError, match="CRM stores one-step counterfactual experiences: n_steps must be 1"):
-        train_population([StudentConfig(task="Reach", method="crm", world="Grid7", engine="population",
-                                         hyperparameters={"n_steps": 3})], tmp_path)
     with pytest.raises(EngineError, match="differ in \\['steps'\\]"):
         train_population(_cell(seeds=(0,)) + _cell(seeds=(1,), steps=800), tmp_path)
     with pytest.raises(EngineError, match="seeds must differ"):
@@ -181,8 +178,8 @@ def test_a_population_trains_on_the_gpu(tmp_path):
 
 @pytest.mark.parametrize("argv,message", [
     (["transfer", "--suite", "quick", "--device", "gpu0"], "--device 'gpu0' is not a torch device"),
-    (["transfer", "--suite", "quick", "--methods", "td3-crm-edges", "--td3-hyper", '{"n_steps": 3}'],
-     "method 'td3-crm-edges': CRM stores one-step counterfactual experiences: n_steps must be 1, got 3"),
+    (["transfer", "--suite", "quick", "--methods", "td3-crm-edges", "--td3-hyper", '{"n_steps": 3}', "--engine",
+      "sb3"], "method 'td3-crm-edges' with n_steps 3: n-step CRM is trained by the population engine only"),
     (["student", "Reach", "--world", "Grid10", "--method", "dqn", "--engine", "population", "--hyper",
       '{"features_extractor": "residual-cnn"}'], "does not support features_extractor 'residual-cnn'"),
 ])

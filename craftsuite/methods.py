@@ -7,8 +7,11 @@ into an agent. This module imports no torch, so listing methods stays cheap.
 A row names its world kind (``Grid``: DQN on the grids, ``Cont``: TD3 in the MuJoCo
 world), whether the policy sees the automaton state, and how the student uses the
 automaton: a distilled target (``static`` or ``dynamic``, with the ``DistilledTarget``
-keywords in ``target``) or counterfactual experience (``crm``). A variant of a method is
-a row of its own, never a hyperparameter of a suite, so a leaderboard row says what ran.
+keywords in ``target``), counterfactual experience (``crm``), or potential-based reward
+shaping from the automaton's values (``shaping``: ``static`` or ``dynamic``, the potential
+solved from the automaton or distilled from a teacher; ``craftsuite.shaping``). A variant
+of a method is a row of its own, never a hyperparameter of a suite, so a leaderboard row
+says what ran.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from .ids import WORLD_KINDS
 
 # the algorithm family of each world kind: DQN needs discrete moves, TD3 continuous thrust
 ALGORITHMS = MappingProxyType({"dqn": "Grid", "td3": "Cont"})
-DISTILLATIONS = (None, "static", "dynamic")
+DISTILLATIONS = (None, "static", "dynamic")  # where a distilled target's, or a shaping potential's, values come from
 # the DistilledTarget's keywords unless a row or a run says otherwise: the paper's rho,
 # and the teacher's values on every label (self-loops included)
 TARGET_DEFAULTS = MappingProxyType({"rho": 0.999, "self_loops": True})
@@ -42,6 +45,7 @@ class Method:
     # DistilledTarget keywords over TARGET_DEFAULTS (read-only once the row is built)
     target: Mapping = field(default_factory=dict, hash=False)
     description: str = ""
+    shaping: str | None = None  # None, "static" or "dynamic": the potential of reward shaping
 
     def __post_init__(self):
         where = f"METHODS row {self.name!r}"
@@ -53,6 +57,11 @@ class Method:
                               f"use one of {fits}")
         if self.distill not in DISTILLATIONS:
             raise MethodError(f"{where}: distill must be one of {list(DISTILLATIONS)}, got {self.distill!r}")
+        if self.shaping not in DISTILLATIONS:
+            raise MethodError(f"{where}: shaping must be one of {list(DISTILLATIONS)}, got {self.shaping!r}")
+        if self.shaping and (self.crm or self.distill or not self.product):
+            raise MethodError(f"{where}: shaping is a method of its own: with the automaton state, without a "
+                              "distilled target or CRM")
         unknown = sorted(set(self.target) - set(TARGET_DEFAULTS))
         if unknown or (self.target and self.distill is None):
             raise MethodError(f"{where}: target takes {sorted(TARGET_DEFAULTS)} and only with distill; "
@@ -62,7 +71,7 @@ class Method:
     @property
     def needs_table(self) -> bool:
         """Whether the method needs a teacher's table (``craftsuite teacher``)."""
-        return self.distill == "dynamic"
+        return self.distill == "dynamic" or self.shaping == "dynamic"
 
     def observes(self, automaton_state: bool | None = None) -> bool:
         """Whether a run of this method sees the automaton state: the row's ``product``, or
@@ -82,6 +91,8 @@ class Method:
             return automaton_state
         if self.crm:  # distilled or not: its replay writes the one-hot the observation must carry
             why = "its counterfactual experiences relabel the automaton state in the observation"
+        elif self.shaping:
+            why = "its shaped rewards change with the automaton state, which its policy sees (as the baseline's does)"
         elif self.product:
             why = f"the automaton state is what it adds to {_scratch_of(self.world)!r}: run that instead"
         else:
@@ -92,8 +103,11 @@ class Method:
 
     def settings(self) -> dict:
         """What the row makes a run do, as plain data (recorded and hashed with each run)."""
-        return {"algorithm": self.algorithm, "product": self.product, "distill": self.distill, "crm": self.crm,
-                "target": self.target_kwargs() if self.distill else None}
+        out = {"algorithm": self.algorithm, "product": self.product, "distill": self.distill, "crm": self.crm,
+               "target": self.target_kwargs() if self.distill else None}
+        if self.shaping:  # only where set: the rows without it keep the run keys they had
+            out["shaping"] = self.shaping
+        return out
 
     def target_kwargs(self, **given) -> dict:
         """The ``DistilledTarget`` keywords: the paper's, then the row's, then ``given``
@@ -115,6 +129,13 @@ METHODS = MappingProxyType({m.name: m for m in (
     Method("crm-edges", "Grid", "dqn", True, "dynamic", crm=True, target={"rho": 1.0, "self_loops": False},
            description="product DQN with counterfactual experiences and the teacher's values on the "
                        "automaton's edges only, never faded"),
+    # The reward-machine literature's shaping baseline: potential-based, so the optimal
+    # policy is the unshaped one's; the potential solved from the automaton (Toro Icarte et
+    # al.'s RS) or the teacher's distilled values (the paper's knowledge, as shaping)
+    Method("rs", "Grid", "dqn", True, shaping="static",
+           description="product DQN, rewards shaped by value iteration over the automaton (RS)"),
+    Method("dynamic-rs", "Grid", "dqn", True, shaping="dynamic",
+           description="product DQN, rewards shaped by the teacher's values distilled into the automaton"),
     Method("td3", "Cont", "td3", False, description="TD3 from scratch"),
     Method("product-td3", "Cont", "td3", True, description="TD3 over the product MDP"),
     Method("td3-static", "Cont", "td3", True, "static", description="TD3 student, statically distilled automaton"),
@@ -127,6 +148,10 @@ METHODS = MappingProxyType({m.name: m for m in (
            description="td3-dynamic with the teacher's values on the automaton's edges only, never faded (rho 1)"),
     Method("td3-crm-edges", "Cont", "td3", True, "dynamic", crm=True, target={"rho": 1.0, "self_loops": False},
            description="td3-dynamic-edges with counterfactual experiences over automaton states (CRM)"),
+    Method("td3-rs", "Cont", "td3", True, shaping="static",
+           description="product TD3, rewards shaped by value iteration over the automaton (RS)"),
+    Method("td3-dynamic-rs", "Cont", "td3", True, shaping="dynamic",
+           description="product TD3, rewards shaped by the teacher's values distilled into the automaton"),
 )})
 
 
@@ -151,7 +176,8 @@ def _scratch_of(kind: str) -> str | None:
 
 
 def _product_of(kind: str) -> str | None:
-    return next((n for n, m in METHODS.items() if m.world == kind and m.product and not (m.distill or m.crm)), None)
+    return next((n for n, m in METHODS.items()
+                 if m.world == kind and m.product and not (m.distill or m.crm or m.shaping)), None)
 
 
 def check_methods(names) -> None:

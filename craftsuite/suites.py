@@ -173,11 +173,14 @@ PAPER_PROTOCOL = dict(teacher_layout_seed=None, teacher_n_envs=10, teacher_hyper
                       grid_layout_seed=None, dqn_n_envs=10, dqn_hyperparameters=AUTHORS_DQN,
                       td3_n_envs=10, td3_hyperparameters=AUTHORS_TD3, students_see_automaton=False)
 
-# The methods of the paper and its baselines (every row before the transfer method): what
-# the standard and paper suites compare. The transfer method's counterfactual replay holds
+# The methods of the paper and its baselines (every row but the transfer method and
+# shaping): what the paper suite compares. The transfer method's counterfactual replay holds
 # one copy of each step per automaton state, which the 1M-transition TD3 buffer cannot
 # afford on Diamond Mine (13 copies of 154 numbers); the transfer suite runs it.
-PAPER_METHODS = tuple(name for name, m in METHODS.items() if not (m.crm and m.distill))
+PAPER_METHODS = tuple(name for name, m in METHODS.items() if not (m.crm and m.distill) and not m.shaping)
+# the standard and hard suites add the field's shaping baseline (the population engine's
+# alone: the paper suite, on the sb3 engine, keeps the paper's methods)
+SUITE_METHODS = PAPER_METHODS + tuple(name for name, m in METHODS.items() if m.shaping)
 TRANSFER_METHODS = ("dqn", "dynamic", "crm-edges", "td3", "td3-dynamic", "td3-crm-edges")
 
 # Budgets, in transitions. TD3 students on the easy and medium rungs get enough to pass the
@@ -195,7 +198,7 @@ SUITES = {s.name: s for s in (
     Suite("standard", "the easy, medium and middle rungs x the paper's methods and baselines, Grid10 and MuJoCo, "
           "5 seeds (on 2 cores: its grid half took 65 min, its MuJoCo half projects about 4 hours; the paper's "
           "tasks are the hard suite)",
-          tags=("easy", "medium"), worlds=("Grid10", "Cont"), methods=PAPER_METHODS, seeds=5,
+          tags=("easy", "medium"), worlds=("Grid10", "Cont"), methods=SUITE_METHODS, seeds=5,
           budgets={"Cont": {"easy": 250_000, "medium": 800_000, "TwoToolsHome": 1_200_000,
                             "KeySwordDragon": 400_000},
                    "Grid": {"easy": 30_000, "medium": 150_000}},
@@ -203,7 +206,7 @@ SUITES = {s.name: s for s in (
     Suite("hard", "the paper's tasks x the paper's methods and baselines at 1M transitions per run, Grid10 and "
           "MuJoCo, 5 seeds (on 2 cores about 5 hours for MuJoCo and 7 for the grids: run it in parts, with "
           "--worlds, --tasks or --methods, on any machines; the results archive gathers them)",
-          tags=("hard",), worlds=("Grid10", "Cont"), methods=PAPER_METHODS, seeds=5,
+          tags=("hard",), worlds=("Grid10", "Cont"), methods=SUITE_METHODS, seeds=5,
           budgets={"Cont": {"hard": 1_000_000}, "Grid": {"hard": 1_000_000}}, **TD3_REGIME, **DQN_REGIME),
     Suite("paper", "the paper's protocol as the authors' code ran it: the paper's methods and baselines on its tasks "
           "in the grid, MuJoCo and kinematic worlds, 20 seeds, 2M steps of 10 envs (20M transitions) per run",

@@ -323,10 +323,14 @@ def student_result(config: StudentConfig, algorithm: str, steps: int, updates: i
 
 def check_sb3_engine(config: StudentConfig) -> None:
     """Raise ValueError, naming the engine that trains it, for a run the sb3 engine does
-    not: n-step CRM (the SB3 agents' CRM replay holds one-step counterfactuals; the
-    population engine carries each counterfactual automaton state through a window)."""
+    not: reward shaping, and n-step CRM (the SB3 agents' CRM replay holds one-step
+    counterfactuals; the population engine carries each counterfactual automaton state
+    through a window). New learning rules are the population engine's."""
     from .methods import METHODS
 
+    if METHODS[config.method].shaping:
+        raise ValueError(f"method {config.method!r}: reward shaping is trained by the population engine only; "
+                         "use --engine population")
     n_steps = config.effective()["hyperparameters"].get("n_steps", 1)
     if METHODS[config.method].crm and n_steps != 1:
         raise ValueError(f"method {config.method!r} with n_steps {n_steps}: n-step CRM is trained by the population "

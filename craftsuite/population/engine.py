@@ -21,6 +21,7 @@ from ..agents.distillation import AutomatonQTable, DistilledTarget, static_disti
 from ..agents.noise import make_action_noise
 from ..agents.td3 import _delay_schedule, delay_at
 from ..methods import METHODS
+from ..shaping import Shaping, potential
 from .dqn import PopulationDQN
 from .envs import step_records
 from .replay import CounterfactualView, PopulationReplay
@@ -145,10 +146,18 @@ class Population:
             self.noises = [make_action_noise(spec, self.act_dim, seed, n_envs) if spec else None for seed in seeds]
         buffer = settings.get("replay_buffer_kwargs") or {}
         crm = CounterfactualView(automaton, completion_reward, obs_dim) if row.crm else None
+        shaping = None
+        if row.shaping is not None:
+            if row.shaping == "dynamic" and table is None:
+                raise EngineError(f"method {method!r} shapes with a teacher's values: give its table (table.npz)")
+            values = table if row.shaping == "dynamic" else static_distillation(automaton,
+                                                                               completion_reward=completion_reward)
+            shaping = Shaping(automaton, potential(values, automaton), float(settings["gamma"]))
         self.replay = PopulationReplay(self.K, int(settings["buffer_size"]), n_envs, obs_dim, action_shape,
                                        action_dtype, prioritized=bool(settings.get("prioritized", True)),
                                        crm=crm, seed=seeds[0] + 1, sparse_width=sparse_width if self.discrete else None,
-                                       n_steps=settings.get("n_steps", 1), gamma=float(settings["gamma"]), **buffer)
+                                       n_steps=settings.get("n_steps", 1), gamma=float(settings["gamma"]),
+                                       shaping=shaping, **buffer)
         self.batch_size = int(settings["batch_size"])
         self.learning_starts = int(settings["learning_starts"])
         self.gradient_steps = int(settings.get("gradient_steps", 1))

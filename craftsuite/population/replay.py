@@ -216,13 +216,18 @@ class PopulationReplay:
     ``n_envs``). ``actions`` are ``action_shape`` of ``action_dtype`` per transition. With
     ``sparse_width``, observations are stored and sampled as ``SparseRows`` of that width
     (at least the most nonzero entries an observation of the world can have). ``n_steps``
-    and ``gamma``: n-step returns (1: one-step samples, as before n-step returns existed)."""
+    and ``gamma``: n-step returns (1: one-step samples, as before n-step returns existed).
+    ``shaping`` (a ``shaping.Shaping``): every sampled reward shaped by the automaton's
+    potential, from the sample's first automaton state to the state after its last step."""
 
     def __init__(self, members: int, capacity: int, n_envs: int, obs_dim: int, action_shape: tuple,
                  action_dtype=np.float32, *, prioritized: bool = True, alpha: float = 0.7, beta: float = 0.4,
                  epsilon: float = 0.1, crm: CounterfactualView | None = None, seed: int = 0,
-                 sparse_width: int | None = None, n_steps: int = 1, gamma: float = 0.99):
+                 sparse_width: int | None = None, n_steps: int = 1, gamma: float = 0.99, shaping=None):
         _check_n_steps(n_steps)
+        if shaping is not None and crm is not None:
+            raise ValueError("reward shaping and CRM: no method combines them, and their rewards are not composed")
+        self.shaping = shaping  # a shaping.Shaping: sampled rewards shaped by the automaton's potential
         self.members, self.n_envs = members, n_envs
         self.capacity = max(capacity // n_envs, 1) * n_envs
         K, C = members, self.capacity
@@ -333,6 +338,8 @@ class PopulationReplay:
             obs, next_obs = self.crm.with_states(obs, next_obs, w, u_after)
         elif self.crm is not None:
             obs, next_obs, rewards, terminals, w = self.crm.relabel(obs, next_obs, rewards, sigma, j)
+        if self.shaping is not None:
+            rewards = self.shaping(rewards, w, take(self.w, last), take(self.sigma, last), terminals, discounts)
         return Batch(obs, take(self.actions), next_obs, rewards, terminals, weights, leaves, w, sigma, discounts)
 
     def _flat(self, index: np.ndarray) -> np.ndarray:

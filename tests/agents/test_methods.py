@@ -80,8 +80,9 @@ def test_n_step_targets_bootstrap_with_the_buffers_discounts(method, table):
             agent.distill.student_counts[:] = 10**6  # beta = 0: the student's own target alone
             expected = agent.distill(data.w, data.sigma, expected)
         assert th.allclose(agent._td_target(data), expected)
-    with pytest.raises(ValueError, match="CRM stores one-step"):
-        make_agent("crm", GRID, n_steps=3, **SMALL_DQN)
+    crm = make_agent("crm", GRID, n_steps=3, **SMALL_DQN)  # built (a population member is saved so) ...
+    with pytest.raises(ValueError, match="samples windows in the population engine only"):
+        crm.learn(150)  # ... but its one-step counterfactual replay never samples n-step CRM
 
 
 def test_method_and_world_must_match(table):

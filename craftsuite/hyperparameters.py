@@ -41,10 +41,13 @@ class OneOf(tuple):
 # The settings a run may also override, beyond its algorithm's defaults above, each with
 # an example (the library's default) whose type a value must have: SB3's keywords of DQN
 # and TD3 that are plain data, and CraftSuite's own (agents/dqn.py, agents/td3.py).
-# With the defaults, these are every name ``check_hyperparameters`` accepts.
+# With the defaults, these are every name ``check_hyperparameters`` accepts. None of these
+# is merged into a run's settings, so a new one here leaves every run key as it was.
+# layer_norm: LayerNorm (learnable affine) after each hidden Linear layer, before the
+# activation, in the value networks only (TD3's critics, DQN's Q-network; their targets too).
 _OFF_POLICY = dict(tau=1.0, train_freq=OneOf((1, [1, "step"])), gradient_steps=1, n_steps=1,
                    optimize_memory_usage=False, replay_buffer_kwargs={}, stats_window_size=100, device="auto",
-                   prioritized=True)
+                   prioritized=True, layer_norm=False)
 # CraftSuite's DQN settings that take one of a few names, the first SB3's behaviour:
 # the loss, what target_update_interval counts, and how the observation reaches the MLP
 # (the grid planes as an image: agents/networks.py)

@@ -11,6 +11,8 @@ Where this differs from SB3's DQN, and nowhere else:
   ``target_update_interval``) or in gradient steps (the authors').
 * ``features_extractor``: SB3's flattening, or a residual CNN over the grid's planes
   (``agents/networks.py``).
+* ``layer_norm``: LayerNorm after each hidden Linear layer of the Q-network and its target
+  (``LayerNormDQNPolicy``; the dueling policy takes it too).
 """
 
 from __future__ import annotations
@@ -19,14 +21,13 @@ import numpy as np
 import torch as th
 import torch.nn.functional as F
 from stable_baselines3 import DQN
-from stable_baselines3.common.torch_layers import create_mlp
 from stable_baselines3.common.utils import polyak_update
 from stable_baselines3.dqn.policies import DQNPolicy, QNetwork
 from torch import nn
 
 from ..hyperparameters import DQN_CHOICES
 from .distillation import DistilledTarget
-from .networks import features_policy_kwargs
+from .networks import features_policy_kwargs, value_mlp
 from .base import AutomatonAlgorithm
 from .replay import AutomatonReplayBuffer, AutomatonSamples, automaton_buffer_kwargs
 
@@ -38,9 +39,9 @@ class _DuelingHead(nn.Module):
     """MLP trunk, then one linear layer giving V (column 0) and A (the rest) together:
     fewer small ops than two heads, which is what costs time for small nets on a CPU."""
 
-    def __init__(self, in_dim: int, n_actions: int, net_arch: list[int], activation_fn):
+    def __init__(self, in_dim: int, n_actions: int, net_arch: list[int], activation_fn, layer_norm: bool = False):
         super().__init__()
-        self.net = nn.Sequential(*create_mlp(in_dim, n_actions + 1, net_arch, activation_fn))
+        self.net = value_mlp(in_dim, n_actions + 1, net_arch, activation_fn, layer_norm)
 
     def forward(self, x: th.Tensor) -> th.Tensor:
         out = self.net(x)
@@ -49,17 +50,46 @@ class _DuelingHead(nn.Module):
 
 
 class DuelingQNetwork(QNetwork):
-    """SB3's QNetwork with its MLP replaced by a dueling head (same trunk sizes)."""
+    """SB3's QNetwork with its MLP replaced by a dueling head (same trunk sizes), its hidden
+    layers with LayerNorm when ``layer_norm``."""
+
+    def __init__(self, *args, layer_norm: bool = False, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.q_net = _DuelingHead(self.features_dim, int(self.action_space.n), self.net_arch, self.activation_fn,
+                                  layer_norm)
+
+
+class LayerNormQNetwork(QNetwork):
+    """SB3's QNetwork with LayerNorm after each hidden Linear layer (same sizes)."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
-        self.q_net = _DuelingHead(self.features_dim, int(self.action_space.n), self.net_arch, self.activation_fn)
+        self.q_net = value_mlp(self.features_dim, int(self.action_space.n), self.net_arch, self.activation_fn,
+                               layer_norm=True)
 
 
-class DuelingDQNPolicy(DQNPolicy):
+class LayerNormDQNPolicy(DQNPolicy):
+    """SB3's DQN policy whose Q-network and target have LayerNorm in their hidden layers
+    when ``layer_norm`` (a policy keyword, so a saved model rebuilds them); SB3's otherwise."""
+
+    def __init__(self, *args, layer_norm: bool = False, **kwargs):
+        self.layer_norm = layer_norm  # before DQNPolicy's __init__, which builds the nets
+        super().__init__(*args, **kwargs)
+
+    def make_q_net(self) -> QNetwork:
+        net_args = self._update_features_extractor(self.net_args, features_extractor=None)
+        return (LayerNormQNetwork if self.layer_norm else QNetwork)(**net_args).to(self.device)
+
+    def _get_constructor_parameters(self) -> dict:
+        return {**super()._get_constructor_parameters(), "layer_norm": self.layer_norm}
+
+
+class DuelingDQNPolicy(LayerNormDQNPolicy):
+    """The dueling head's policy (``DuelingQNetwork``), with ``layer_norm`` as its base's."""
+
     def make_q_net(self) -> DuelingQNetwork:
         net_args = self._update_features_extractor(self.net_args, features_extractor=None)
-        return DuelingQNetwork(**net_args).to(self.device)
+        return DuelingQNetwork(**net_args, layer_norm=self.layer_norm).to(self.device)
 
 
 class AutomatonDQN(AutomatonAlgorithm, DQN):
@@ -76,6 +106,8 @@ class AutomatonDQN(AutomatonAlgorithm, DQN):
         target_update_unit: what ``target_update_interval`` counts: ``"transitions"`` (SB3's
             meaning: env steps over all envs) or ``"gradient_steps"``.
         features_extractor: ``"flatten"`` (SB3's) or ``"residual-cnn"`` (grid worlds).
+        layer_norm: LayerNorm after each hidden Linear layer of the Q-network and its
+            target, before the activation (with ``policy="MlpPolicy"``; a policy keyword).
 
     ``algorithm`` (``"dqn"``) is saved with the model, so that ``load_agent`` knows its class.
     """
@@ -83,7 +115,7 @@ class AutomatonDQN(AutomatonAlgorithm, DQN):
     def __init__(self, policy, env, *, double: bool = True, dueling: bool = True, prioritized: bool = True,
                  distill: DistilledTarget | None = None, n_steps: int = 1, loss: str = "huber",
                  target_update_unit: str = "transitions", features_extractor: str = "flatten",
-                 replay_buffer_kwargs: dict | None = None, **kwargs):
+                 layer_norm: bool = False, replay_buffer_kwargs: dict | None = None, **kwargs):
         if loss not in LOSSES:
             raise ValueError(f"loss must be one of {list(LOSSES)}, got {loss!r}")
         if target_update_unit not in TARGET_UPDATE_UNITS:
@@ -92,8 +124,11 @@ class AutomatonDQN(AutomatonAlgorithm, DQN):
         if env is not None:  # None when SB3 loads a saved agent: its policy_kwargs hold the extractor already
             kwargs["policy_kwargs"] = features_policy_kwargs(features_extractor, env, kwargs.get("policy_kwargs"))
         self.loss, self.target_update_unit, self.features_extractor = loss, target_update_unit, features_extractor
-        if dueling and policy == "MlpPolicy":
-            policy = DuelingDQNPolicy
+        if policy == "MlpPolicy" and (dueling or layer_norm):
+            policy = DuelingDQNPolicy if dueling else LayerNormDQNPolicy
+        if layer_norm:  # a policy keyword, saved with the model's policy_kwargs; off, they stay SB3's
+            kwargs["policy_kwargs"] = {**(kwargs.get("policy_kwargs") or {}), "layer_norm": True}
+        self.layer_norm = layer_norm
         kwargs.setdefault("replay_buffer_class", AutomatonReplayBuffer)
         replay_buffer_kwargs = automaton_buffer_kwargs(prioritized, n_steps, kwargs.get("gamma", 0.99),
                                                        replay_buffer_kwargs)

@@ -5,18 +5,28 @@ reads the grid's planes as an image, as the paper's authors' network did: a 3x3
 convolution and three residual blocks of two 3x3 convolutions (32 filters, batch norm,
 leaky ReLU), flattened; the rest of the vector (inventory, and the automaton state's
 one-hot for product methods) joins the flattened maps before the MLP head.
+
+``value_mlp`` is the value networks' MLP (TD3's critics, DQN's Q-network), with the
+``layer_norm`` setting's LayerNorm after each hidden Linear layer when asked.
 """
 
 from __future__ import annotations
 
 import gymnasium as gym
 import torch as th
-from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
+from stable_baselines3.common.torch_layers import BaseFeaturesExtractor, create_mlp
 from torch import nn
 
 from ..hyperparameters import DQN_CHOICES
 
 FEATURES_EXTRACTORS = DQN_CHOICES["features_extractor"]
+
+
+def value_mlp(in_dim: int, out_dim: int, net_arch: list[int], activation_fn, layer_norm: bool) -> nn.Sequential:
+    """SB3's MLP ``in_dim -> net_arch -> out_dim``; with ``layer_norm``, Linear -> LayerNorm ->
+    activation in each hidden layer (SB3's ``post_linear_modules``), none after the output."""
+    return nn.Sequential(*create_mlp(in_dim, out_dim, net_arch, activation_fn,
+                                     post_linear_modules=[nn.LayerNorm] if layer_norm else None))
 
 
 class _Residual(nn.Module):

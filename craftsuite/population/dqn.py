@@ -31,8 +31,10 @@ class PopulationDQN:
         act = activation_of(policy_kwargs.get("activation_fn", nn.ReLU))
         self.dueling = bool(settings.get("dueling", True))
         outputs = n_actions + 1 if self.dueling else n_actions  # column 0 is V, as agents.dqn's head
-        self.q_net = StackedMLP(members, [obs_dim, *hidden, outputs], act, device=self.device)
-        self.q_net_target = StackedMLP(members, [obs_dim, *hidden, outputs], act, device=self.device)
+        layer_norm = bool(settings.get("layer_norm", False))  # in the hidden layers, as agents.dqn's policies
+        self.q_net = StackedMLP(members, [obs_dim, *hidden, outputs], act, device=self.device, layer_norm=layer_norm)
+        self.q_net_target = StackedMLP(members, [obs_dim, *hidden, outputs], act, device=self.device,
+                                       layer_norm=layer_norm)
         self.q_net_target.load_state_dict(self.q_net.state_dict())
         optimizer_kwargs = {**(policy_kwargs.get("optimizer_kwargs") or {})}
         self.optimizer = th.optim.Adam(self.q_net.parameters(), lr=float(settings["learning_rate"]),

@@ -39,12 +39,12 @@ _READ = {
     "td3": {"learning_rate", "buffer_size", "batch_size", "learning_starts", "gamma", "tau", "target_policy_noise",
             "target_noise_clip", "action_noise", "policy_kwargs", "train_freq", "gradient_steps", "n_steps",
             "prioritized", "replay_buffer_kwargs", "policy_delay", "delay_schedule", "device",
-            "stats_window_size", "optimize_memory_usage"},
+            "stats_window_size", "optimize_memory_usage", "layer_norm"},
     "dqn": {"learning_rate", "buffer_size", "batch_size", "learning_starts", "gamma", "tau", "train_freq",
             "gradient_steps", "target_update_interval", "exploration_fraction", "exploration_initial_eps",
             "exploration_final_eps", "policy_kwargs", "n_steps", "prioritized", "replay_buffer_kwargs",
             "max_grad_norm", "double", "dueling", "loss", "target_update_unit", "features_extractor", "device",
-            "stats_window_size", "optimize_memory_usage"},
+            "stats_window_size", "optimize_memory_usage", "layer_norm"},
 }
 _POLICY_KWARGS = {"net_arch", "activation_fn", "optimizer_kwargs", "n_critics"}
 

@@ -8,7 +8,8 @@ core: 1.70 ms for one plain-torch member, 1.13 ms per member at K = 10-20).
 for these sizes and keeps the parameters plain tensors that one Adam steps together.
 
 Members are copied from and to stable-baselines3's MLPs (``nn.Sequential`` of ``Linear``
-and activations), so a member can be saved as an ordinary SB3 policy.
+and activations, and ``LayerNorm`` with ``layer_norm``), so a member can be saved as an
+ordinary SB3 policy.
 """
 
 from __future__ import annotations
@@ -19,14 +20,18 @@ import torch as th
 from torch import nn
 
 ACTIVATIONS = {nn.ReLU: th.relu, nn.Tanh: th.tanh, nn.LeakyReLU: nn.functional.leaky_relu}
+LAYER_NORM_EPS = 1e-5  # nn.LayerNorm's default, which SB3's post_linear_modules build with
 
 
 class StackedMLP(nn.Module):
     """K MLPs ``sizes[0] -> ... -> sizes[-1]``, ``activation`` between layers and ``output``
     (None, or e.g. ``th.tanh``) after the last; initialised as ``nn.Linear`` does, each
-    member from its own draws."""
+    member from its own draws. With ``layer_norm``, each hidden layer is Linear -> LayerNorm
+    -> activation, each member with its own affine weight and bias (``norm_weights``,
+    ``norm_biases``: ones and zeros at first, as ``nn.LayerNorm``)."""
 
-    def __init__(self, members: int, sizes: list[int], activation=th.relu, output=None, device=None):
+    def __init__(self, members: int, sizes: list[int], activation=th.relu, output=None, device=None,
+                 layer_norm: bool = False):
         super().__init__()
         if members < 1:
             raise ValueError(f"a population has at least one member, got {members}")
@@ -40,6 +45,17 @@ class StackedMLP(nn.Module):
             b = th.empty(members, 1, fan_out, device=device).uniform_(-bound, bound)
             self.weights.append(nn.Parameter(w))
             self.biases.append(nn.Parameter(b))
+        # empty without layer_norm: the parameters and state dict stay those of the plain MLP
+        self.norm_weights = nn.ParameterList()
+        self.norm_biases = nn.ParameterList()
+        for width in (sizes[1:-1] if layer_norm else []):  # no random draws: the Linears' stay as they were
+            self.norm_weights.append(nn.Parameter(th.ones(members, 1, width, device=device)))
+            self.norm_biases.append(nn.Parameter(th.zeros(members, 1, width, device=device)))
+
+    @property
+    def layer_norm(self) -> bool:
+        """Whether each hidden layer has a LayerNorm."""
+        return len(self.norm_weights) > 0
 
     def forward(self, x) -> th.Tensor:
         """``x``: a ``(K, B, in)`` tensor, or ``(index, value)`` tensors ``(K, B, width)``
@@ -52,8 +68,14 @@ class StackedMLP(nn.Module):
             else:
                 x = th.baddbmm(b, x, w)
             if i < last:
-                x = self.activation(x)
+                x = self.activation(self._norm(i, x) if self.layer_norm else x)
         return x if self.output is None else self.output(x)
+
+    def _norm(self, i: int, x: th.Tensor) -> th.Tensor:
+        """Hidden layer ``i``'s LayerNorm: nn.LayerNorm's normalisation, then each member's
+        own affine (``F.layer_norm`` takes one weight for every leading index, members too)."""
+        normalized = nn.functional.layer_norm(x, x.shape[-1:], eps=LAYER_NORM_EPS)
+        return th.addcmul(self.norm_biases[i], normalized, self.norm_weights[i])
 
     def _sparse_first_layer(self, index: th.Tensor, value: th.Tensor) -> th.Tensor:
         w, b = self.weights[0], self.biases[0]
@@ -65,20 +87,27 @@ class StackedMLP(nn.Module):
 
     # -- members as SB3 modules --------------------------------------------------------------
     def load_member(self, k: int, sequential: nn.Sequential) -> None:
-        """Member ``k``'s weights from an ``nn.Sequential`` of the same shape (SB3's MLPs)."""
-        linears = _linears(sequential, self.sizes)
+        """Member ``k``'s weights from an ``nn.Sequential`` of the same shape (SB3's MLPs),
+        its LayerNorms' affine too."""
+        linears, norms = _linears(sequential, self.sizes), _norms(sequential, self)
         with th.no_grad():
             for w, b, lin in zip(self.weights, self.biases, linears):
                 w[k].copy_(lin.weight.T)
                 b[k, 0].copy_(lin.bias)
+            for w, b, norm in zip(self.norm_weights, self.norm_biases, norms):
+                w[k, 0].copy_(norm.weight)
+                b[k, 0].copy_(norm.bias)
 
     def store_member(self, k: int, sequential: nn.Sequential) -> None:
         """Member ``k``'s weights into an ``nn.Sequential`` of the same shape."""
-        linears = _linears(sequential, self.sizes)
+        linears, norms = _linears(sequential, self.sizes), _norms(sequential, self)
         with th.no_grad():
             for w, b, lin in zip(self.weights, self.biases, linears):
                 lin.weight.copy_(w[k].T)
                 lin.bias.copy_(b[k, 0])
+            for w, b, norm in zip(self.norm_weights, self.norm_biases, norms):
+                norm.weight.copy_(w[k, 0])
+                norm.bias.copy_(b[k, 0])
 
 
 def _linears(sequential: nn.Module, sizes: list[int]) -> list[nn.Linear]:
@@ -87,6 +116,22 @@ def _linears(sequential: nn.Module, sizes: list[int]) -> list[nn.Linear]:
     if shape != list(sizes):
         raise ValueError(f"an MLP of sizes {shape} is not a member of a population of sizes {sizes}")
     return linears
+
+
+def _norms(sequential: nn.Module, stacked: StackedMLP) -> list[nn.LayerNorm]:
+    """The LayerNorms of an SB3 MLP, one per hidden layer of ``stacked`` (none without
+    ``layer_norm``), each with the affine and epsilon that ``StackedMLP`` computes."""
+    norms = [m for m in sequential.modules() if isinstance(m, nn.LayerNorm)]
+    widths = [tuple(n.normalized_shape) for n in norms]
+    want = [(w.shape[-1],) for w in stacked.norm_weights]
+    if widths != want:
+        raise ValueError(f"an MLP with LayerNorms of widths {widths} is not a member of a population with "
+                         f"{want or 'none'}: build both with the same layer_norm setting")
+    odd = [n for n in norms if n.weight is None or n.bias is None or n.eps != LAYER_NORM_EPS]
+    if odd:
+        raise ValueError(f"{odd[0]} is not a member's LayerNorm: it needs nn.LayerNorm's affine and "
+                         f"eps={LAYER_NORM_EPS}")
+    return norms
 
 
 def activation_of(activation_fn) -> callable:

@@ -41,12 +41,16 @@ class PopulationTD3:
         pi, qf = net_arch(policy_kwargs, [400, 300])
         act = activation_of(policy_kwargs.get("activation_fn", nn.ReLU))
         n_critics = policy_kwargs.get("n_critics", 2)
+        layer_norm = bool(settings.get("layer_norm", False))  # the critics' only, as agents.td3's policy
+
+        def critics():
+            return nn.ModuleList(StackedMLP(members, [obs_dim + act_dim, *qf, 1], act, device=self.device,
+                                            layer_norm=layer_norm) for _ in range(n_critics))
+
         self.actor = StackedMLP(members, [obs_dim, *pi, act_dim], act, th.tanh, device=self.device)
-        self.critics = nn.ModuleList(StackedMLP(members, [obs_dim + act_dim, *qf, 1], act, device=self.device)
-                                     for _ in range(n_critics))
+        self.critics = critics()
         self.actor_target = StackedMLP(members, [obs_dim, *pi, act_dim], act, th.tanh, device=self.device)
-        self.critics_target = nn.ModuleList(StackedMLP(members, [obs_dim + act_dim, *qf, 1], act, device=self.device)
-                                            for _ in range(n_critics))
+        self.critics_target = critics()
         self.actor_target.load_state_dict(self.actor.state_dict())
         self.critics_target.load_state_dict(self.critics.state_dict())
         optimizer_kwargs = {**(policy_kwargs.get("optimizer_kwargs") or {})}

@@ -37,11 +37,13 @@ def _close(a: th.Tensor, b: th.Tensor):
     assert th.allclose(a, b, atol=1e-6, rtol=1e-5), (a - b).abs().max()
 
 
-@pytest.mark.parametrize("prioritized", [True, False])
-def test_td3_update_matches_automaton_td3(prioritized):
+@pytest.mark.parametrize("prioritized,layer_norm", [(True, False), (False, False), (True, True)])
+def test_td3_update_matches_automaton_td3(prioritized, layer_norm):
+    """``layer_norm``: the critics' LayerNorms (each member's own affine) learn as SB3's."""
     agent = _filled("td3-static", "CraftSuite/FirstTool-Kinematic-v0", batch_size=32, policy_delay=1,
-                    prioritized=prioritized, policy_kwargs={"net_arch": [32, 24]})
-    settings = agent_settings(agent, "td3", prioritized=prioritized, policy_kwargs={"net_arch": [32, 24]})
+                    prioritized=prioritized, policy_kwargs={"net_arch": [32, 24]}, layer_norm=layer_norm)
+    settings = agent_settings(agent, "td3", prioritized=prioritized, policy_kwargs={"net_arch": [32, 24]},
+                              layer_norm=layer_norm)
     obs_dim = agent.observation_space.shape[0]
     pop = PopulationTD3(1, obs_dim, 2, settings, MemberTargets(agent.distill, 1))
     pop.targets.counts[0] = agent.distill.student_counts.reshape(-1)
@@ -54,7 +56,7 @@ def test_td3_update_matches_automaton_td3(prioritized):
         th.manual_seed(step)
         td = pop.update(_batch(samples), delay=1)
     assert np.abs(td).sum() > 0
-    mine = _fresh_td3(agent)
+    mine = _fresh_td3(agent, layer_norm)
     pop.store_member(0, mine)
     for name in ("actor", "actor_target", "critic", "critic_target"):
         for a, b in zip(getattr(agent.policy, name).parameters(), getattr(mine.policy, name).parameters()):
@@ -62,15 +64,18 @@ def test_td3_update_matches_automaton_td3(prioritized):
     np.testing.assert_array_equal(pop.targets.counts[0], agent.distill.student_counts.reshape(-1))
 
 
-@pytest.mark.parametrize("loss,prioritized,sparse", [("huber", True, False), ("mse", False, False),
-                                                     ("huber", True, True)])
-def test_dqn_update_matches_automaton_dqn(loss, prioritized, sparse):
+@pytest.mark.parametrize("loss,prioritized,sparse,layer_norm", [
+    ("huber", True, False, False), ("mse", False, False, False), ("huber", True, True, False),
+    ("huber", True, True, True)])
+def test_dqn_update_matches_automaton_dqn(loss, prioritized, sparse, layer_norm):
     """``sparse``: the minibatch's observations as their nonzero entries, as the grid
-    students' replay stores them (the first layer a sum of weight rows)."""
+    students' replay stores them (the first layer a sum of weight rows). ``layer_norm``:
+    the Q-network's LayerNorms learn (and are clipped) as SB3's."""
     agent = _filled("static", "CraftSuite/FirstTool-Grid7-v0", batch_size=32, loss=loss, prioritized=prioritized,
-                    target_update_interval=2, target_update_unit="gradient_steps", max_grad_norm=0.05)
+                    target_update_interval=2, target_update_unit="gradient_steps", max_grad_norm=0.05,
+                    layer_norm=layer_norm)
     settings = agent_settings(agent, "dqn", loss=loss, prioritized=prioritized, target_update_interval=2,
-                              target_update_unit="gradient_steps", max_grad_norm=0.05)
+                              target_update_unit="gradient_steps", max_grad_norm=0.05, layer_norm=layer_norm)
     pop = PopulationDQN(1, agent.observation_space.shape[0], 4, settings, MemberTargets(agent.distill, 1))
     pop.targets.counts[0] = agent.distill.student_counts.reshape(-1)
     pop.load_member(0, agent)
@@ -84,7 +89,7 @@ def test_dqn_update_matches_automaton_dqn(loss, prioritized, sparse):
             batch = batch._replace(observations=sparse_rows(batch.observations, width),
                                    next_observations=sparse_rows(batch.next_observations, width))
         pop.update(batch)
-    mine = make_agent("static", "CraftSuite/FirstTool-Grid7-v0", seed=9, buffer_size=16)
+    mine = make_agent("static", "CraftSuite/FirstTool-Grid7-v0", seed=9, buffer_size=16, layer_norm=layer_norm)
     pop.store_member(0, mine)
     for name in ("q_net", "q_net_target"):
         for a, b in zip(getattr(agent.policy, name).parameters(), getattr(mine.policy, name).parameters()):
@@ -97,6 +102,6 @@ def agent_settings(agent, algorithm, **overrides) -> dict:
     return algorithm_settings(algorithm, overrides)
 
 
-def _fresh_td3(like):
+def _fresh_td3(like, layer_norm=False):
     return make_agent("td3-static", "CraftSuite/FirstTool-Kinematic-v0", seed=11, buffer_size=16,
-                      policy_kwargs={"net_arch": [32, 24]})
+                      policy_kwargs={"net_arch": [32, 24]}, layer_norm=layer_norm)

@@ -87,7 +87,7 @@ def main(argv=None) -> None:
             print(f"| {name} | `{json.dumps(overrides)}` | {runs} ({len(mine[name])} rungs) | {shown} |")
         groups = [list(settings)] if args.wave == 1 else [[list(settings)[0], other] for other in list(settings)[1:]]
         for order in groups:
-            kept, lines = decide(order, mine, sum(len(r) for r in driver.RUNGS.values()))
+            kept, lines = decide(order, mine, sum(len(driver.RUNGS[suite]) for suite in driver.WAVES[args.wave]))
             print("")
             for line in lines:
                 print(f"- {line}")

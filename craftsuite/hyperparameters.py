@@ -42,7 +42,7 @@ class OneOf(tuple):
 # an example (the library's default) whose type a value must have: SB3's keywords of DQN
 # and TD3 that are plain data, and CraftSuite's own (agents/dqn.py, agents/td3.py).
 # With the defaults, these are every name ``check_hyperparameters`` accepts. None of these
-# is merged into a run's settings, so a new one here leaves every run key as it was.
+# is merged into a run's settings: a run's key hashes only those it gives.
 # layer_norm: LayerNorm (learnable affine) after each hidden Linear layer, before the
 # activation, in the value networks only (TD3's critics, DQN's Q-network; their targets too).
 _OFF_POLICY = dict(tau=1.0, train_freq=OneOf((1, [1, "step"])), gradient_steps=1, n_steps=1,

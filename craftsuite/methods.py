@@ -105,7 +105,7 @@ class Method:
         """What the row makes a run do, as plain data (recorded and hashed with each run)."""
         out = {"algorithm": self.algorithm, "product": self.product, "distill": self.distill, "crm": self.crm,
                "target": self.target_kwargs() if self.distill else None}
-        if self.shaping:  # only where set: the rows without it keep the run keys they had
+        if self.shaping:  # only where set: a row without it records (and hashes) the four fields alone
             out["shaping"] = self.shaping
         return out
 
@@ -129,9 +129,9 @@ METHODS = MappingProxyType({m.name: m for m in (
     Method("crm-edges", "Grid", "dqn", True, "dynamic", crm=True, target={"rho": 1.0, "self_loops": False},
            description="product DQN with counterfactual experiences and the teacher's values on the "
                        "automaton's edges only, never faded"),
-    # The reward-machine literature's shaping baseline: potential-based, so the optimal
-    # policy is the unshaped one's; the potential solved from the automaton (Toro Icarte et
-    # al.'s RS) or the teacher's distilled values (the paper's knowledge, as shaping)
+    # The reward-machine literature's shaping baseline (Toro Icarte et al.'s RS): potential-
+    # based, so the optimal policy is the unshaped one's; the potential solved from the
+    # automaton, or the teacher's distilled values (the paper's knowledge, as shaping)
     Method("rs", "Grid", "dqn", True, shaping="static",
            description="product DQN, rewards shaped by value iteration over the automaton (RS)"),
     Method("dynamic-rs", "Grid", "dqn", True, shaping="dynamic",

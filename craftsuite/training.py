@@ -330,11 +330,11 @@ def check_sb3_engine(config: StudentConfig) -> None:
 
     if METHODS[config.method].shaping:
         raise ValueError(f"method {config.method!r}: reward shaping is trained by the population engine only; "
-                         "use --engine population")
+                         "use --engine population (or leave the method out: --methods)")
     n_steps = config.effective()["hyperparameters"].get("n_steps", 1)
     if METHODS[config.method].crm and n_steps != 1:
         raise ValueError(f"method {config.method!r} with n_steps {n_steps}: n-step CRM is trained by the population "
-                         "engine only; use --engine population")
+                         "engine only; use --engine population (or leave the method out: --methods)")
 
 
 def train_student(config: StudentConfig, root, progress: bool = True) -> Path:

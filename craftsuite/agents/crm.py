@@ -61,7 +61,7 @@ class CRMReplayBuffer(AutomatonReplayBuffer):
                          n_envs=n_envs * self.n_live, **kwargs)
 
     def sample(self, *args, **kwargs):
-        if self.n_steps_trained != 1:
+        if getattr(self, "n_steps_trained", 1) != 1:  # a pickle without it holds one-step CRM
             raise ValueError(f"n-step CRM (n_steps {self.n_steps_trained}) samples windows in the population "
                              "engine only: train it with --engine population")
         return super().sample(*args, **kwargs)

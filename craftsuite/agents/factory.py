@@ -34,7 +34,8 @@ assert set(CLASSES) == set(ALGORITHMS), "every algorithm of the methods table ne
 
 def make_agent(method: str, env, *, table: AutomatonQTable | None = None, seed: int = 0,
                n_envs: int = 1, rho: float | None = None, self_loops: bool | None = None, verbose: int = 0,
-               env_kwargs: dict | None = None, automaton_state: bool | None = None, **overrides):
+               env_kwargs: dict | None = None, automaton_state: bool | None = None, to_save: bool = False,
+               **overrides):
     """An untrained agent of ``method``: each step of the agent collects one transition per
     env, then takes ``gradient_steps`` updates.
 
@@ -47,9 +48,14 @@ def make_agent(method: str, env, *, table: AutomatonQTable | None = None, seed: 
     target (``DistilledTarget``; None: the method's); ``overrides`` to the algorithm,
     checked by name and type (``craftsuite.hyperparameters.check_hyperparameters``; TD3's
     ``action_noise`` may be a spec such as ``{"type": "persistent", "sigma": 0.6,
-    "resample": 0.1}``: ``agents/noise.py``)."""
+    "resample": 0.1}``: ``agents/noise.py``). ``to_save``: the agent is built to hold a
+    population member's trained weights, not to learn: the only way to build one of a
+    method whose learning rule only the population engine has (reward shaping)."""
     check_methods([method])
     m = METHODS[method]
+    if m.shaping and not to_save:  # its rule is the population engine's: an SB3 agent of it would learn unshaped
+        raise ValueError(f"method {method!r}: reward shaping is trained by the population engine only; use "
+                         "--engine population (make_agent builds its model only to save a member: to_save=True)")
     product = m.observes(automaton_state)  # a MethodError naming both, for a method that cannot go without
     kwargs = algorithm_settings(m.algorithm, overrides)  # bad settings are named before an env is made
     if isinstance(env, str):

@@ -48,7 +48,7 @@ class StackedMLP(nn.Module):
         # empty without layer_norm: the parameters and state dict stay those of the plain MLP
         self.norm_weights = nn.ParameterList()
         self.norm_biases = nn.ParameterList()
-        for width in (sizes[1:-1] if layer_norm else []):  # no random draws: the Linears' stay as they were
+        for width in (sizes[1:-1] if layer_norm else []):  # no random draws: the Linears' draws do not depend on it
             self.norm_weights.append(nn.Parameter(th.ones(members, 1, width, device=device)))
             self.norm_biases.append(nn.Parameter(th.zeros(members, 1, width, device=device)))
 

@@ -276,7 +276,7 @@ def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, 
     from ..training import student_result
 
     agent = make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=1,
-                       env_kwargs=config.env_kwargs, automaton_state=config.automaton_state,
+                       env_kwargs=config.env_kwargs, automaton_state=config.automaton_state, to_save=True,
                        **config.effective()["hyperparameters"])
     pop.learner.store_member(k, agent)
     agent.num_timesteps, agent.n_updates = pop.num_timesteps, pop.learner.n_updates

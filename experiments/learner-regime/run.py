@@ -26,7 +26,6 @@ RUNGS = {"standard": ("KeySwordDragon", "ToolHome", "TwoToolsHome"), "hard": ("D
 WAVES = {1: ("standard", "hard"), 2: ("standard",)}
 SCRATCH = {"Cont": "td3", "Grid10": "dqn"}
 ARCHIVES = ("results/{suite}", "results/n-step-returns/{suite}", "results/learner-regime/{suite}")
-# Cheaper settings first, the suites' current one where two cost the same (the README's rule).
 # {} is the suites' own regime: its runs are the suites' records.
 N_STEPS = {"n1": {}, "n3": {"n_steps": 3}, "n5": {"n_steps": 5}}
 
@@ -43,6 +42,16 @@ def wave_2(world: str, n: int) -> dict[str, dict]:
     else:
         settings[f"n{n}-updates0.25"] = {**base, "gradient_steps": 1}
     return settings
+
+
+def factors(wave: int, world: str, n: int | None) -> list[list[str]]:
+    """Each factor's settings in the rule's order: the cheaper first (the incumbent), the
+    suites' current one first where two cost the same (the README's table)."""
+    if wave == 1:
+        return [list(N_STEPS)]
+    base = f"n{n}"
+    last = [base, f"{base}-gaussian"] if world == "Cont" else [f"{base}-updates0.25", base]  # 0.25 is the cheaper
+    return [[base, f"{base}-layernorm"], [base, f"{base}-w256"], last]
 
 
 def settings_for(wave: int, world: str, n: int | None) -> dict[str, dict]:

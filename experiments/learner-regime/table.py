@@ -27,8 +27,7 @@ def _driver():
 
 def auc_by_setting(driver, wave: int, ns: dict, roots: list[Path]) -> dict:
     """{(world, setting): [AUCs of rung 1's seeds, rung 2's, ...]} for the runs found under
-    ``roots`` (each a directory of a suite's runs); a cell with fewer than 2 runs is left
-    out (a stratified bootstrap needs 2 a rung)."""
+    ``roots`` (each a directory of a suite's runs)."""
     found = {}
     for root in roots:
         for run in root.glob("*/students/*") if root.is_dir() else []:
@@ -43,13 +42,16 @@ def auc_by_setting(driver, wave: int, ns: dict, roots: list[Path]) -> dict:
     return {key: [aucs for _, aucs in sorted(rungs.items())] for key, rungs in out.items()}
 
 
-def decide(order: list[str], aucs: dict[str, list], rungs: int) -> tuple[str | None, list[str]]:
+def decide(order: list[str], aucs: dict[str, list], rungs: int, seeds: int) -> tuple[str | None, list[str]]:
     """The README's rule over the settings in ``order`` (cheapest first): the setting kept
-    (None until every setting has run on all ``rungs``), and a line per comparison made."""
+    (None until every setting has all ``seeds`` runs on all ``rungs``), and a line per
+    comparison made."""
     incumbent, lines = order[0], []
     for candidate in order[1:]:
-        if any(len(aucs.get(s, [])) != rungs for s in (candidate, incumbent)):
-            lines.append(f"{candidate} against {incumbent}: not every rung has run")
+        complete = [len(aucs.get(s, [])) == rungs and all(len(r) == seeds for r in aucs[s])
+                    for s in (candidate, incumbent)]
+        if not all(complete):
+            lines.append(f"{candidate} against {incumbent}: not every rung has all its seeds yet")
             return None, lines
         p = probability_of_improvement(aucs[candidate], aucs[incumbent])
         wins = p.low > 0.5
@@ -85,9 +87,10 @@ def main(argv=None) -> None:
             est = aggregate_iqm(mine[name]) if all(len(r) >= 2 for r in mine[name]) else None
             shown = "n/a" if est is None else f"{est.value:.2f} [{est.low:.2f}, {est.high:.2f}]"
             print(f"| {name} | `{json.dumps(overrides)}` | {runs} ({len(mine[name])} rungs) | {shown} |")
-        groups = [list(settings)] if args.wave == 1 else [[list(settings)[0], other] for other in list(settings)[1:]]
-        for order in groups:
-            kept, lines = decide(order, mine, sum(len(driver.RUNGS[suite]) for suite in driver.WAVES[args.wave]))
+        rungs = sum(len(driver.RUNGS[suite]) for suite in driver.WAVES[args.wave])
+        seeds = min(driver.SUITES[suite].seeds for suite in driver.WAVES[args.wave])
+        for order in driver.factors(args.wave, world, ns[world]):
+            kept, lines = decide(order, mine, rungs, seeds)
             print("")
             for line in lines:
                 print(f"- {line}")

@@ -147,15 +147,17 @@ def test_suites_are_well_formed(tmp_path):
     assert both.teachers() == {}  # no method needs a teacher
     grid_distiller = dataclasses.replace(SUITES["quick"], methods=("td3", "dynamic"))
     assert grid_distiller.teachers() == {}  # `dynamic` needs one, but runs on the grids, not in this suite's world
-    # standard and hard: every rung x the paper's methods and baselines (each in its world) x 5 seeds,
-    # budgets by level or by the rung's own name
-    from craftsuite.suites import PAPER_METHODS
+    # standard and hard: every rung x the paper's methods and baselines and the shaping baseline (each in its
+    # world) x 5 seeds, budgets by level or by the rung's own name; the paper suite without shaping
+    from craftsuite.suites import PAPER_METHODS, SUITE_METHODS
 
     standard = SUITES["standard"].student_configs(tmp_path)
     hard = SUITES["hard"].student_configs(tmp_path)
-    assert {(c.task, c.method) for c in standard + hard} == set(product([s.name for s in ladder()], PAPER_METHODS))
+    assert {(c.task, c.method) for c in standard + hard} == set(product([s.name for s in ladder()], SUITE_METHODS))
+    assert set(SUITE_METHODS) - set(PAPER_METHODS) == {m for m in METHODS if METHODS[m].shaping}
+    assert not any(METHODS[m].shaping for m in SUITES["paper"].methods)
     assert {c.task for c in hard} == {s.name for s in ladder("paper")} and {c.steps for c in hard} == {1_000_000}
-    assert set(METHODS) - set(PAPER_METHODS) == {"crm-edges", "td3-crm-edges"}  # the transfer suite's
+    assert set(METHODS) - set(SUITE_METHODS) == {"crm-edges", "td3-crm-edges"}  # the transfer suite's
     transfer = SUITES["transfer"].student_configs(tmp_path)
     assert {c.method for c in transfer} == {"dqn", "dynamic", "crm-edges", "td3", "td3-dynamic", "td3-crm-edges"}
     # every TD3 method of the transfer suite gets the same replay, small enough for CRM's copies

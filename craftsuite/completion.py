@@ -24,9 +24,8 @@ import json
 from pathlib import Path
 
 from .files import atomic_write
-from .runs import EPISODE_FIELDS, EVAL_FIELDS, FORMAT, RunError, csv_text, read_config, read_csv
+from .runs import EPISODE_FIELDS, EVAL_FIELDS, FORMAT, RunError, counts_acceptance, csv_text, read_config, read_csv
 
-COMPLETION_FORMAT = 3  # the first record format whose kinematic success is completion
 REREAD = ("success re-read as completion from a record that counted the automaton's acceptance: "
           "a training episode completed if accepted and ended before its time limit")
 
@@ -37,11 +36,9 @@ def needs_reread(record: dict) -> bool:
     Raises:
         RunError: the record's task is unknown here, so its board cannot be read.
     """
-    from .ids import KINEMATIC, parse_id
-
-    env_id = record.get("effective", {}).get("world", {}).get("id")
-    if record.get("format", 1) >= COMPLETION_FORMAT or not env_id or parse_id(env_id)[1] != KINEMATIC:
+    if not counts_acceptance(record):
         return False
+    env_id = record["effective"]["world"]["id"]
     from .envs.board import BoardRules
     from .labelling import Labeller
     from .task_registry import resolve_task

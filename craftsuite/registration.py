@@ -178,12 +178,6 @@ def make_grid_vector(num_envs: int, **kwargs) -> gym.vector.VectorEnv:
     return make(num_envs, **kwargs)
 
 
-def check_num_envs(num_envs) -> None:
-    """Raise a ValueError unless ``num_envs`` is a positive integer (every vectorization mode)."""
-    if not isinstance(num_envs, int) or isinstance(num_envs, bool) or num_envs < 1:
-        raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
-
-
 def make_vec(id: str | gym.envs.registration.EnvSpec, num_envs: int = 1, vectorization_mode=None,
              **kwargs) -> gym.vector.VectorEnv:
     """``gymnasium.make_vec``, ``num_envs`` checked first in every vectorization mode.
@@ -192,6 +186,8 @@ def make_vec(id: str | gym.envs.registration.EnvSpec, num_envs: int = 1, vectori
     one, so with none they fail with an IndexError before any CraftSuite code runs; their
     make_vec has no hook for a check (the "vector_entry_point" mode checks in the vector env).
     """
+    from .envs.vector import check_num_envs
+
     check_num_envs(num_envs)
     return gym.make_vec(id, num_envs=num_envs, vectorization_mode=vectorization_mode, **kwargs)
 

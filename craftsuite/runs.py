@@ -57,11 +57,22 @@ class RunError(RuntimeError):
 # nothing of the effective settings, so a run directory holding one is never resumed.
 # Layout 2 is layout 3 whose kinematic success counted acceptance (``completion``).
 FORMAT = 3
+COMPLETION_FORMAT = 3  # the first layout whose kinematic success is completion
 RECORD_KEYS = ("format", "provenance")  # in config.json, beside the settings: not hashed, not compared
 # fields that say where a file lives, not what the run computes from: recorded, but neither
 # hashed nor compared, so a moved or remounted runs directory keeps its keys (a student's
 # teacher is in its effective settings by the teacher's run name, which hashes the teacher's)
 LOCATIONS = ("table",)
+
+
+def counts_acceptance(record: dict) -> bool:
+    """Whether a ``config.json`` record is of a kinematic run made when its success counted
+    the automaton's acceptance (record format 2 and before; ``craftsuite.completion`` says
+    whether its task's acceptance and completion differ, and re-reads it)."""
+    from .ids import KINEMATIC, parse_id
+
+    env_id = record.get("effective", {}).get("world", {}).get("id")
+    return record.get("format", 1) < COMPLETION_FORMAT and bool(env_id) and parse_id(env_id)[1] == KINEMATIC
 
 
 def config_dict(config) -> dict:
@@ -219,11 +230,10 @@ class RunDir:
                                "choose another output directory")
             if self.finished():
                 return
-            from .completion import needs_reread
-
-            if needs_reread(saved):  # its logs so far count another success than it would go on to
-                raise RunError(f"{self.path} holds a run whose success counted the automaton's acceptance (record "
-                               f"format {saved.get('format', 1)}); it is not resumed: choose another output directory")
+            if counts_acceptance(saved):  # its logs so far may count another success than it would go on to
+                raise RunError(f"{self.path} holds a kinematic run recorded when success counted the automaton's "
+                               f"acceptance (record format {saved.get('format', 1)}); it is not resumed: choose "
+                               "another output directory")
             sessions = saved.get("provenance", [])
         record = {**mine, "format": FORMAT, "provenance": [*sessions, stamp()]}
         atomic_write(path, json.dumps(record, indent=2, sort_keys=True) + "\n")

@@ -325,15 +325,15 @@ def _counting_acceptance(runs: list[Path]) -> list[Path]:
             whose record cannot say what completed.
     """
     from .completion import needs_reread, reread_logs
-    from .runs import RunError, read_config
+    from .runs import RunError, counts_acceptance, read_config
 
     found = []
     for run in runs:
         config = read_config(run) if (run / "config.json").exists() else {}
+        if config and counts_acceptance(config) and not (run / "result.json").exists():  # as RunDir refuses it
+            raise RunError(f"{run} is an unfinished kinematic run recorded when success counted the automaton's "
+                           "acceptance (record format 2): it cannot be resumed; move it aside, and it trains anew")
         if config and needs_reread(config):
-            if not (run / "result.json").exists():
-                raise RunError(f"{run} is an unfinished run whose success counted the automaton's acceptance "
-                               "(record format 2): it cannot be resumed; move it aside, and it trains anew")
             reread_logs(run, config)  # decidable, or named now
             found.append(run)
     return found

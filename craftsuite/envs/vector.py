@@ -46,7 +46,6 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from ..registration import check_num_envs
 from ..spec import TaskSpec
 from ..wrappers import AutomatonObservation
 from .cells import EMPTY, MOVES
@@ -280,6 +279,12 @@ class CraftVectorEnv(VectorEnv):
         raise NotImplementedError(
             f"{type(self).__name__} does not render; make the single env to render "
             "(gymnasium.make(id, render_mode='rgb_array'))")
+
+
+def check_num_envs(num_envs) -> None:
+    """Raise a ValueError unless ``num_envs`` is a positive integer (every vectorization mode)."""
+    if not isinstance(num_envs, int) or isinstance(num_envs, bool) or num_envs < 1:
+        raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
 
 
 def _check_kwargs(world: str, kwargs: dict, accepted: tuple[str, ...]) -> None:

@@ -166,7 +166,7 @@ def test_transfer_re_reads_finished_runs_that_counted_acceptance_and_refuses_unf
     assert _counting_acceptance([finished, tmp_path / "students" / "absent"]) == [finished]
     unfinished = _old_kinematic_run(tmp_path / "students", name="student-BlindCraftsman-Kinematic-td3-s1")
     (unfinished / "result.json").unlink()
-    with pytest.raises(RunError, match=r"unfinished run whose success counted .* move it aside"):
+    with pytest.raises(RunError, match=r"unfinished kinematic run recorded when success counted .* move it aside"):
         _counting_acceptance([finished, unfinished])
     assert reread_in_place(finished) and not reread_in_place(finished)  # once: then it is of this format
     assert [int(r["success"]) for r in read_csv(finished / "episodes.csv")] == [0, 1]  # the plain log rewritten

@@ -6,8 +6,8 @@ middle rungs and Dungeon Quest, one factor at a time (the plan: this folder's RE
 
 Each run is its suite's config (standard: the middle rungs; hard: Dungeon Quest) with the
 setting's overrides added to its algorithm's settings. The runs the results archive holds
-are restored first and not trained again; the rest train as the suites train them (each
-cell's seeds as one population). Runs land in ``<out>/<suite>/students``, ready for
+are not trained again (nor copied: ``table.py`` reads them there); the rest train as the
+suites train them (each cell's seeds as one population). Runs land in ``<out>/<suite>/students``, ready for
 ``craftsuite archive <out>/<suite> --suite <suite> --archive results/learner-regime``.
 """
 
@@ -83,19 +83,16 @@ def main(argv=None) -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--dry-run", action="store_true", help="say what would train, and train nothing")
     args = parser.parse_args(argv)
-    from craftsuite.archive import restore
     from craftsuite.suite_runner import cells, run_students
 
     ns = {"Cont": args.n[0], "Grid10": args.n[1]} if args.n else {"Cont": None, "Grid10": None}
     for suite in RUNGS:
         wanted = [c for _, c in configs(suite, args.wave, ns)]
         out = args.out / suite
-        names = {"students": {c.run_name() for c in wanted}}
-        for archive in ARCHIVES:
-            restore(Path(archive.format(suite=suite)), out, names, log=print)
-        todo = [c for c in wanted if not (out / "students" / c.run_name() / "result.json").exists()]
-        print(f"{suite}: {len(wanted)} runs, {len(wanted) - len(todo)} restored from the archive, "
-              f"{len(cells(todo))} cells to train ({sum(c.steps for c in todo):,} transitions)")
+        held = [out] + [Path(archive.format(suite=suite)) for archive in ARCHIVES]
+        todo = [c for c in wanted if not any((h / "students" / c.run_name() / "result.json").exists() for h in held)]
+        print(f"{suite}: {len(wanted)} runs, {len(wanted) - len(todo)} held already (the archive's are read "
+              f"there: table.py), {len(cells(todo))} cells to train ({sum(c.steps for c in todo):,} transitions)")
         if not args.dry_run and todo:
             run_students(todo, out / "students", workers=args.workers)
 

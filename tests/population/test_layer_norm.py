@@ -161,22 +161,13 @@ def test_a_layer_norm_population_trains_and_its_models_load(method, world, task,
 def test_a_killed_layer_norm_population_resumes_with_its_norms(tmp_path, monkeypatch):
     from craftsuite.population import train as population_train
 
+    from .test_runs import _killed_at_the_second_evaluation
+
     hyper = {"batch_size": 16, "learning_starts": 100, "policy_kwargs": {"net_arch": [16, 16]}, "layer_norm": True}
     configs = [StudentConfig(task="Reach", method="td3", world="Kinematic", seed=s, steps=600, eval_every=200,
                              eval_episodes=1, hyperparameters=hyper, n_envs=2, engine="population")
                for s in (0, 1)]
-    evaluate, calls = population_train._evaluate, {"n": 0}
-
-    def dies_at_the_second(*args):
-        calls["n"] += 1
-        if calls["n"] == 2:
-            raise KeyboardInterrupt
-        evaluate(*args)
-
-    with monkeypatch.context() as patch:
-        patch.setattr(population_train, "_evaluate", dies_at_the_second)
-        with pytest.raises(KeyboardInterrupt):
-            train_population(configs, tmp_path, progress=False)
+    _killed_at_the_second_evaluation(configs, tmp_path, monkeypatch)
     seen = {}
     load = population_train.Population.load_states
 

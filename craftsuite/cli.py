@@ -121,7 +121,7 @@ def _scripted(args) -> int:
     from .ids import CONT, file_stem, parse_id
     from .progress import progress_iter
     from .registration import registered_ids
-    from .rollouts import rollout
+    from .episodes import rollout
     from .scripted import scripted_policy
     from .task_registry import tasks
 

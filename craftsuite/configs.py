@@ -142,3 +142,13 @@ def _effective(method: str, hyperparameters: dict, env_id: str, env_kwargs: dict
     row = METHODS[method]
     return {"method": row.settings(), "hyperparameters": algorithm_settings(row.algorithm, hyperparameters),
             "world": {"id": env_id, "kwargs": env_kwargs, "rules": resolve_task(task).digest()}}
+
+
+def student_result(config: StudentConfig, algorithm: str, steps: int, updates: int, seconds: float,
+                   **more) -> dict:
+    """A finished student's ``result.json``, whichever engine trained it (``more``: what
+    that engine adds, e.g. the population's size)."""
+    return {"kind": "student", "env_id": config.env_id, "method": config.method, "algorithm": algorithm,
+            "task": config.task, "seed": config.seed, "steps": int(steps), "updates": int(updates),
+            "product": config.product, "env_kwargs": config.env_kwargs, "model": "model.zip",
+            **more, "seconds_this_session": round(seconds, 1)}

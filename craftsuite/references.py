@@ -34,7 +34,7 @@ class Reference:
 
 def reference(env_id: str, policy: str, episodes: int = 100, seed: int = 0) -> Reference:
     """Play ``episodes`` episodes of ``policy`` ("scripted" or "random") on ``env_id``."""
-    from .rollouts import rollout
+    from .episodes import rollout
     from .scripted import scripted_policy
 
     if policy not in POLICIES:

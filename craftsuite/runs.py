@@ -52,6 +52,18 @@ class RunError(RuntimeError):
     """A run directory that cannot be used (locked by a live run, or holding another config)."""
 
 
+class CheckpointError(RunError):
+    """A checkpoint whose model or replay buffer cannot be read (truncated or damaged)."""
+
+
+def machine_errors() -> tuple[type[BaseException], ...]:
+    """Errors of the machine, not of a checkpoint's files, which loading one may raise:
+    every trainer raises them as they are, never reads them as damage."""
+    import torch  # (only where checkpoints load: torch is there already)
+
+    return (MemoryError, torch.cuda.OutOfMemoryError)
+
+
 # config.json's layout: 3, the dataclass fields with ``effective`` and ``provenance``. A
 # record without ``format`` is read as layout 1, the fields alone: it loads, but it says
 # nothing of the effective settings, so a run directory holding one is never resumed.

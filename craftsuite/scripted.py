@@ -322,7 +322,7 @@ def scripted_policy(env):
 
 def run_episode(env, policy, seed: int | None = None, max_steps: int = 10_000):
     """Roll out ``policy`` until the episode ends: (total reward, steps, last info)."""
-    from .rollouts import rollout
+    from .episodes import rollout
 
     episode = rollout(env, policy, 1, seed, max_steps=max_steps)[0]
     return episode.total_reward, episode.length, episode.info

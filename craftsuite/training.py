@@ -23,9 +23,10 @@ import numpy as np
 import torch
 from stable_baselines3.common.callbacks import BaseCallback
 
-from .configs import StudentConfig, TeacherConfig  # noqa: F401  (defined there, torch-free; re-exported)
+from .configs import StudentConfig, TeacherConfig, student_result  # noqa: F401  (defined there, torch-free; re-exported)
 from .files import atomic_path
-from .runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, RunError, eval_seed, read_csv
+from .runs import (EPISODE_FIELDS, EVAL_FIELDS, CheckpointError, RunDir, RunError, eval_seed,  # noqa: F401  (re-exported)
+                   machine_errors, read_csv)
 
 
 class Evaluation(NamedTuple):
@@ -40,7 +41,7 @@ def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kw
     batch per step (an untrained policy that never finishes costs one batched call per
     decision of the episode limit, not ``episodes`` times as many). ``on_step(episode,
     reward, info)``, if given, sees every step (for measures beyond an ``Evaluation``'s)."""
-    from .rollouts import rollout
+    from .episodes import rollout
 
     envs = [gym.make(env_id, product=product, **(env_kwargs or {})) for _ in range(episodes)]
     try:
@@ -147,10 +148,6 @@ def _purge_tensorboard(logger, step: int) -> None:
             output.writer.file_writer.add_event(Event(step=step + 1, session_log=SessionLog(status=SessionLog.START)))
 
 
-class CheckpointError(RunError):
-    """A checkpoint whose model or replay buffer cannot be read (truncated or damaged)."""
-
-
 def save_checkpoint(agent, run: RunDir) -> None:
     """Model and replay buffer together, into the run's next checkpoint (each file flushed
     to disk), then committed (``RunDir.commit_checkpoint`` keeps the one before)."""
@@ -163,8 +160,6 @@ def save_checkpoint(agent, run: RunDir) -> None:
 
 
 UNLOADABLE = "checkpoint-unloadable"  # where a checkpoint that failed to load is kept aside
-# Errors of the machine, not of a checkpoint's files: they are raised as they are, never read as damage
-_RESOURCES = (MemoryError, torch.cuda.OutOfMemoryError)
 
 
 def _resume(run: RunDir, fresh):
@@ -206,13 +201,13 @@ def _load_checkpoint(saved: Path, fresh):
     model, replay = saved / "model.zip", saved / "replay.pkl"
     try:
         agent = type(fresh).load(model, env=fresh.get_env(), device=fresh.device)
-    except _RESOURCES:
+    except machine_errors():
         raise  # the machine's limits, not the file's fault: the checkpoint stays a candidate
     except Exception as err:  # a damaged zip (BadZipFile, KeyError, EOFError, ...), or spaces that differ
         raise CheckpointError(f"{model} cannot be loaded ({type(err).__name__}: {err})") from None
     try:
         agent.load_replay_buffer(replay)
-    except _RESOURCES:
+    except machine_errors():
         raise
     except Exception as err:  # a truncated pickle: UnpicklingError, EOFError, ...
         raise CheckpointError(f"{replay} cannot be loaded ({type(err).__name__}: {err})") from None
@@ -309,16 +304,6 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
     return _train(config, config.run_name(), root, fresh, product=True, total=config.max_steps,
                   stop_at=config.target_success, model="teacher.zip", keep_checkpoint=True, result=result,
                   progress=progress, desc=f"teacher {config.task}", write_more=write_table)
-
-
-def student_result(config: StudentConfig, algorithm: str, steps: int, updates: int, seconds: float,
-                   **more) -> dict:
-    """A finished student's ``result.json``, whichever engine trained it (``more``: what
-    that engine adds, e.g. the population's size)."""
-    return {"kind": "student", "env_id": config.env_id, "method": config.method, "algorithm": algorithm,
-            "task": config.task, "seed": config.seed, "steps": int(steps), "updates": int(updates),
-            "product": config.product, "env_kwargs": config.env_kwargs, "model": "model.zip",
-            **more, "seconds_this_session": round(seconds, 1)}
 
 
 def check_sb3_engine(config: StudentConfig) -> None:

@@ -237,7 +237,7 @@ def _resume(pop: Population, runs) -> None:
     commits leaves the one before), and trim each member's logs to it. With no checkpoint at
     all, the population starts at step 0. A checkpoint that cannot be loaded is an error that
     names it (nothing is deleted); so is a population whose members share no step."""
-    from ..training import _RESOURCES, CheckpointError
+    from ..runs import CheckpointError, machine_errors
 
     found = [_saved_steps(run) for run in runs]
     if not any(found):
@@ -256,7 +256,7 @@ def _resume(pop: Population, runs) -> None:
         path = steps[step]
         try:
             states.append(th.load(path, weights_only=False, map_location=pop.learner.device))
-        except _RESOURCES:
+        except machine_errors():
             raise  # the machine's limits, not the file's fault
         except Exception as err:  # a damaged file
             raise CheckpointError(f"{path} cannot be loaded ({type(err).__name__}: {err}): move it aside to "
@@ -273,7 +273,7 @@ def _resume(pop: Population, runs) -> None:
 def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, seconds: float, device: str) -> None:
     """Member ``k``'s model as an SB3 agent (``model.zip``), its result, its checkpoints gone."""
     from ..agents.factory import make_agent
-    from ..training import student_result
+    from ..configs import student_result
 
     agent = make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=1,
                        env_kwargs=config.env_kwargs, automaton_state=config.automaton_state, to_save=True,

@@ -18,7 +18,7 @@ import numpy as np
 import craftsuite  # noqa: F401  (registers the ids)
 from craftsuite.configs import StudentConfig
 from craftsuite.ids import cont_id
-from craftsuite.rollouts import rollout
+from craftsuite.episodes import rollout
 from craftsuite.scripted import scripted_policy
 from craftsuite.suites import SUITES
 from craftsuite.task_registry import ladder

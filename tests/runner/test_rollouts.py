@@ -5,7 +5,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 
-from craftsuite.rollouts import rollout
+from craftsuite.episodes import rollout
 
 ENV_ID = "CraftSuite/DungeonQuest-Grid7-v0"
 

@@ -24,7 +24,7 @@ import json
 from pathlib import Path
 
 from .files import atomic_write
-from .runs import EPISODE_FIELDS, EVAL_FIELDS, FORMAT, RunError, counts_acceptance, csv_text, read_config, read_csv
+from .runs import EPISODE_FIELDS, EVAL_FIELDS, FORMAT, RunError, counts_acceptance, csv_text, read_config, read_log
 
 REREAD = ("success re-read as completion from a record that counted the automaton's acceptance: "
           "a training episode completed if accepted and ended before its time limit")
@@ -117,17 +117,5 @@ def reread_logs(run: Path, config: dict) -> tuple[list[dict], list[dict]]:
     Raises:
         RunError: as ``reread``, or a log that does not read, naming the file.
     """
-    return reread(config, _log(run / "episodes.csv", EPISODE_FIELDS), _log(run / "evals.csv", EVAL_FIELDS))
-
-
-def _log(path: Path, fields: tuple[str, ...]) -> list[dict]:
-    """A log the re-reading needs, every column of it.
-
-    Raises:
-        RunError: it is missing or does not read as a run's log, naming the file.
-    """
-    try:
-        return read_csv(path, fields, required=path.name == "evals.csv")
-    except (KeyError, ValueError, OSError, EOFError) as err:  # OSError, EOFError: a damaged .gz
-        raise RunError(f"{path} does not read as a run's log ({type(err).__name__}: {err}): its success cannot "
-                       "be re-read") from None
+    return reread(config, read_log(run / "episodes.csv", EPISODE_FIELDS),
+                  read_log(run / "evals.csv", EVAL_FIELDS, required=True))

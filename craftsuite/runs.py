@@ -409,6 +409,23 @@ def _check_log(header: list[str] | None, rows: list[dict], fields: tuple[str, ..
                          "kill, may")
 
 
+def read_log(path, fields: tuple[str, ...], row=dict, required: bool = False) -> list:
+    """A run's CSV log for a reader of records, each row as ``row`` reads it (``fields``: the
+    columns it reads); ``required``: a log every finished run has.
+
+    Raises:
+        RunError: a log that is missing (``required``) or does not read as the log's, naming the file.
+    """
+    try:
+        return [row(r) for r in read_csv(path, fields, required)]
+    except FileNotFoundError:  # before OSError: not damaged bytes, but no file
+        raise RunError(f"{path} is missing: the run's record is damaged (a finished run has evaluated at least "
+                       "once, at its end)") from None
+    except (KeyError, ValueError, OSError, EOFError) as err:  # OSError, EOFError: a damaged .gz
+        raise RunError(f"{path} does not read as a run's log ({type(err).__name__}: {err}): "
+                       "the run's record is damaged") from None
+
+
 def csv_text(fields, rows) -> str:
     """Rows as a CSV log's text, its header first."""
     import io

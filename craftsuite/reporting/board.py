@@ -40,7 +40,7 @@ import numpy as np
 
 from .. import stats
 from ..completion import needs_reread
-from ..runs import RunError, flatten, read_config, read_csv, run_settings
+from ..runs import RunError, flatten, read_config, read_log, run_settings
 
 # metrics with a mean and an interval per task and method; a rate lies in [0, 1]
 METRICS = {"success": (0.0, 1.0), "return": (-math.inf, math.inf), "train_success": (0.0, 1.0),
@@ -64,23 +64,6 @@ def world_label(world: str, kwargs: dict) -> str:
     if not kwargs:
         return world
     return f"{world}: " + ", ".join(f"{k}={json.dumps(v)}" for k, v in sorted(kwargs.items()))
-
-
-def _log(path: Path, fields: tuple[str, ...], row, required: bool = False) -> list[tuple]:
-    """A run's CSV log, each row as ``row`` reads it (``fields``: the columns it reads);
-    ``required``: a log every finished run has.
-
-    Raises:
-        RunError: a log that is missing (``required``) or does not read as the log's, naming the file.
-    """
-    try:
-        return [row(r) for r in read_csv(path, fields, required)]
-    except FileNotFoundError:  # before OSError: not damaged bytes, but no file
-        raise RunError(f"{path} is missing: the run's record is damaged (a finished run has evaluated at least "
-                       "once, at its end)") from None
-    except (KeyError, ValueError, OSError, EOFError) as err:  # OSError, EOFError: a damaged .gz
-        raise RunError(f"{path} does not read as a run's log ({type(err).__name__}: {err}): "
-                       "the run's record is damaged") from None
 
 
 def _result(run: Path) -> dict:
@@ -120,10 +103,10 @@ def run_metrics(run: Path) -> dict | None:
                        "RUNS --suite S), which re-reads it as completion")
     budget = int(config["steps"])
     # (step, return, won) per training episode; (step, greedy success) per evaluation
-    episodes = _log(run / "episodes.csv", ("step", "return", "success"),
+    episodes = read_log(run / "episodes.csv", ("step", "return", "success"),
                     lambda e: (int(e["step"]), float(e["return"]), int(e["success"])))
     # no episodes.csv is no episode yet (a budget shorter than an episode); no evals.csv, damage
-    evals = _log(run / "evals.csv", ("step", "success"), lambda e: (int(e["step"]), float(e["success"])),
+    evals = read_log(run / "evals.csv", ("step", "success"), lambda e: (int(e["step"]), float(e["success"])),
                  required=True)
     tail = [e for e in episodes if e[0] > 0.9 * budget]
     if not tail and episodes:  # fewer episodes than the window: the last one

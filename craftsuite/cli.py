@@ -338,6 +338,8 @@ def _transfer(args) -> int:
         changes["td3_hyperparameters"] = {**suite.td3_hyperparameters, **_hyper(args.td3_hyper, "td3", "--td3-hyper")}
     if args.engine is not None:
         changes["engine"] = args.engine
+    if args.regime is not None:  # another regime's runs never pool with the suite's: they may share its archive
+        changes["regime"] = args.regime
     suite = dataclasses.replace(suite, **changes)
     print(f"suite {suite.name}: {suite.description}")
     out = args.out or f"runs/{args.suite}"
@@ -496,6 +498,7 @@ def build_parser() -> argparse.ArgumentParser:
     from . import __version__
     from .configs import ENGINES
     from .methods import METHODS
+    from .regimes import REGIMES
     from .suites import SUITES
     from .task_registry import SPEC_SUFFIX, ladder
 
@@ -615,6 +618,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-archive", action="store_true", help="neither read nor write a results archive")
     p.add_argument("--engine", choices=ENGINES, help="what trains the students: population (each cell's seeds in "
                    "one process) or sb3 (one SB3 agent per run); default: the suite's")
+    p.add_argument("--regime", choices=list(REGIMES), help="the students' learner regime (craftsuite.regimes: "
+                   "n-step returns and the like, for every method alike); default: the suite's")
     p.add_argument("--device", help="the population engine's torch device: cpu (default) or cuda (the sb3 engine "
                    "takes none: its agents use a GPU where there is one)")
     p.set_defaults(run=_transfer)

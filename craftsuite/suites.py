@@ -14,6 +14,7 @@ from pathlib import Path
 from .configs import StudentConfig, TeacherConfig
 from .ids import CONT, KINEMATIC, world_kind
 from .methods import METHODS, check_methods, methods_for
+from .regimes import check_regime
 from .spec import TaskSpec
 from .task_registry import ladder, resolve_task
 
@@ -50,6 +51,10 @@ class Suite:
     dqn_hyperparameters: dict = field(default_factory=dict)
     td3_n_envs: int = 1
     dqn_n_envs: int = 1
+    # the learner regime (craftsuite.regimes): learning settings every method's students get
+    # beneath the suite's own hyperparameters above (which, with any command-line overrides,
+    # win), so that a distilled student and scratch learn by the same rule
+    regime: str = "one-step"
     # grid students learn one fixed instance, generated independently of the teacher's (layout 0),
     # as the paper's did; None gives them a new layout every episode
     grid_layout_seed: int | None = 1
@@ -121,6 +126,8 @@ class Suite:
                     continue
                 steps = self.budget(spec, world)
                 cont = world_kind(world) == CONT
+                hyperparameters = {**check_regime(self.regime).settings("td3" if cont else "dqn"),
+                                   **(self.td3_hyperparameters if cont else self.dqn_hyperparameters)}
                 for method in methods:
                     table = None
                     if METHODS[method].needs_table:
@@ -129,7 +136,7 @@ class Suite:
                         out.append(StudentConfig(
                             task=spec.name, method=method, world=world, seed=seed, steps=steps, table=table,
                             eval_every=self.eval_interval(steps, world), eval_episodes=self.eval_episodes,
-                            hyperparameters=dict(self.td3_hyperparameters if cont else self.dqn_hyperparameters),
+                            hyperparameters=dict(hyperparameters),
                             layout_seed=None if cont else self.grid_layout_seed,
                             # each continuous world its own keywords (MuJoCo's frame_skip, the board's size)
                             world_kwargs=dict(self.cont_world_kwargs if world == CONT else

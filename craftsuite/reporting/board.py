@@ -21,7 +21,7 @@ at another frame skip are another benchmark, so they get a row of their own. Run
 method whose settings differ in more than the seed are not pooled: each setting is a row
 of its own, flagged.
 
-Across tasks, per world (``aggregates``): each method's IQM of final success and of AUC
+Across tasks, per world and learner regime (``aggregates``): each method's IQM of final success and of AUC
 with stratified-bootstrap intervals, and the probability that it improves on the same
 algorithm from scratch.
 
@@ -56,6 +56,18 @@ def world_of(config: dict) -> tuple[str, dict]:
     from ..runs import config_from
 
     return config["world"], config_from(StudentConfig, config).env_kwargs
+
+
+def regime_of(config: dict) -> str:
+    """The learner regime a student's ``config.json`` ran under (``craftsuite.regimes``),
+    read from the settings it recorded."""
+    from ..methods import METHODS
+    from ..regimes import regime_of as named
+
+    algorithm = (config.get("effective") or {}).get("method", {}).get("algorithm")
+    if algorithm is None:
+        algorithm = METHODS[config["method"]].algorithm
+    return named(algorithm, config.get("hyperparameters") or {})
 
 
 def world_label(world: str, kwargs: dict) -> str:
@@ -116,7 +128,8 @@ def run_metrics(run: Path) -> dict | None:
     world, world_kwargs = world_of(config)
     return {
         "task": config["task"], "world": world, "world_kwargs": world_kwargs, "method": config["method"],
-        "seed": config["seed"], "budget": budget, "steps": result["steps"], "updates": result.get("updates"),
+        "regime": regime_of(config), "seed": config["seed"], "budget": budget, "steps": result["steps"],
+        "updates": result.get("updates"),
         "success": success[-1] if success else float("nan"),
         "return": float(np.mean([r for _, r, _ in tail])) if tail else float("nan"),
         "train_success": float(np.mean([won for _, _, won in tail])) if tail else float("nan"),
@@ -141,6 +154,7 @@ class Entry:
     differs: dict = field(default_factory=dict)  # with a variant: the settings that tell it apart, and its values
     runs: list[Path] = field(default_factory=list)  # the run directories, in seed order
     world_kwargs: dict = field(default_factory=dict)  # the settings that change the world, beyond its name
+    regime: str = "one-step"  # the learner regime its runs trained under (craftsuite.regimes)
 
     @property
     def label(self) -> str:
@@ -170,6 +184,7 @@ class Unfinished:
     method: str
     seed: int
     run: str  # the run directory's name
+    regime: str = "one-step"
 
     @property
     def world_label(self) -> str:
@@ -189,6 +204,19 @@ class Board:
 
     def __len__(self) -> int:
         return len(self.entries)
+
+    @property
+    def regimes(self) -> list[str]:
+        """The learner regimes of its runs, the regimes' table's order first."""
+        from ..regimes import REGIMES
+
+        mine = {e.regime for e in self.entries} | {u.regime for u in self.unfinished}
+        return [r for r in REGIMES if r in mine] + sorted(mine - set(REGIMES))
+
+    def of_regime(self, regime: str) -> Board:
+        """The runs of one learner regime (an unreadable record has none to tell: not among them)."""
+        return Board([e for e in self.entries if e.regime == regime],
+                     [u for u in self.unfinished if u.regime == regime])
 
 
 def build(students_root) -> Board:
@@ -210,7 +238,7 @@ def build(students_root) -> Board:
             if m is None:
                 if not (run / "result.json").exists() and run.name.startswith("student-"):
                     board.unfinished.append(Unfinished(config["task"], *world_of(config), config["method"],
-                                                       config["seed"], run.name))
+                                                       config["seed"], run.name, regime_of(config)))
                 continue
         except RunError as err:
             board.unreadable.append(str(err))
@@ -219,16 +247,18 @@ def build(students_root) -> Board:
             board.unreadable.append(f"{run / 'config.json'}: {type(err).__name__}: {err}")
             continue
         setting = {k: v for k, v in run_settings(config).items() if k != "seed"}
-        key = (m["task"], world_label(m["world"], m["world_kwargs"]), m["method"], json.dumps(setting, sort_keys=True))
+        # a regime's runs are never variants of another's: each regime is a board of its own (of_regime)
+        key = (m["task"], world_label(m["world"], m["world_kwargs"]), m["method"], m["regime"],
+               json.dumps(setting, sort_keys=True))
         groups.setdefault(key, []).append(({**m, "run": run}, setting))
     by_method: dict[tuple, list[tuple]] = {}
     for key in groups:
-        by_method.setdefault(key[:3], []).append(key)
-    for (task, _, method), keys in sorted(by_method.items()):
+        by_method.setdefault(key[:4], []).append(key)
+    for (task, _, method, regime), keys in sorted(by_method.items()):
         settings = [flatten(groups[k][0][1]) for k in keys]
         differing = sorted({name for s in settings for name in s
                             if len({json.dumps(t.get(name), sort_keys=True) for t in settings}) > 1})
-        for i, key in enumerate(sorted(keys, key=lambda k: (-len(groups[k]), k[3]))):  # most runs first
+        for i, key in enumerate(sorted(keys, key=lambda k: (-len(groups[k]), k[4]))):  # most runs first
             runs = sorted((m for m, _ in groups[key]), key=lambda m: m["seed"])
             setting = flatten(groups[key][0][1])
             updates = [r["updates"] for r in runs]
@@ -238,7 +268,7 @@ def build(students_root) -> Board:
                 updates=None if None in updates else round(float(np.mean(updates))),
                 variant=(string.ascii_lowercase[i] if i < 26 else str(i + 1)) if len(keys) > 1 else "",
                 differs={name: setting.get(name, "(not recorded)") for name in differing},
-                runs=[r["run"] for r in runs], world_kwargs=runs[0]["world_kwargs"]))
+                runs=[r["run"] for r in runs], world_kwargs=runs[0]["world_kwargs"], regime=regime))
     return board
 
 
@@ -386,6 +416,7 @@ class Aggregate:
 
     world: str  # the world's name
     world_kwargs: dict  # and its settings: runs in another setting are another aggregate
+    regime: str  # the learner regime: another regime's runs are another aggregate
     tasks: list[str]  # the tasks every aggregated method ran
     baseline: str | None  # the world's algorithm from scratch, if it ran
     iqm: dict[str, dict[str, stats.Estimate]]  # method -> metric -> IQM
@@ -397,6 +428,11 @@ class Aggregate:
     @property
     def world_label(self) -> str:
         return world_label(self.world, self.world_kwargs)
+
+    @property
+    def label(self) -> str:
+        """The world and the regime, e.g. ``Cont, n-step regime``: what its heading and profile name."""
+        return f"{self.world_label}, {self.regime} regime"
 
 
 def aggregates(entries) -> list[Aggregate]:
@@ -410,14 +446,19 @@ def aggregates(entries) -> list[Aggregate]:
         return x[np.isfinite(x)]
 
     out = []
-    for label in sorted({e.world_label for e in entries}):
-        mine = [e for e in entries if e.world_label == label]
+    for label, regime in sorted({(e.world_label, e.regime) for e in entries}):
+        mine = [e for e in entries if (e.world_label, e.regime) == (label, regime)]
         world, world_kwargs = mine[0].world, mine[0].world_kwargs
         left_out = []
         variants = sorted({e.method for e in mine if e.variant})
         if variants:
             left_out.append(f"{', '.join(variants)}: runs of more than one setting")
         methods = sorted({e.method for e in mine} - set(variants))
+        twice = sorted({(e.task, e.method) for e in mine if e.method in methods
+                        and sum((f.task, f.method) == (e.task, e.method) for f in mine if not f.variant) > 1})
+        if twice:  # one cell run into two directories at other budgets, say: neither is pooled
+            left_out.append("; ".join(f"{m} on {t}: runs in more than one directory" for t, m in twice))
+            methods = [m for m in methods if m not in {m for _, m in twice}]
         cells = {(e.task, e.method): e for e in mine if e.method in methods}
         tasks = sorted({e.task for e in mine}, key=rung_order)
         blank = sum(len(e.seeds) - len(finite(e, m)) for e in cells.values() for m in AGGREGATED[:1])
@@ -444,7 +485,7 @@ def aggregates(entries) -> list[Aggregate]:
         per_task = {m: {metric: [finite(cells[(t, m)], metric) for t in common] for metric in AGGREGATED}
                     for m in methods}
         out.append(Aggregate(
-            world=world, world_kwargs=world_kwargs, tasks=common, baseline=baseline,
+            world=world, world_kwargs=world_kwargs, regime=regime, tasks=common, baseline=baseline,
             iqm={m: {metric: stats.aggregate_iqm(per_task[m][metric]) for metric in AGGREGATED} for m in methods},
             improvement={m: {metric: stats.probability_of_improvement(per_task[m][metric], per_task[baseline][metric])
                              for metric in AGGREGATED} for m in methods if baseline and m != baseline},

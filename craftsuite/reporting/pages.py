@@ -14,6 +14,7 @@ import numpy as np
 from .. import stats
 from ..files import atomic_write
 from ..ids import CONT, world_kind
+from ..regimes import describe
 from ..archive import size as archive_size
 from .board import (
     METRICS,
@@ -104,9 +105,22 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
     from ..methods import METHODS
 
     h = "#" * level
-    entries = list(board)
     lines = [title, ""] if title else []
+    regimes = board.regimes
+    if len(regimes) > 1:  # each regime a leaderboard of its own: its runs are never pooled with another's
+        aggs = aggregates(list(board)) if aggs is None else aggs
+        lines += [f"Runs of {len(regimes)} learner regimes, each apart.", ""]
+        for regime in regimes:
+            part = leaderboard_markdown(board.of_regime(regime), title=f"{h} Learner regime `{regime}`",
+                                        profiles=profiles, aggs=[a for a in aggs if a.regime == regime],
+                                        level=level + 1)
+            lines += [part.strip(), ""]
+        lines += [f"Not read: {reason}\n" for reason in board.unreadable]
+        return "\n".join(lines)
+    entries = list(board)
     lines += [LEGEND, ""]
+    if regimes:
+        lines += [f"Learner regime: `{regimes[0]}`, {describe(regimes[0])}.", ""]
     for task, world in sorted({(e.task, e.world_label) for e in entries}, key=lambda k: (rung_order(k[0]), k[1])):
         rows = ranked([e for e in entries if (e.task, e.world_label) == (task, world)])
         lines += [f"{h} {task} ({world})", "", *task_table(rows)]
@@ -161,23 +175,25 @@ def comparisons_markdown(boards: list[Board]) -> list[str]:
     rows, decided, trivial = [], 0, 0
     for board in boards:
         entries = list(board)
-        for task, world in sorted({(e.task, e.world_label) for e in entries}, key=lambda k: (rung_order(k[0]), k[1])):
-            here = [e for e in entries if (e.task, e.world_label) == (task, world)]
+        for task, world, regime in sorted({(e.task, e.world_label, e.regime) for e in entries},
+                                          key=lambda k: (rung_order(k[0]), k[1], k[2])):
+            here = [e for e in entries if (e.task, e.world_label, e.regime) == (task, world, regime)]
             for entry, base in distilled_against_scratch(here):
                 if entry.budget != base.budget:  # never set side by side as if they were one comparison
-                    rows.append(f"| {task} | {world} | `{entry.label}` − `{base.label}` | | | {entry.budget:,} "
-                                f"against {base.budget:,} | not compared: other budgets |")
+                    rows.append(f"| {task} | {world} | {regime} | `{entry.label}` − `{base.label}` | | "
+                                f"| {entry.budget:,} against {base.budget:,} | not compared: other budgets |")
                     continue
                 c = compare(entry, base)
-                rows.append(f"| {task} | {world} | `{entry.label}` − `{base.label}` "
+                rows.append(f"| {task} | {world} | {regime} | `{entry.label}` − `{base.label}` "
                             f"| {_fmt(c.difference, signed=True)} | {_fmt(c.improvement)} | {entry.budget:,} "
                             f"| {c.verdict} |")
                 decided += c.decided
                 trivial += c.trivial
     if not rows:
         return []
-    return ["| rung | world | distilled − scratch | difference in success [95% Welch t] | P(distilled > scratch) "
-            "[95% bootstrap] | transitions per run | verdict |", "|---|---|---|---|---|---|---|", *rows, "",
+    return ["| rung | world | learner regime | distilled − scratch | difference in success [95% Welch t] "
+            "| P(distilled > scratch) [95% bootstrap] | transitions per run | verdict |",
+            "|---|---|---|---|---|---|---|---|", *rows, "",
             f"Decided (ahead, behind, or no difference of {SMALLEST_DIFFERENCE:g} or more) on "
             f"{decided} of {len(rows)} comparisons, {trivial} of them only because every seed of both sat "
             "at 0 or at 1: *ahead*/*behind* where the two t-intervals are apart or the "
@@ -191,10 +207,10 @@ def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = 
     for agg in aggs:
         base = agg.baseline
         if not agg.iqm:
-            lines += [f"{h} {agg.world_label}", "",
+            lines += [f"{h} {agg.label}", "",
                       "Nothing to aggregate: " + "; ".join(agg.left_out or ["no method"]) + ".", ""]
             continue
-        lines += [f"{h} {agg.world_label}: {len(agg.tasks)} task{'s' if len(agg.tasks) > 1 else ''} "
+        lines += [f"{h} {agg.label}: {len(agg.tasks)} task{'s' if len(agg.tasks) > 1 else ''} "
                   f"({', '.join(agg.tasks)})", "",
                   AGGREGATE_LEGEND.format(baseline=f"`{base}`" if base else "the algorithm from scratch (not run)"),
                   "",
@@ -209,8 +225,8 @@ def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = 
                             ("(the baseline) | |" if m == base else "| |")))
         if agg.left_out:
             lines += ["", "Not in this aggregate: " + "; ".join(agg.left_out) + "."]
-        if images and agg.world_label in images:
-            lines += ["", f"![performance profile, {agg.world_label}]({images[agg.world_label].as_posix()})"]
+        if images and agg.label in images:
+            lines += ["", f"![performance profile, {agg.label}]({images[agg.label].as_posix()})"]
         lines.append("")
     return lines
 
@@ -218,13 +234,13 @@ def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = 
 def leaderboard_csv(board: Board) -> str:
     buf = io.StringIO()
     writer = csv.writer(buf)
-    writer.writerow(["task", "world", "method", "variant", "seeds",
+    writer.writerow(["task", "world", "regime", "method", "variant", "seeds",
                      *(f"{m}{s}" for m in METRICS for s in ("", "_lo", "_hi")),
                      "success_per_seed", "reached_80", "reached_80_median", "differs_in", "budget_transitions",
                      "updates"])
     for e in board:
         st = e.stats
-        writer.writerow([e.task, e.world_label, e.method, e.variant, len(e.seeds),
+        writer.writerow([e.task, e.world_label, e.regime, e.method, e.variant, len(e.seeds),
                          *(("" if math.isnan(v) else v) for m in METRICS
                            for v in (st[m].value, st[m].low, st[m].high)),
                          " ".join(str(v) for v in e.values["success"]), e.reached.k,
@@ -266,6 +282,11 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
         lines += ["## Distilled against scratch", "",
                   "Each distilled method against its algorithm from scratch on each rung, in final greedy success "
                   "(the rows come from the leaderboards below).", "", *compared]
+    if len(directories) > 1:
+        ladder = aggregates([e for runs in directories for e in runs.board])
+        if any(agg.iqm for agg in ladder):
+            lines += ["## Across the ladder", "", "Every directory below together, per world and learner regime "
+                      "(the sections below aggregate each directory alone):", "", *aggregates_markdown(ladder)]
     figures, videos = [], []  # (images directory, its figures), (video, its copy): written once all is drawn
     for runs in directories:
         suite, board = runs.suite, runs.board

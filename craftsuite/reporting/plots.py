@@ -37,7 +37,7 @@ class Drawn:
 
     stem: str
     figure: object  # a matplotlib Figure
-    world_label: str = ""
+    world_label: str = ""  # a profile's aggregate: its world and regime (Aggregate.label)
 
 
 def save_figures(drawn: list[Drawn], out) -> list[Path]:
@@ -66,10 +66,11 @@ def draw_curves(board: Board) -> list[Drawn]:
     runs: dict[tuple, list[tuple[str, list, list, int]]] = {}
     for e in board:
         for run in e.runs:
-            runs.setdefault((e.task, e.world_label), []).append(
+            runs.setdefault((e.task, e.world_label, e.regime), []).append(
                 (e.label, read_csv(run / "episodes.csv"), read_csv(run / "evals.csv"), e.budget))
+    several = len(board.regimes) > 1  # then each regime's curves are a figure of their own
     drawn = []
-    for (task, world), group in sorted(runs.items()):
+    for (task, world, regime), group in sorted(runs.items()):
         budget = max(g[3] for g in group)
         grid = np.linspace(budget / 50, budget, 50)
         fig = Figure(figsize=(14, 3.6))
@@ -101,7 +102,7 @@ def draw_curves(board: Board) -> list[Drawn]:
             firsts = [next((int(e["step"]) for e in g[2] if float(e["success"]) >= THRESHOLD), None) for g in mine]
             share = [np.mean([f is not None and f <= x for f in firsts]) for x in grid]
             axes[2].step(grid, share, where="post", color=color, label=f"{method} ({len(mine)} seeds)")
-        fig.suptitle(f"{task} ({world})")  # a world with settings is too long for a panel's title
+        fig.suptitle(f"{task} ({world}, {regime} regime)")  # a world with settings is too long for a panel's title
         axes[0].set(title="training episode return", xlabel="transitions", ylabel="return")
         axes[1].set(xlabel="transitions", ylabel="success rate", ylim=(-0.02, 1.02))
         axes[1].set_title("success: greedy evaluation (solid), training episodes (dashed)", fontsize=9)
@@ -111,7 +112,7 @@ def draw_curves(board: Board) -> list[Drawn]:
         for ax in axes:  # 800k, not 800000 run into its neighbours
             ax.xaxis.set_major_formatter(EngFormatter(sep=""))
         fig.tight_layout()
-        name = f"curves-{task}-{file_part(world)}"
+        name = f"curves-{task}-{file_part(world)}" + (f"-{file_part(regime)}" if several else "")
         if any(d.stem == name for d in drawn):  # two settings that read alike once in a file name
             name += "-" + hashlib.sha256(world.encode()).hexdigest()[:6]
         drawn.append(Drawn(name, fig))
@@ -135,7 +136,7 @@ def smoothed(values_at, grid, window: float = 0.1):
 
 @dataclass
 class Profile:
-    world_label: str  # the aggregate's world, as its page names it
+    world_label: str  # the aggregate's world and regime, as its page names it (Aggregate.label)
     path: Path
 
 
@@ -164,10 +165,10 @@ def draw_profiles(board: Board, aggs: list[Aggregate] | None = None) -> list[Dra
             value, low, high = stats.performance_profile(agg.scores[method], taus - 1e-9)
             line, = ax.plot(taus, value, label=f"{method} ({agg.runs[method]} runs)")
             ax.fill_between(taus, low, high, color=line.get_color(), alpha=0.2)
-        ax.set(title=f"{agg.world_label}: {len(agg.tasks)} task{'s' if len(agg.tasks) > 1 else ''}",
+        ax.set(title=f"{agg.label}: {len(agg.tasks)} task{'s' if len(agg.tasks) > 1 else ''}",
                xlabel="final greedy success \u03c4",
                ylabel="share of runs with success \u2265 \u03c4", ylim=(-0.02, 1.02))
         ax.legend(fontsize=8)
         fig.tight_layout()
-        drawn.append(Drawn(f"profile-{file_part(agg.world_label)}", fig, agg.world_label))
+        drawn.append(Drawn(f"profile-{file_part(f'{agg.world_label} {agg.regime}')}", fig, agg.label))
     return drawn

@@ -131,7 +131,7 @@ def test_a_good_page_path_still_writes_the_page_and_its_images(runs, tmp_path, m
     assert main(["leaderboard", str(runs), "--page", "docs/results.md"]) == 0
     assert (tmp_path / "docs" / "results.md").is_file()
     assert {p.name for p in (tmp_path / "docs" / "images").rglob("*.png")} == {
-        "profile-Cont.png", "curves-BlindCraftsman-Cont.png"}
+        "profile-Cont-one-step.png", "curves-BlindCraftsman-Cont.png"}
 
 
 def test_a_directory_given_as_the_page_draws_no_image_into_the_working_directory(runs, tmp_path, monkeypatch,

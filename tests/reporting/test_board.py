@@ -274,7 +274,7 @@ def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_pa
     assert said("Reach").improvement.low == 0.0 and said("Reach").verdict == "undecided"
     text = "\n".join(comparisons_markdown([board]))
     assert "Decided (ahead, behind, or no difference of 0.2 or more) on 3 of 6 comparisons, 1 of them only" in text
-    assert "| ToolHome | Cont | `td3-dynamic` − `td3` | -0.80 [" in text
+    assert "| ToolHome | Cont | one-step | `td3-dynamic` − `td3` | -0.80 [" in text
     # the best run: the highest final success, then the hardest rung, then the return
     run, entry, i = best_run(board)
     assert (entry.task, entry.method, entry.values["success"][i]) == ("DungeonQuest", "td3-dynamic", 1.0)

@@ -33,7 +33,7 @@ def test_markdown_csv_and_profile(runs, tmp_path):
     assert float(rows["td3-dynamic"]["train_success"]) == pytest.approx(0.375)
     assert rows["td3"]["reached_80"] == "1" and float(rows["td3"]["reached_80_median"]) == 1000
     assert rows["td3-dynamic"]["success_per_seed"] == "1.0 0.6"
-    assert (tmp_path / "profile-Cont.png").exists() and "](profile-Cont.png)" in md
+    assert (tmp_path / "profile-Cont-one-step.png").exists() and "](profile-Cont-one-step.png)" in md
 
 
 def test_budget_reads_in_transitions_and_gradient_updates_and_methods_are_explained(runs):
@@ -73,7 +73,7 @@ def test_a_world_with_nothing_to_aggregate_says_why(tmp_path):
     fake_run(root, "td3", 0, [(1000, 1.0)], [(995, 1.0)])
     fake_run(root, "td3-dynamic", 0, [(1000, 1.0)], [(995, 1.0)])
     md = leaderboard_markdown(build(root))
-    assert "### Cont\n\nNothing to aggregate: td3, td3-dynamic: fewer than 2 runs on some task" in md
+    assert "### Cont, one-step regime\n\nNothing to aggregate: td3, td3-dynamic: fewer than 2 runs on some task" in md
 
 
 def test_a_page_of_archived_runs_says_it_has_no_video_and_its_size(tmp_path):

@@ -31,5 +31,5 @@ def test_a_profile_per_world_with_an_aggregate(tmp_path):
         fake_run(root, "td3", seed, [(1000, 0.5)], [(995, 0.0)])
         fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)])
     [profile] = plot_profiles(build(root), tmp_path)
-    assert profile.world_label == "Cont"
-    assert profile.path.name == "profile-Cont.png" and profile.path.read_bytes()[:4] == b"\x89PNG"
+    assert profile.world_label == "Cont, one-step regime"
+    assert profile.path.name == "profile-Cont-one-step.png" and profile.path.read_bytes()[:4] == b"\x89PNG"

@@ -31,3 +31,23 @@ def test_each_experiment_script_imports(script, monkeypatch):
     spec.loader.exec_module(module)
     assert callable(getattr(module, "main", None)), f"{script} has no main()"
     sys.modules.pop(spec.name, None)
+
+
+def _load(script: Path):
+    spec = importlib.util.spec_from_file_location(f"experiment_{script.parent.name}_{script.stem}", script)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_learner_regime_wave_3_combines_wave_2s_winners_beside_wave_1s():
+    run = _load(Path(__file__).resolve().parents[1] / "experiments" / "learner-regime" / "run.py")
+    settings = run.wave_3("Cont", 3, ["layernorm", "gaussian"])
+    assert settings == {"n3-layernorm-gaussian": {"n_steps": 3, "layer_norm": True,
+                                                  "action_noise": {"type": "normal", "sigma": 0.3}},
+                        "n3": {"n_steps": 3}}
+    # the combination is the incumbent: wave 1's winner must beat it by the rule
+    assert run.factors(3, "Cont", 3, ["layernorm", "gaussian"]) == [["n3-layernorm-gaussian", "n3"]]
+    assert run.factors(3, "Grid10", 3, []) == []  # no wave-2 winner: nothing to confirm
+    with pytest.raises(SystemExit, match="Grid10 has no wave-2 setting \\['gaussian'\\]"):
+        run.wave_3("Grid10", 3, ["gaussian"])

@@ -3,7 +3,7 @@ folder's README): per setting, the IQM of AUC over the rungs' runs with its
 stratified-bootstrap interval; per factor, each costlier setting's probability of
 improvement over the incumbent, and the setting the rule keeps.
 
-    python experiments/learner-regime/table.py [--wave 2 --n TD3_N DQN_N] [--runs DIR]
+    python experiments/learner-regime/table.py [--wave 2 --n TD3_N DQN_N] [--winners TD3 DQN] [--runs DIR]
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ def _driver():
     return module
 
 
-def auc_by_setting(driver, wave: int, ns: dict, roots: list[Path]) -> dict:
+def auc_by_setting(driver, wave: int, ns: dict, roots: list[Path], winners: dict | None = None) -> dict:
     """{(world, setting): [AUCs of rung 1's seeds, rung 2's, ...]} for the runs found under
     ``roots`` (each a directory of a suite's runs)."""
     found = {}
@@ -35,7 +35,7 @@ def auc_by_setting(driver, wave: int, ns: dict, roots: list[Path]) -> dict:
                 found[run.name] = run
     out = {}
     for suite in driver.RUNGS:
-        for name, c in driver.configs(suite, wave, ns):
+        for name, c in driver.configs(suite, wave, ns, winners):
             run = found.get(c.run_name())
             if run is not None:
                 out.setdefault((c.world, name), {}).setdefault(c.task, []).append(run_metrics(run)["auc"])
@@ -64,17 +64,19 @@ def decide(order: list[str], aucs: dict[str, list], rungs: int, seeds: int) -> t
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--wave", type=int, choices=(1, 2), default=1)
+    parser.add_argument("--wave", type=int, choices=(1, 2, 3), default=1)
     parser.add_argument("--n", type=int, nargs=2, metavar=("TD3_N", "DQN_N"))
+    parser.add_argument("--winners", nargs=2, metavar=("TD3", "DQN"), help="wave 3: as run.py's")
     parser.add_argument("--runs", type=Path, nargs="+",
                         default=[Path("results/learner-regime"), Path(__file__).parent / "results",
                                  Path("results/n-step-returns"), Path("results")])
     args = parser.parse_args(argv)
     driver = _driver()
     ns = {"Cont": args.n[0], "Grid10": args.n[1]} if args.n else {"Cont": None, "Grid10": None}
-    aucs = auc_by_setting(driver, args.wave, ns, args.runs)
+    winners = dict(zip(("Cont", "Grid10"), map(driver.parse_winners, args.winners or ("none", "none")), strict=True))
+    aucs = auc_by_setting(driver, args.wave, ns, args.runs, winners)
     for world, algorithm in driver.SCRATCH.items():
-        settings = driver.settings_for(args.wave, world, ns[world])
+        settings = driver.settings_for(args.wave, world, ns[world], winners[world])
         print(f"\n### {algorithm.upper()} ({world})\n")
         print("| setting | overrides | runs | IQM of AUC [95% stratified bootstrap] |")
         print("|---|---|---|---|")
@@ -89,7 +91,7 @@ def main(argv=None) -> None:
             print(f"| {name} | `{json.dumps(overrides)}` | {runs} ({len(mine[name])} rungs) | {shown} |")
         rungs = sum(len(driver.RUNGS[suite]) for suite in driver.WAVES[args.wave])
         seeds = min(driver.SUITES[suite].seeds for suite in driver.WAVES[args.wave])
-        for order in driver.factors(args.wave, world, ns[world]):
+        for order in driver.factors(args.wave, world, ns[world], winners[world]):
             kept, lines = decide(order, mine, rungs, seeds)
             print("")
             for line in lines:

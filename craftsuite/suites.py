@@ -121,35 +121,36 @@ class Suite:
         out = []
         for spec in self.rungs():
             for world in self.worlds:
-                methods = [m for m in methods_for(world) if m in self.methods]
-                if not methods:
-                    continue
-                steps = self.budget(spec, world)
-                cont = world_kind(world) == CONT
-                hyperparameters = {**check_regime(self.regime).settings("td3" if cont else "dqn"),
-                                   **(self.td3_hyperparameters if cont else self.dqn_hyperparameters)}
-                for method in methods:
+                for method in [m for m in methods_for(world) if m in self.methods]:
                     table = None
                     if METHODS[method].needs_table:
                         table = str((Path(teacher_root) / teachers[spec.name].run_name() / "table.npz").resolve())
-                    for seed in range(self.seeds):
-                        out.append(StudentConfig(
-                            task=spec.name, method=method, world=world, seed=seed, steps=steps, table=table,
-                            eval_every=self.eval_interval(steps, world), eval_episodes=self.eval_episodes,
-                            hyperparameters=dict(hyperparameters),
-                            layout_seed=None if cont else self.grid_layout_seed,
-                            # each continuous world its own keywords (MuJoCo's frame_skip, the board's size)
-                            world_kwargs=dict(self.cont_world_kwargs if world == CONT else
-                                              self.kinematic_world_kwargs if world == KINEMATIC else {}),
-                            n_envs=self.n_envs(world),
-                            # hidden from distilled students where the suite says so, but for
-                            # those whose counterfactual replay relabels it (crm-edges)
-                            automaton_state=None if self.students_see_automaton or not METHODS[method].distill
-                            or METHODS[method].crm else False, engine=self.engine))
+                    out += [self.student_config(spec, world, method, seed, table) for seed in range(self.seeds)]
         if not out:
             raise ValueError(f"no method of {list(self.methods)} runs in the worlds {list(self.worlds)} "
                              f"({', '.join(f'{w}: {methods_for(w)}' for w in self.worlds)})")
         return out
+
+    def student_config(self, spec: TaskSpec, world: str, method: str, seed: int = 0,
+                       table: str | None = None) -> StudentConfig:
+        """One student run of the suite: its budget, evaluations, world settings and
+        learner settings (``table``: a teacher's, for a method that needs one)."""
+        steps = self.budget(spec, world)
+        cont = world_kind(world) == CONT
+        hyperparameters = {**check_regime(self.regime).settings("td3" if cont else "dqn"),
+                           **(self.td3_hyperparameters if cont else self.dqn_hyperparameters)}
+        return StudentConfig(
+            task=spec.name, method=method, world=world, seed=seed, steps=steps, table=table,
+            eval_every=self.eval_interval(steps, world), eval_episodes=self.eval_episodes,
+            hyperparameters=hyperparameters, layout_seed=None if cont else self.grid_layout_seed,
+            # each continuous world its own keywords (MuJoCo's frame_skip, the board's size)
+            world_kwargs=dict(self.cont_world_kwargs if world == CONT else
+                              self.kinematic_world_kwargs if world == KINEMATIC else {}),
+            n_envs=self.n_envs(world),
+            # hidden from distilled students where the suite says so, but for those whose
+            # counterfactual replay relabels it (crm-edges)
+            automaton_state=None if self.students_see_automaton or not METHODS[method].distill
+            or METHODS[method].crm else False, engine=self.engine)
 
 
 # The collection regimes measured to learn most per wall-clock second on two cores

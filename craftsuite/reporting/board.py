@@ -58,12 +58,17 @@ def world_of(config: dict) -> tuple[str, dict]:
     return config["world"], config_from(StudentConfig, config).env_kwargs
 
 
+SELF_REPORTED = "self-reported"  # the regime of a run trained outside CraftSuite (craftsuite.recorder)
+
+
 def regime_of(config: dict) -> str:
     """The learner regime a student's ``config.json`` ran under (``craftsuite.regimes``),
     read from the settings it recorded."""
     from ..methods import METHODS
     from ..regimes import regime_of as named
 
+    if config.get("self_reported"):  # a learner of its own: its settings are not CraftSuite's to read
+        return SELF_REPORTED
     algorithm = (config.get("effective") or {}).get("method", {}).get("algorithm")
     if algorithm is None:
         algorithm = METHODS[config["method"]].algorithm

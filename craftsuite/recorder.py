@@ -1,0 +1,223 @@
+"""A recorder for any training loop: the run directory a suite's run writes, for an agent
+trained outside CraftSuite.
+
+``Recorder`` is a gymnasium wrapper around the suite's env of a rung: a user's own loop
+steps it as it would the env, and calls ``evaluate(policy)`` when ``evaluation_due`` says
+the suite's schedule has come (every 20th of the budget, ``craftsuite.evaluate``'s
+protocol), and ``finish(policy, updates=...)`` at the budget. It writes what the suites'
+runs write, in their record format (``craftsuite.runs``): ``config.json`` (the method's
+name, the library, the budget, the settings as given, provenance and the user's commit),
+``episodes.csv`` (every training episode, with how far along the task it got),
+``evals.csv`` and, last, ``result.json`` (transitions and gradient updates). Its records are
+marked ``self_reported``: CraftSuite did not train them, and says so wherever it shows them.
+
+    env = craftsuite.Recorder("CraftSuite/ToolHome-Cont-v0", "my_runs", method="my-sac", seed=0)
+    obs, _ = env.reset(seed=0)
+    while not env.done:
+        obs, reward, terminated, truncated, info = env.step(agent.act(obs))
+        ...  # learn
+        if terminated or truncated:
+            obs, _ = env.reset()
+        if env.evaluation_due:
+            env.evaluate(agent.act)
+    env.finish(agent.act, updates=agent.updates)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+
+from . import ids
+from .envs.grid import layout_kwargs
+from .runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, RunError, config_key
+
+
+@dataclass(frozen=True)
+class RecordedConfig:
+    """A self-reported run's configuration: what its ``config.json`` records and hashes
+    into its run key (the world's settings as the suite's; the learner's as given)."""
+
+    task: str
+    method: str  # the user's own name (not one of CraftSuite's METHODS rows)
+    world: str
+    seed: int
+    steps: int  # the budget in transitions
+    eval_every: int
+    eval_episodes: int
+    suite: str = "standard"
+    library: str = ""  # what trained it, e.g. "stable-baselines3 2.4 SAC"
+    settings: dict = field(default_factory=dict)  # the learner's settings, as given (not read by CraftSuite)
+    commit: str | None = None  # the user's code's commit, where given
+    layout_seed: int | None = None
+    world_kwargs: dict = field(default_factory=dict)
+    self_reported: bool = True
+
+    @property
+    def env_id(self) -> str:
+        return ids.env_id(self.task, self.world)
+
+    @property
+    def env_kwargs(self) -> dict:
+        return {**layout_kwargs(self.layout_seed), **self.world_kwargs}
+
+    def run_name(self) -> str:
+        return f"student-{self.task}-{self.world}-{self.method}-s{self.seed}-{config_key(self)}"
+
+
+def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "standard", library: str = "",
+                    settings: dict | None = None, commit: str | None = None) -> RecordedConfig:
+    """The record of a run of ``method`` on ``env_id`` under ``suite``'s protocol.
+
+    Raises:
+        ValueError: a method named as one of CraftSuite's (its runs would pool with the
+            archive's), a bad seed, id or suite; each named with its fix.
+    """
+    from .evaluation import protocol
+    from .methods import METHODS
+
+    if not isinstance(method, str) or not method or any(c in method for c in "/\\ "):
+        raise ValueError(f"method must be a name without spaces or slashes, e.g. my-sac, got {method!r}")
+    if method in METHODS:
+        raise ValueError(f"method {method!r} is one of CraftSuite's own methods: name yours (e.g. my-{method}), "
+                         "so that its runs never pool with the archive's")
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+    suite_config, _ = protocol(env_id, suite)
+    return RecordedConfig(task=suite_config.task, method=method, world=suite_config.world, seed=seed,
+                          steps=suite_config.steps, eval_every=suite_config.eval_every,
+                          eval_episodes=suite_config.eval_episodes, suite=suite, library=library,
+                          settings=dict(settings or {}), commit=commit, layout_seed=suite_config.layout_seed,
+                          world_kwargs=dict(suite_config.world_kwargs))
+
+
+class Recorder(gym.Wrapper):
+    """The suite's env of a rung, recording a user's training run into ``out`` (see the
+    module's docstring). The run's directory is ``out/<run name>``, as the suites' runs'."""
+
+    def __init__(self, env_id: str, out, *, method: str, seed: int = 0, suite: str = "standard",
+                 library: str = "", settings: dict | None = None, commit: str | None = None,
+                 product: bool = False):
+        from .reached import Reached
+        from .task_registry import resolve_task
+
+        self.config = recorded_config(env_id, method, seed, suite, library, settings, commit)
+        self.path = Path(out) / self.config.run_name()
+        if self.path.exists():  # a recording is one session: a second would mix two runs' logs
+            state = "finished" if (self.path / "result.json").exists() else "unfinished"
+            raise RunError(f"{self.path} holds a recording already ({state}): choose another seed or output "
+                           "directory, or delete it to record again")
+        super().__init__(gym.make(self.config.env_id, product=product, **self.config.env_kwargs))
+        self.product = product
+        self.run = RunDir(self.path, self.config).__enter__()  # held until finish() or close()
+        self.transitions = 0
+        self.evaluated: list[int] = []  # the steps evaluated so far
+        self._episode = None  # (return, length) of the episode being played
+        self._pending: list[dict] = []
+        self._reached = Reached(resolve_task(self.config.task).automaton, 1, self.config.task)
+
+    # -- the env ----------------------------------------------------------------------------------
+    def reset(self, **kwargs):
+        self._episode = [0.0, 0]
+        self._reached.take([0])
+        return self.env.reset(**kwargs)
+
+    def step(self, action):
+        if self._episode is None:
+            raise RuntimeError("step() before reset(): reset the env first, as gymnasium envs need")
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        self.transitions += 1
+        self._episode[0] += float(reward)
+        self._episode[1] += 1
+        self._reached.step(np.array([info["label_mask"]], dtype=np.int64),
+                           np.array([info["automaton_state"]], dtype=np.int64))
+        if terminated or truncated:
+            (seen,), (states,) = self._reached.take([0])
+            self._pending.append({"step": self.transitions, "return": round(self._episode[0], 4),
+                                  "length": self._episode[1], "success": int(bool(info.get("is_success"))),
+                                  "seen": seen, "states": states})
+            self._episode = None
+        return obs, reward, terminated, truncated, info
+
+    # -- the schedule ---------------------------------------------------------------------------
+    @property
+    def budget(self) -> int:
+        return self.config.steps
+
+    @property
+    def done(self) -> bool:
+        """Whether the budget's transitions have been collected."""
+        return self.transitions >= self.budget
+
+    @property
+    def next_evaluation(self) -> int:
+        """The step of the next evaluation the suite's schedule holds (the budget: the last)."""
+        done = self.evaluated[-1] if self.evaluated else 0
+        return min(self.budget, (done // self.config.eval_every + 1) * self.config.eval_every)
+
+    @property
+    def evaluation_due(self) -> bool:
+        return self.transitions >= self.next_evaluation and self.next_evaluation not in self.evaluated
+
+    def _due_step(self) -> int:
+        """The latest step of the schedule that the transitions have reached: an evaluation
+        called late is that step's (a step skipped is missing from the run's curve, as the
+        board's AUC then shows)."""
+        return min(self.budget, self.transitions // self.config.eval_every * self.config.eval_every)
+
+    def evaluate(self, policy):
+        """The suite's evaluation at the schedule's step now due (its seeds are that
+        step's), recorded; the episodes so far are written with it. Returns the
+        ``craftsuite.Evaluation``."""
+        from .evaluation import evaluate
+
+        if not self.evaluation_due:
+            raise RuntimeError(f"no evaluation is due at {self.transitions:,} transitions (the next is at "
+                               f"{self.next_evaluation:,}): call it when evaluation_due says so")
+        step = self._due_step()
+        result = evaluate(policy, self.config.env_id, suite=self.config.suite, step=step,
+                          episodes=self.config.eval_episodes, product=self.product)
+        self._flush()
+        self.run.append("evals.csv", EVAL_FIELDS, [{"step": step, "success": result.success,
+                                                    "return": round(result.mean_return, 4),
+                                                    "episodes": self.config.eval_episodes,
+                                                    "length": round(result.mean_length, 2)}])
+        self.evaluated.append(step)
+        return result
+
+    def finish(self, policy, updates: int) -> Path:
+        """The last evaluation (at the budget) if not yet made, then ``result.json``: the
+        run is finished, and the leaderboard reads it. Returns the run's directory.
+
+        Raises:
+            ValueError: the budget not collected yet, or a bad count of gradient updates.
+        """
+        if not self.done:
+            raise ValueError(f"{self.transitions:,} transitions of the budget's {self.budget:,}: a run is finished "
+                             "at its budget (step the env until done)")
+        if not isinstance(updates, int) or isinstance(updates, bool) or updates < 0:
+            raise ValueError(f"updates must be the count of gradient updates made (an integer >= 0), got {updates!r}")
+        if self.budget not in self.evaluated:  # the last evaluation, at the budget
+            self.evaluate(policy)
+        self._flush()
+        self.run.write_result({"kind": "student", "env_id": self.config.env_id, "method": self.config.method,
+                               "task": self.config.task, "seed": self.config.seed, "steps": self.transitions,
+                               "updates": updates, "product": self.product, "env_kwargs": self.config.env_kwargs,
+                               "self_reported": True, "library": self.config.library})
+        self.close()
+        return self.path
+
+    def close(self):
+        if getattr(self, "run", None) is not None:
+            self._flush()
+            self.run.__exit__(None, None, None)
+            self.run = None
+        super().close()
+
+    def _flush(self) -> None:
+        if self._pending:
+            self.run.append("episodes.csv", EPISODE_FIELDS, self._pending)
+            self._pending = []

@@ -1,0 +1,94 @@
+"""``craftsuite.Recorder``: a user's own training loop writes a run directory in the suites'
+record format, on the suite's budget and evaluation schedule, marked self-reported, which the
+leaderboard reads; bad use is refused in one line and leaves nothing behind."""
+
+import json
+
+import numpy as np
+import pytest
+
+import craftsuite
+from craftsuite.recorder import recorded_config
+from craftsuite.reporting.board import build
+from craftsuite.runs import RunError, read_csv
+from craftsuite.suites import SUITES
+
+ENV = "CraftSuite/Reach-Grid10-v0"
+
+
+def _random_loop(env, rng, evaluate=True):
+    env.reset(seed=0)
+    while not env.done:
+        _, _, terminated, truncated, _ = env.step(int(rng.integers(env.action_space.n)))
+        if terminated or truncated:
+            env.reset()
+        if evaluate and env.evaluation_due:
+            env.evaluate(lambda obs: int(rng.integers(4)))
+
+
+def test_a_users_loop_writes_a_run_the_leaderboard_reads(tmp_path):
+    rng = np.random.default_rng(0)
+    env = craftsuite.Recorder(ENV, tmp_path, method="my-random", seed=3, library="numpy", settings={"p": 0.25},
+                              commit="abc123")
+    _random_loop(env, rng)
+    path = env.finish(lambda obs: int(rng.integers(4)), updates=0)
+    standard = SUITES["standard"]
+    budget = standard.budget(craftsuite.resolve_task("Reach"), "Grid10")
+    config = json.loads((path / "config.json").read_text())
+    assert (config["method"], config["seed"], config["steps"], config["library"], config["commit"]) == \
+        ("my-random", 3, budget, "numpy", "abc123")
+    assert config["self_reported"] is True and config["layout_seed"] == standard.grid_layout_seed
+    assert config["provenance"]  # the session that recorded it
+    every = standard.eval_interval(budget, "Grid10")
+    assert [int(r["step"]) for r in read_csv(path / "evals.csv")] == list(range(every, budget + 1, every))
+    episodes = read_csv(path / "episodes.csv")
+    assert episodes and all(int(e["states"]) & 1 for e in episodes)  # the initial state, in every episode
+    result = json.loads((path / "result.json").read_text())
+    assert (result["steps"], result["updates"], result["self_reported"]) == (budget, 0, True)
+    (entry,) = build(tmp_path)
+    assert (entry.method, entry.regime, entry.budget, entry.seeds) == ("my-random", "self-reported", budget, [3])
+
+
+def test_an_evaluation_called_late_is_the_latest_step_reached(tmp_path):
+    env = craftsuite.Recorder(ENV, tmp_path, method="my-late")
+    env.reset(seed=0)
+    every = env.config.eval_every
+    for _ in range(2 * every + 5):
+        _, _, terminated, truncated, _ = env.step(0)
+        if terminated or truncated:
+            env.reset()
+    assert env.evaluation_due
+    env.evaluate(lambda obs: 0)
+    assert env.evaluated == [2 * every] and not env.evaluation_due
+    with pytest.raises(RuntimeError, match="no evaluation is due"):
+        env.evaluate(lambda obs: 0)
+    env.close()
+
+
+@pytest.mark.parametrize("method, message", [
+    ("td3", "method 'td3' is one of CraftSuite's own methods: name yours"),
+    ("my sac", "method must be a name without spaces or slashes"),
+])
+def test_a_method_named_as_craftsuites_own_is_refused(tmp_path, method, message):
+    with pytest.raises(ValueError, match=message):
+        craftsuite.Recorder(ENV, tmp_path / "out", method=method)
+    assert not (tmp_path / "out").exists()
+
+
+def test_finishing_before_the_budget_is_refused_and_a_second_recording_too(tmp_path):
+    env = craftsuite.Recorder(ENV, tmp_path, method="my-short")
+    env.reset(seed=0)
+    env.step(0)
+    with pytest.raises(ValueError, match=r"1 transitions of the budget's 30,000: a run is finished at its budget"):
+        env.finish(lambda obs: 0, updates=0)
+    env.close()
+    with pytest.raises(RunError, match="holds a recording already \\(unfinished\\)"):
+        craftsuite.Recorder(ENV, tmp_path, method="my-short")
+
+
+def test_the_record_is_the_suites_protocol_for_the_rung():
+    config = recorded_config("CraftSuite/ToolHome-Cont-v0", "my-sac", seed=1)
+    suite = SUITES["standard"]
+    mine = suite.student_config(craftsuite.resolve_task("ToolHome"), "Cont", "td3", 1)
+    assert (config.steps, config.eval_every, config.eval_episodes, config.env_kwargs) == \
+        (mine.steps, mine.eval_every, mine.eval_episodes, mine.env_kwargs)

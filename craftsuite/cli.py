@@ -404,6 +404,7 @@ def _archive(args) -> int:
 def _leaderboard(args) -> int:
     from .files import directory_to_write, file_to_write
     from .reporting.pages import write_leaderboard, write_results_page
+    from .reporting.board import build
     from .reporting.plots import draw_curves, save_figures
     from .reporting.sources import read_runs
 
@@ -424,17 +425,17 @@ def _leaderboard(args) -> int:
         path = write_results_page(args.runs, args.page)
         print(f"wrote {path}")
         return 0
-    if len(args.runs) > 1:
-        raise ValueError("several run directories make one results page: add --page PATH")
     if args.out:
         directory_to_write(args.out, "--out")
-    runs = read_runs(args.runs[0])
-    out = Path(args.out or runs.path)
-    curves = draw_curves(runs.board)  # drawn before the leaderboard is written: a failure leaves no part of it
-    path = write_leaderboard(runs.board, out)
+    # several directories are one board: a user's runs beside the archive's, on the same rungs
+    runs = [read_runs(d) for d in args.runs]
+    board = runs[0].board if len(runs) == 1 else build(*(r.students for r in runs))
+    out = Path(args.out or runs[0].path)
+    curves = draw_curves(board)  # drawn before the leaderboard is written: a failure leaves no part of it
+    path = write_leaderboard(board, out)
     plots = save_figures(curves, out)
     print(path.read_text())
-    print(f"wrote {path}, {out / 'leaderboard.csv'}" + "".join(f", {p}" for p in plots))
+    print(f"wrote {path}, {out / 'leaderboard.csv'}, {out / 'seeds.csv'}" + "".join(f", {p}" for p in plots))
     return 0
 
 
@@ -632,9 +633,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_archive)
 
     p = sub.add_parser("leaderboard", help="leaderboard (Markdown, CSV) and learning curves from run directories")
-    p.add_argument("runs", nargs="+", help="a transfer output directory, or a directory of student runs "
-                   "(several with --page)")
-    p.add_argument("--out", help="where to write (default: RUNS)")
+    p.add_argument("runs", nargs="+", help="a transfer output directory, or a directory of student runs; several "
+                   "are one leaderboard (e.g. your runs from craftsuite.Recorder beside results/standard), or, with "
+                   "--page, a section each")
+    p.add_argument("--out", help="where to write (default: the first RUNS)")
     p.add_argument("--page", metavar="PATH", help="write a results page (Markdown with provenance, tables, plots) "
                    "from the RUNS directories to PATH, e.g. docs/results.md")
     p.add_argument("--reproduction", metavar="PATH", help="write the paper's Figure 5 panels, each beside the "

@@ -123,13 +123,14 @@ def run_metrics(run: Path) -> dict | None:
     episodes = read_log(run / "episodes.csv", ("step", "return", "success"),
                     lambda e: (int(e["step"]), float(e["return"]), int(e["success"])))
     # no episodes.csv is no episode yet (a budget shorter than an episode); no evals.csv, damage
-    evals = read_log(run / "evals.csv", ("step", "success"), lambda e: (int(e["step"]), float(e["success"])),
-                 required=True)
+    evals = read_log(run / "evals.csv", ("step", "success"), lambda e: (int(e["step"]), float(e["success"]),
+                                                                        float(e.get("length") or "nan")),
+                     required=True)
     tail = [e for e in episodes if e[0] > 0.9 * budget]
     if not tail and episodes:  # fewer episodes than the window: the last one
         tail = episodes[-1:]
-    success = [s for _, s in evals]
-    reached = next((step for step, s in evals if s >= THRESHOLD), None)
+    success = [s for _, s, _ in evals]
+    reached = next((step for step, s, _ in evals if s >= THRESHOLD), None)
     world, world_kwargs = world_of(config)
     return {
         "task": config["task"], "world": world, "world_kwargs": world_kwargs, "method": config["method"],
@@ -140,6 +141,7 @@ def run_metrics(run: Path) -> dict | None:
         "train_success": float(np.mean([won for _, _, won in tail])) if tail else float("nan"),
         "auc": float(np.mean(success)) if success else float("nan"),
         "steps_to_80": reached,
+        "length": evals[-1][2] if evals else float("nan"),  # mean decisions of the last evaluation's episodes
     }
 
 
@@ -159,7 +161,13 @@ class Entry:
     differs: dict = field(default_factory=dict)  # with a variant: the settings that tell it apart, and its values
     runs: list[Path] = field(default_factory=list)  # the run directories, in seed order
     world_kwargs: dict = field(default_factory=dict)  # the settings that change the world, beyond its name
+    lengths: list[float] = field(default_factory=list)  # per seed: the last evaluation's mean episode length
     regime: str = "one-step"  # the learner regime its runs trained under (craftsuite.regimes)
+
+    @property
+    def self_reported(self) -> bool:
+        """Trained outside CraftSuite, its records written by ``craftsuite.Recorder``."""
+        return self.regime == SELF_REPORTED
 
     @property
     def label(self) -> str:
@@ -212,26 +220,40 @@ class Board:
 
     @property
     def regimes(self) -> list[str]:
-        """The learner regimes of its runs, the regimes' table's order first."""
+        """The learner regimes of CraftSuite's runs here, the regimes' table's order first
+        (self-reported runs have a learner of their own: they stand beside every regime's
+        runs, and make a regime of their own only where CraftSuite's runs are absent)."""
         from ..regimes import REGIMES
 
         mine = {e.regime for e in self.entries} | {u.regime for u in self.unfinished}
+        if mine - {SELF_REPORTED}:
+            mine.discard(SELF_REPORTED)
         return [r for r in REGIMES if r in mine] + sorted(mine - set(REGIMES))
 
     def of_regime(self, regime: str) -> Board:
-        """The runs of one learner regime (an unreadable record has none to tell: not among them)."""
-        return Board([e for e in self.entries if e.regime == regime],
-                     [u for u in self.unfinished if u.regime == regime])
+        """The runs of one learner regime, and the self-reported runs beside them (an
+        unreadable record has none to tell: not among them)."""
+        mine = (regime, SELF_REPORTED)
+        return Board([e for e in self.entries if e.regime in mine], [u for u in self.unfinished if u.regime in mine])
 
 
-def build(students_root) -> Board:
-    """The leaderboard of the runs under ``students_root``: one entry per task, world,
-    method and setting (runs that differ in more than the seed are never pooled). A run
-    whose record is damaged is left out and named in ``Board.unreadable``."""
-    root = Path(students_root)
+def build(students_root, *more) -> Board:
+    """The leaderboard of the runs under ``students_root`` (and the ``more`` directories of
+    runs beside it: one board of them all): one entry per task, world, method and setting
+    (runs that differ in more than the seed are never pooled). A run whose record is
+    damaged is left out and named in ``Board.unreadable``, as is a run found twice."""
     groups: dict[tuple, list[tuple[dict, dict]]] = {}
     board = Board([])
-    for run in sorted(root.iterdir()) if root.is_dir() else []:
+    found: dict[str, Path] = {}
+    runs = []
+    for root in map(Path, (students_root, *more)):
+        for run in sorted(root.iterdir()) if root.is_dir() else []:
+            if run.name in found and (run / "result.json").exists():  # one run key, one run: never counted twice
+                board.unreadable.append(f"{run}: the same run as {found[run.name]}, counted once")
+                continue
+            found.setdefault(run.name, run)
+            runs.append(run)
+    for run in runs:
         if not (run / "config.json").exists():
             if (run / "result.json").exists():  # a result of no known run
                 board.unreadable.append(f"{run / 'config.json'} is missing beside its result.json: "
@@ -273,7 +295,8 @@ def build(students_root) -> Board:
                 updates=None if None in updates else round(float(np.mean(updates))),
                 variant=(string.ascii_lowercase[i] if i < 26 else str(i + 1)) if len(keys) > 1 else "",
                 differs={name: setting.get(name, "(not recorded)") for name in differing},
-                runs=[r["run"] for r in runs], world_kwargs=runs[0]["world_kwargs"], regime=regime))
+                runs=[r["run"] for r in runs], world_kwargs=runs[0]["world_kwargs"],
+                lengths=[r["length"] for r in runs], regime=regime))
     return board
 
 
@@ -404,15 +427,17 @@ def compare(entry: Entry, baseline: Entry) -> Comparison:
     return Comparison(diff, better, said)
 
 
-def distilled_against_scratch(rows: list[Entry]) -> list[tuple[Entry, Entry]]:
-    """For one task and world: each distilled student (a method with a distilled target)
-    beside its algorithm from scratch; none where scratch did not run or ran in variants."""
+def distilled_against_scratch(rows: list[Entry], self_reported: bool = False) -> list[tuple[Entry, Entry]]:
+    """For one task, world and regime: each distilled student (a method with a distilled
+    target), and with ``self_reported`` each self-reported method, beside its world's
+    algorithm from scratch; none where scratch did not run or ran in variants."""
     from ..methods import METHODS, scratch
 
-    base = [e for e in rows if e.method == scratch(e.world)]
+    base = [e for e in rows if e.method == scratch(e.world) and not e.self_reported]
     if len(base) != 1:
         return []
-    return [(e, base[0]) for e in rows if e.method in METHODS and METHODS[e.method].distill]
+    return [(e, base[0]) for e in rows if (e.method in METHODS and METHODS[e.method].distill and not e.self_reported)
+            or (self_reported and e.self_reported)]
 
 
 @dataclass
@@ -451,8 +476,12 @@ def aggregates(entries) -> list[Aggregate]:
         return x[np.isfinite(x)]
 
     out = []
-    for label, regime in sorted({(e.world_label, e.regime) for e in entries}):
-        mine = [e for e in entries if (e.world_label, e.regime) == (label, regime)]
+    # self-reported runs join every regime's aggregate of their world (their learner is their own)
+    own = {(e.world_label, e.regime) for e in entries if not e.self_reported}
+    worlds = {label for label, _ in own}
+    own |= {(e.world_label, e.regime) for e in entries if e.self_reported and e.world_label not in worlds}
+    for label, regime in sorted(own):
+        mine = [e for e in entries if e.world_label == label and (e.regime == regime or e.self_reported)]
         world, world_kwargs = mine[0].world, mine[0].world_kwargs
         left_out = []
         variants = sorted({e.method for e in mine if e.variant})

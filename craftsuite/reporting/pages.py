@@ -18,6 +18,7 @@ from ..regimes import describe
 from ..archive import size as archive_size
 from .board import (
     METRICS,
+    SELF_REPORTED,
     SMALLEST_DIFFERENCE,
     Aggregate,
     Board,
@@ -47,6 +48,11 @@ LEGEND = (
     "the budget; reached 80%: how many seeds reached 80% greedy success, and the median transitions of those "
     "that did; budget: transitions / gradient updates per run. A world with settings beyond the registered one "
     "names them.")
+
+SELF_REPORTED_LEGEND = (
+    "*Self-reported*: trained outside CraftSuite and recorded by `craftsuite.Recorder` on the suite's budget and "
+    "evaluation schedule (its evaluations are `craftsuite.evaluate`'s, on the same seeds and world); CraftSuite did "
+    "not train it. Its learner is its own, so it stands beside every learner regime's runs.")
 
 AGGREGATE_LEGEND = (
     "Across the tasks every method of a world ran: the interquartile mean (IQM) over all runs of all tasks, with "
@@ -86,7 +92,8 @@ def task_table(rows: list[Entry]) -> list[str]:
     for e in ranked(rows):
         st = e.stats
         seeds = " ".join(f"{v:.2f}" for v in e.values["success"])
-        lines.append(f"| {e.label} | {len(e.seeds)} | {_fmt(st['success'])} | {seeds} | {_fmt(st['auc'])} "
+        label = f"{e.label} *(self-reported)*" if e.self_reported else e.label
+        lines.append(f"| {label} | {len(e.seeds)} | {_fmt(st['success'])} | {seeds} | {_fmt(st['auc'])} "
                      f"| {_fmt(st['return'], 1)} | {_fmt(st['train_success'])} | {e.reached} | {e.budget_text} |")
     # in both continuous worlds: the authors' figures come from their kinematic toy (our
     # Kinematic world follows its step), beside which the MuJoCo world is the harder test
@@ -119,12 +126,14 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
         return "\n".join(lines)
     entries = list(board)
     lines += [LEGEND, ""]
-    if regimes:
+    if regimes and regimes[0] != SELF_REPORTED:
         lines += [f"Learner regime: `{regimes[0]}`, {describe(regimes[0])}.", ""]
+    if any(e.self_reported for e in entries):
+        lines += [SELF_REPORTED_LEGEND, ""]
     for task, world in sorted({(e.task, e.world_label) for e in entries}, key=lambda k: (rung_order(k[0]), k[1])):
         rows = ranked([e for e in entries if (e.task, e.world_label) == (task, world)])
         lines += [f"{h} {task} ({world})", "", *task_table(rows)]
-        pairs = distilled_against_scratch(rows)
+        pairs = distilled_against_scratch(rows, self_reported=True)
         if pairs:
             lines += ["", f"Transfer target (80% greedy success in at most half the transitions "
                       f"`{pairs[0][1].method}` needs; median over seeds, a seed that never reached 80% counting "
@@ -163,6 +172,8 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
 
 
 def _comparison_text(entry: Entry, baseline: Entry) -> str:
+    if entry.budget != baseline.budget:  # never set side by side as if they were one comparison
+        return f"`{entry.label}` not compared: {entry.budget:,} transitions against {baseline.budget:,}"
     c = compare(entry, baseline)
     return (f"`{entry.label}` {_fmt(c.difference, signed=True)}, P(> `{baseline.label}`) {_fmt(c.improvement)}: "
             f"**{c.verdict}**")
@@ -249,15 +260,38 @@ def leaderboard_csv(board: Board) -> str:
     return buf.getvalue()
 
 
+# the per-seed export's columns: DeepLTL's published per-seed results' (method, task, seed,
+# success rate, mean steps), then what places a run: its world, budget and learner regime
+SEED_FIELDS = ("method", "task", "seed", "success_rate", "mean_steps", "world", "budget_transitions", "regime",
+               "self_reported")
+
+
+def seeds_csv(board: Board) -> str:
+    """Every run of the board, one row each (``SEED_FIELDS``): its final greedy success and
+    the mean length of that evaluation's episodes."""
+    buf = io.StringIO()
+    writer = csv.writer(buf)
+    writer.writerow(SEED_FIELDS)
+    for e in board:
+        for seed, success, length in zip(e.seeds, e.values["success"], e.lengths or [math.nan] * len(e.seeds)):
+            writer.writerow([e.label, e.task, seed, "" if math.isnan(success) else success,
+                             "" if math.isnan(length) else length, e.world_label, e.budget, e.regime,
+                             int(e.self_reported)])
+    return buf.getvalue()
+
+
 def write_leaderboard(board: Board, out) -> Path:
-    """``leaderboard.md``, ``leaderboard.csv`` and the performance profiles in ``out``;
-    returns the Markdown path. All is drawn and rendered before the first file is written."""
+    """``leaderboard.md``, ``leaderboard.csv``, ``seeds.csv`` (a row per run) and the
+    performance profiles in ``out``; returns the Markdown path. All is drawn and rendered
+    before the first file is written."""
     out = Path(out)
     aggs = aggregates(list(board))
     drawn = draw_profiles(board, aggs)
     profiles = {d.world_label: Path(f"{d.stem}.png") for d in drawn}
     table, text = leaderboard_csv(board), leaderboard_markdown(board, profiles=profiles, aggs=aggs)
+    per_seed = seeds_csv(board)
     save_figures(drawn, out)
+    atomic_write(out / "seeds.csv", per_seed)
     atomic_write(out / "leaderboard.csv", table)
     atomic_write(out / "leaderboard.md", text)
     return out / "leaderboard.md"

@@ -92,3 +92,29 @@ def test_the_record_is_the_suites_protocol_for_the_rung():
     mine = suite.student_config(craftsuite.resolve_task("ToolHome"), "Cont", "td3", 1)
     assert (config.steps, config.eval_every, config.eval_episodes, config.env_kwargs) == \
         (mine.steps, mine.eval_every, mine.eval_episodes, mine.env_kwargs)
+
+
+def test_the_leaderboard_sets_self_reported_runs_beside_every_regimes_own(tmp_path):
+    from craftsuite.cli import main
+
+    from ..reporting.fakes import fake_run
+
+    archive, mine, out = tmp_path / "archive", tmp_path / "mine", tmp_path / "board"
+    for seed in range(3):
+        fake_run(archive, "td3", seed, [(1000, 0.0)], [(995, 1.0)], hyperparameters={})
+        fake_run(archive, "td3", seed, [(1000, 0.5)], [(995, 1.0)], hyperparameters={"n_steps": 3})
+        fake_run(mine, "my-sac", seed, [(1000, 1.0)], [(995, 1.0)], self_reported=True)
+        fake_run(mine, "my-long", seed, [(2000, 1.0)], [(1995, 1.0)], budget=2000, self_reported=True)
+    assert main(["leaderboard", str(mine), str(archive), "--out", str(out)]) == 0
+    md = (out / "leaderboard.md").read_text()
+    one_step, n_step = md.split("## Learner regime `n-step`")
+    for part in (one_step, n_step):
+        assert "| my-sac *(self-reported)* | 3 | 1.00" in part
+        assert "`my-long` not compared: 2,000 transitions against 1,000" in part
+    assert "`my-sac` +1.00 [+1.00, +1.00], P(> `td3`) 1.00" in one_step
+    assert "`my-sac` +0.50 [+0.50, +0.50], P(> `td3`) 1.00" in n_step
+    rows = read_csv(out / "seeds.csv")
+    assert {(r["method"], r["regime"], r["self_reported"]) for r in rows} == {
+        ("my-sac", "self-reported", "1"), ("my-long", "self-reported", "1"), ("td3", "one-step", "0"),
+        ("td3", "n-step", "0")}
+    assert {r["budget_transitions"] for r in rows if r["method"] == "my-long"} == {"2000"}

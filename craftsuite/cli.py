@@ -439,6 +439,16 @@ def _leaderboard(args) -> int:
     return 0
 
 
+def _method(text: str) -> str:
+    """A method's name, or ``module:name`` (the module registers the row: ``methods.resolve_method``)."""
+    from .methods import resolve_method
+
+    try:
+        return resolve_method(text)
+    except (KeyError, ValueError) as err:
+        raise argparse.ArgumentTypeError(err.args[0]) from None
+
+
 def _positive(text: str) -> int:
     value = int(text)
     if value < 1:
@@ -562,8 +572,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("student", help="train one student or baseline run (any method, one seed)")
     p.add_argument("task", help=task_help)
-    p.add_argument("--method", default="td3-dynamic", choices=list(METHODS), metavar="METHOD",
-                   help=f"one of {methods} (craftsuite.methods.METHODS; default: td3-dynamic)")
+    p.add_argument("--method", default="td3-dynamic", type=_method, metavar="METHOD",
+                   help=f"one of {methods} (craftsuite.methods.METHODS; default: td3-dynamic), or module:name, a "
+                   "row the module registers (craftsuite.methods.register_method)")
     p.add_argument("--world", default="Cont", type=_world,
                    help=f"Cont (MuJoCo), Kinematic or Grid<size>, a world of the task; the known tasks': {worlds}")
     p.add_argument("--table", help="a teacher's table.npz (craftsuite teacher), for the methods that distil one: "
@@ -596,7 +607,8 @@ def build_parser() -> argparse.ArgumentParser:
                    f"each {task_help}")
     p.add_argument("--worlds", nargs="+", choices=_known_worlds(),
                    help="override the student worlds (Cont, Kinematic: TD3 methods; Grid10, Grid7: DQN methods)")
-    p.add_argument("--methods", nargs="+", metavar="METHOD", help=f"override the suite's methods: any of {methods}")
+    p.add_argument("--methods", nargs="+", metavar="METHOD", type=_method,
+                   help=f"override the suite's methods: any of {methods}, or module:name (a row of your own)")
     p.add_argument("--seeds", type=_positive, help="override the number of seeds")
     p.add_argument("--steps", type=_positive, help="one student budget for every rung (transitions)")
     p.add_argument("--teacher-steps", type=_positive, help="override the teacher's step limit")

@@ -16,6 +16,7 @@ says what ran.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -115,7 +116,7 @@ class Method:
         return {**TARGET_DEFAULTS, **self.target, **{k: v for k, v in given.items() if v is not None}}
 
 
-METHODS = MappingProxyType({m.name: m for m in (
+_ROWS = {m.name: m for m in (
     Method("dqn", "Grid", "dqn", False, description="DQN without the automaton state"),
     Method("product-dqn", "Grid", "dqn", True, description="DQN over the product MDP (also the teacher)"),
     Method("crm", "Grid", "dqn", True, crm=True, description="product DQN with counterfactual experiences"),
@@ -152,7 +153,79 @@ METHODS = MappingProxyType({m.name: m for m in (
            description="product TD3, rewards shaped by value iteration over the automaton (RS)"),
     Method("td3-dynamic-rs", "Cont", "td3", True, shaping="dynamic",
            description="product TD3, rewards shaped by the teacher's values distilled into the automaton"),
-)})
+)}
+# the table every module reads: a read-only view of the rows, those registered from outside
+# the package included (``register_method``)
+METHODS = MappingProxyType(_ROWS)
+BUILTIN = tuple(_ROWS)  # the package's own rows, in table order
+ENTRY_POINTS = "craftsuite.methods"  # the entry-point group of installed packages' rows
+_MODULES: list[str] = []  # the user modules whose rows were registered (``resolve_method``), for spawned workers
+_NAME = re.compile(r"[a-z0-9][a-z0-9.]*(-[a-z0-9.]+)*\Z")  # as the package's rows: lowercase, digits, dashes
+
+
+def register_method(row: Method) -> None:
+    """Add a row from outside the package to ``METHODS`` (as ``gymnasium.register`` adds an
+    id): it then runs in the suites, the command line and the leaderboard as the package's
+    rows do, trained by CraftSuite's learners with the rules the row names. Registering the
+    same row twice is nothing.
+
+    Raises:
+        MethodError: not a ``Method``, a name that is not lowercase words joined by dashes,
+            or a name taken by another row.
+    """
+    if not isinstance(row, Method):
+        raise MethodError(f"register_method takes a craftsuite.methods.Method row, got {type(row).__name__}")
+    if not _NAME.match(row.name):
+        raise MethodError(f"method name {row.name!r}: use lowercase letters, digits and dashes (e.g. td3-rho09), "
+                          "as run directories and the command line take it")
+    if row.name in _ROWS:
+        if _ROWS[row.name] == row:
+            return
+        raise MethodError(f"method {row.name!r} is a row already ({_ROWS[row.name].description or 'registered'}): "
+                          "give yours another name")
+    _ROWS[row.name] = row
+
+
+def resolve_method(text: str) -> str:
+    """A method as the command line names it: a row's name, or ``module:name``, which
+    imports ``module`` first (where the row registers itself, as gymnasium's
+    ``module:Env-v0``). Returns the name.
+
+    Raises:
+        KeyError: no such row (after the import), naming the rows there are.
+        ValueError: the module cannot be imported, naming it.
+    """
+    import importlib
+
+    module, sep, name = text.rpartition(":")
+    if sep:
+        try:
+            importlib.import_module(module)
+        except ImportError as err:
+            raise ValueError(f"method {text!r}: module {module!r} cannot be imported ({err}); put it on the "
+                             "Python path (PYTHONPATH) or install its package") from None
+        if module not in _MODULES:
+            _MODULES.append(module)
+    check_methods([name])
+    return name
+
+
+def user_modules() -> tuple[str, ...]:
+    """The modules ``resolve_method`` imported: a spawned worker imports them too."""
+    return tuple(_MODULES)
+
+
+def load_entry_points() -> None:
+    """Register the rows installed packages declare under the ``craftsuite.methods``
+    entry-point group: each entry a ``Method``, a list of them, or a function returning
+    them (a package's rows then need no import on the command line)."""
+    from importlib.metadata import entry_points
+
+    for point in entry_points(group=ENTRY_POINTS):
+        rows = point.load()
+        rows = rows() if callable(rows) and not isinstance(rows, Method) else rows
+        for row in [rows] if isinstance(rows, Method) else list(rows):
+            register_method(row)
 
 
 def methods_for(world: str) -> list[str]:
@@ -184,4 +257,8 @@ def check_methods(names) -> None:
     """Raise KeyError naming the unknown methods and the known ones."""
     unknown = [n for n in names if n not in METHODS]
     if unknown:
-        raise KeyError(f"unknown method(s) {unknown}; methods: {list(METHODS)}")
+        raise KeyError(f"unknown method(s) {unknown}; methods: {list(METHODS)} (a row of your own: "
+                       "module:name, whose module calls craftsuite.methods.register_method)")
+
+
+load_entry_points()

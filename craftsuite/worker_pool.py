@@ -13,6 +13,8 @@ import threading
 import time
 from concurrent.futures import Future, ProcessPoolExecutor
 
+from .methods import user_modules
+
 
 def _exit_with(driver: int, period: float = 0.5) -> None:
     """Exit this worker soon after ``driver``, the process that started it, is gone.
@@ -28,13 +30,19 @@ def _exit_with(driver: int, period: float = 0.5) -> None:
     threading.Thread(target=watch, name="craftsuite-driver-watch", daemon=True).start()
 
 
-def _report_and_watch(driver: int, started, stopping) -> None:
+def _report_and_watch(driver: int, started, stopping, modules=()) -> None:
     """A local worker's initializer: report this process's pid to the pool (``started``, a
     queue), then watch the driver. A worker that reports after the pool began to stop
-    (``stopping``, an event, set before the pool reads the pids) runs nothing."""
+    (``stopping``, an event, set before the pool reads the pids) runs nothing. ``modules``:
+    the user modules whose method rows the driver registered (a spawned worker starts
+    with the package's rows alone)."""
+    import importlib
+
     started.put(os.getpid())
     if stopping.is_set():
         os._exit(1)
+    for module in modules:
+        importlib.import_module(module)
     _exit_with(driver)
 
 
@@ -97,7 +105,8 @@ class WorkerPool:
             self._pids, self._reported, self._stopping = set(), context.SimpleQueue(), context.Event()
             self.pool = ProcessPoolExecutor(workers or max(1, min(jobs, os.cpu_count() or 1)), mp_context=context,
                                             initializer=_report_and_watch,
-                                            initargs=(os.getpid(), self._reported, self._stopping))
+                                            initargs=(os.getpid(), self._reported, self._stopping,
+                                                      user_modules()))
 
     def submit(self, job, *args) -> Future:
         if self.ray is not None:

@@ -1,0 +1,77 @@
+"""Method rows from outside the package: a user's module (``module:name`` on the command
+line) or an installed package's entry point registers them, and the suites train them as
+the package's own rows, in spawned workers too."""
+
+import importlib.metadata
+import json
+import sys
+
+import pytest
+
+from craftsuite import methods
+from craftsuite.cli import main
+from craftsuite.methods import METHODS, Method, MethodError, methods_for, register_method, resolve_method
+
+MODULE = '''
+from craftsuite.methods import Method, register_method
+
+ROWS = [Method("dqn-mine", "Grid", "dqn", False, description="my DQN from scratch")]
+register_method(ROWS[0])
+'''
+
+
+@pytest.fixture
+def user_module(tmp_path, monkeypatch):
+    (tmp_path / "my_methods.py").write_text(MODULE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setenv("PYTHONPATH", str(tmp_path))  # the spawned workers' path too
+    yield "my_methods"
+    for name in [n for n in METHODS if n not in methods.BUILTIN]:
+        del methods._ROWS[name]
+    methods._MODULES.clear()
+    sys.modules.pop("my_methods", None)
+
+
+def test_a_users_module_registers_a_row_the_suites_run(user_module):
+    assert resolve_method(f"{user_module}:dqn-mine") == "dqn-mine"
+    assert "dqn-mine" in methods_for("Grid10") and methods.user_modules() == (user_module,)
+    register_method(METHODS["dqn-mine"])  # the same row again: nothing
+
+
+def test_transfer_trains_a_users_row_in_a_spawned_worker(user_module, tmp_path):
+    out = tmp_path / "out"
+    code = main(["transfer", "--suite", "standard", "--worlds", "Grid10", "--tasks", "Reach", "--methods",
+                 f"{user_module}:dqn-mine", "--seeds", "1", "--steps", "2000", "--workers", "1", "--no-video",
+                 "--no-archive", "--out", str(out)])
+    assert code == 0
+    (run,) = (out / "students").glob("student-Reach-Grid10-dqn-mine-s0-*")
+    assert json.loads((run / "result.json").read_text())["steps"] == 2000
+    assert "| dqn-mine |" in (out / "leaderboard.md").read_text()
+
+
+@pytest.mark.parametrize("row, message", [
+    (Method("td3", "Cont", "td3", False), "method 'td3' is a row already"),
+    (Method("My Method", "Cont", "td3", False), "use lowercase letters, digits and dashes"),
+    ("td3-mine", "register_method takes a craftsuite.methods.Method row, got str"),
+])
+def test_a_bad_row_is_refused_by_name(row, message):
+    with pytest.raises(MethodError, match=message):
+        register_method(row)
+
+
+def test_a_module_that_is_not_there_or_registers_no_such_row_is_named(user_module, capsys):
+    with pytest.raises(ValueError, match="module 'no_such_module' cannot be imported"):
+        resolve_method("no_such_module:x")
+    with pytest.raises(KeyError, match=r"unknown method\(s\) \['dqn-other'\]"):
+        resolve_method(f"{user_module}:dqn-other")
+    with pytest.raises(SystemExit):
+        main(["student", "Reach", "--method", "no_such_module:x"])
+    assert "module 'no_such_module' cannot be imported" in capsys.readouterr().err
+
+
+def test_an_installed_packages_entry_point_registers_its_rows(user_module, monkeypatch):
+    point = importlib.metadata.EntryPoint(name="mine", value=f"{user_module}:ROWS", group=methods.ENTRY_POINTS)
+    monkeypatch.setattr(importlib.metadata, "entry_points",
+                        lambda group: [point] if group == methods.ENTRY_POINTS else [])
+    methods.load_entry_points()
+    assert METHODS["dqn-mine"].description == "my DQN from scratch"

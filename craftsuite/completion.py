@@ -24,7 +24,7 @@ import json
 from pathlib import Path
 
 from .files import atomic_write
-from .runs import EPISODE_FIELDS, EVAL_FIELDS, FORMAT, RunError, counts_acceptance, csv_text, read_config, read_log
+from .runs import EPISODE_CORE, EVAL_FIELDS, FORMAT, RunError, counts_acceptance, csv_text, read_config, read_log
 
 REREAD = ("success re-read as completion from a record that counted the automaton's acceptance: "
           "a training episode completed if accepted and ended before its time limit")
@@ -99,10 +99,11 @@ def reread_in_place(run: Path) -> bool:
     if not needs_reread(config):
         return False
     episodes, evals = reread_logs(run, config)
+    fields = tuple(episodes[0]) if episodes else EPISODE_CORE  # the log's own columns, in its order
     if (run / "episodes.csv").exists():
-        atomic_write(run / "episodes.csv", csv_text(EPISODE_FIELDS, episodes))
+        atomic_write(run / "episodes.csv", csv_text(fields, episodes))
     elif (run / "episodes.csv.gz").exists():  # mtime 0: the same log compresses to the same bytes (the archive's)
-        atomic_write(run / "episodes.csv.gz", gzip.compress(csv_text(EPISODE_FIELDS, episodes).encode(),
+        atomic_write(run / "episodes.csv.gz", gzip.compress(csv_text(fields, episodes).encode(),
                                                            compresslevel=9, mtime=0))
     atomic_write(run / "evals.csv", csv_text(EVAL_FIELDS, evals))
     atomic_write(run / "config.json", json.dumps({**config, "format": FORMAT}, indent=2, sort_keys=True) + "\n")
@@ -117,5 +118,6 @@ def reread_logs(run: Path, config: dict) -> tuple[list[dict], list[dict]]:
     Raises:
         RunError: as ``reread``, or a log that does not read, naming the file.
     """
-    return reread(config, read_log(run / "episodes.csv", EPISODE_FIELDS),
+    # the columns of every record's log: one made before ``seen`` and ``states`` has only these
+    return reread(config, read_log(run / "episodes.csv", EPISODE_CORE),
                   read_log(run / "evals.csv", EVAL_FIELDS, required=True))

@@ -9,7 +9,9 @@ A run directory holds
   CraftSuite version, the git commit and the versions of torch, SB3, gymnasium and
   mujoco). The run key, the last part of the directory's name, hashes the configuration
   and the effective settings, so a change of a default makes a new run;
-* ``episodes.csv``: one row per finished training episode (step, return, length, success);
+* ``episodes.csv``: one row per finished training episode (step, return, length, success,
+  and how far along the task it got: the propositions it saw and the automaton states it
+  visited, as bitmasks: ``craftsuite.reached``);
 * ``evals.csv``: one row per evaluation (step, success rate, mean return, episodes, mean
   episode length);
 * ``checkpoint/``: the last model and replay buffer, written together at each evaluation,
@@ -44,7 +46,10 @@ from pathlib import Path
 
 from .files import atomic_write
 
-EPISODE_FIELDS = ("step", "return", "length", "success")
+EPISODE_FIELDS = ("step", "return", "length", "success", "seen", "states")
+# the columns every episodes.csv has: records made before ``seen`` and ``states`` have only
+# these (a run resumed since has them empty in the rows of its first session)
+EPISODE_CORE = EPISODE_FIELDS[:4]
 EVAL_FIELDS = ("step", "success", "return", "episodes", "length")
 
 

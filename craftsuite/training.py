@@ -71,6 +71,12 @@ class RunCallback(BaseCallback):
         self.pending: list[dict] = []
 
     def _on_training_start(self) -> None:
+        from .reached import Reached
+        from .task_registry import resolve_task
+
+        # learn() starts every env's episode afresh (SB3 resets them), a resumed run's too
+        task = self.run.config.task
+        self.reached = Reached(resolve_task(task).automaton, self.training_env.num_envs, task)
         if self.num_timesteps > 0:  # resumed from a checkpoint
             _purge_tensorboard(self.logger, self.num_timesteps)
         else:  # once per run: a resumed run's first session logged them
@@ -87,10 +93,16 @@ class RunCallback(BaseCallback):
             self.bar.update(self.num_timesteps - self.bar.n)
 
     def _on_step(self) -> bool:
-        for info in self.locals["infos"]:
+        infos = self.locals["infos"]
+        # an ended env's info is its episode's last step's (SB3 keeps the reset's apart)
+        self.reached.step(np.array([info["label_mask"] for info in infos], dtype=np.int64),
+                          np.array([info["automaton_state"] for info in infos], dtype=np.int64))
+        for i, info in enumerate(infos):
             if "episode" in info:
+                (seen,), (states,) = self.reached.take([i])
                 self.pending.append({"step": self.num_timesteps, "return": round(float(info["episode"]["r"]), 4),
-                                     "length": int(info["episode"]["l"]), "success": int(bool(info.get("is_success")))})
+                                     "length": int(info["episode"]["l"]), "success": int(bool(info.get("is_success"))),
+                                     "seen": seen, "states": states})
         if self.bar is not None:
             self.bar.update(self.num_timesteps - self.bar.n)
         if self.num_timesteps >= self.next_flush:
@@ -260,6 +272,10 @@ def _train(config, name: str, root, fresh, *, product: bool, total: int, stop_at
     then save the agent as ``model`` and what ``write_more(run, agent)`` writes beside it
     (timed with the run), write ``result(run, agent, seconds)`` as the run's result and
     remove the checkpoints (but the last with ``keep_checkpoint``)."""
+    from .reached import check_automaton
+    from .task_registry import resolve_task
+
+    check_automaton(resolve_task(config.task).automaton, config.task)  # before a run directory exists
     with RunDir(Path(root) / name, config) as run:
         if run.finished():
             return run.path

@@ -209,7 +209,8 @@ class Population:
         """One step of every member's envs: act on ``obs`` ``(K * n_envs, obs_dim)``, step
         ``envs`` (same-step autoreset, ``envs.make_envs``), store the transitions, restart
         the noise of envs whose episode ended. Returns (next observations, rewards, ended,
-        success) of the ``K * n_envs`` envs."""
+        success, automaton transitions) of the ``K * n_envs`` envs: the transitions ``(w,
+        sigma, w')`` each env's action caused, as ``(K * n_envs, 3)`` (``step_records``)."""
         K, n = self.K, self.n_envs
         shaped = obs.reshape(K, n, -1)
         actions = self.actions(shaped)
@@ -220,7 +221,7 @@ class Population:
                      terminated.reshape(K, n).astype(np.float32), transitions.reshape(K, n, 3), ended.reshape(K, n))
         if ended.any():
             self.episodes_ended(ended.reshape(K, n))
-        return next_obs, rewards, ended, success
+        return next_obs, rewards, ended, success, transitions
 
     # -- learning ----------------------------------------------------------------------------------
     def observe(self, obs, next_obs, actions, rewards, terminated, transitions, ended=None) -> None:

@@ -26,6 +26,7 @@ from ..configs import StudentConfig
 from ..files import atomic_path, atomic_write
 from ..ids import world_kind
 from ..methods import METHODS
+from ..reached import Reached, check_automaton
 from ..runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, eval_seed
 from .engine import EngineError, Population, check_supported, sparse_width
 from .envs import make_envs, step_records
@@ -80,6 +81,7 @@ def train_population(configs: list[StudentConfig], root, progress: bool = True, 
     root = Path(root)
     names = [c.run_name() for c in configs]
     spec = resolve_task(config.task)
+    check_automaton(spec.automaton, config.task)  # before any run directory exists
     table = None
     if method.needs_table and not all((root / n / "result.json").exists() for n in names):
         if config.table is None:
@@ -117,7 +119,7 @@ def _train(todo, settings, table, spec, device, progress, desc) -> None:
         eval_envs = make_envs(config.env_id, K * config.eval_episodes, config.env_kwargs, config.product)
         stack.callback(eval_envs.close)
         with progress_bar(K * total, desc, initial=K * pop.num_timesteps, enabled=progress) as bar:
-            _loop(pop, envs, eval_envs, configs, runs, bar)
+            _loop(pop, envs, eval_envs, configs, runs, bar, spec.automaton)
         for k, (c, run) in enumerate(todo):
             _finish(pop, k, c, run, table, time.perf_counter() - start, str(device))
     finally:
@@ -125,24 +127,31 @@ def _train(todo, settings, table, spec, device, progress, desc) -> None:
         th.set_num_threads(threads)
 
 
-def _loop(pop: Population, envs, eval_envs, configs, runs, bar) -> None:
+def _loop(pop: Population, envs, eval_envs, configs, runs, bar, automaton) -> None:
     config = configs[0]
     K, n, total, every = pop.K, pop.n_envs, config.steps, config.eval_every
     seeds = [c.seed + j for c in configs for j in range(n)]  # as SB3's make_vec_env seeds each run's envs
     obs, _ = envs.reset(seed=seeds)
     pop.restart_noise()
     returns, lengths = np.zeros(K * n), np.zeros(K * n, dtype=np.int64)
+    reached = Reached(automaton, K * n, config.task)  # every env starts an episode here
     pending: list[list[dict]] = [[] for _ in range(K)]
     next_eval = (pop.num_timesteps // every + 1) * every
     next_flush = pop.num_timesteps + 1_000
     while pop.num_timesteps < total:
-        obs, rewards, ended, success = pop.step(envs, obs)
+        obs, rewards, ended, success, transitions = pop.step(envs, obs)
         returns += rewards
         lengths += 1
+        # an ended env's transition is its episode's last (same-step autoreset), so it is
+        # counted before ``take`` starts the env's next episode
+        reached.step(transitions[:, 1], transitions[:, 2])
         if ended.any():
-            for i in np.flatnonzero(ended):
+            ended_at = np.flatnonzero(ended)
+            seen, states = reached.take(ended_at)
+            for i, s, q in zip(ended_at.tolist(), seen, states):
                 pending[i // n].append({"step": pop.num_timesteps, "return": round(float(returns[i]), 4),
-                                        "length": int(lengths[i]), "success": int(success[i])})
+                                        "length": int(lengths[i]), "success": int(success[i]),
+                                        "seen": s, "states": q})
             returns[ended], lengths[ended] = 0.0, 0
         bar.update(K * n)
         t = pop.num_timesteps

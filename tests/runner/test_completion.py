@@ -16,7 +16,7 @@ from craftsuite import archive
 from craftsuite.completion import needs_reread, reread, reread_in_place
 from craftsuite.envs.board import BoardRules
 from craftsuite.labelling import Labeller
-from craftsuite.runs import (EPISODE_FIELDS, EVAL_FIELDS, RunDir, RunError, read_config, read_csv, record_key, settings,
+from craftsuite.runs import (EPISODE_CORE, EVAL_FIELDS, RunDir, RunError, read_config, read_csv, record_key, settings,
                              write_csv)
 from craftsuite.task_registry import resolve_task
 from craftsuite.training import StudentConfig
@@ -78,8 +78,9 @@ def _old_kinematic_run(root, name="student-BlindCraftsman-Kinematic-td3-s0"):
     (run / "config.json").write_text(json.dumps(config))
     write_csv(run / "evals.csv", EVAL_FIELDS, [{"step": 2000, "success": 0.0, "return": -99.0, "episodes": 20,
                                                "length": 1000.0}])
-    write_csv(run / "episodes.csv", EPISODE_FIELDS, [{"step": 1000, "return": -99.0, "length": 1000, "success": 1},
-                                                     {"step": 1400, "return": 60.0, "length": 400, "success": 1}])
+    # a record of format 2 predates episodes.csv's seen and states
+    write_csv(run / "episodes.csv", EPISODE_CORE, [{"step": 1000, "return": -99.0, "length": 1000, "success": 1},
+                                                   {"step": 1400, "return": 60.0, "length": 400, "success": 1}])
     (run / "result.json").write_text(json.dumps({"kind": "student", "steps": 2000}))
     return run
 
@@ -89,6 +90,7 @@ def test_archiving_a_record_that_counted_acceptance_re_reads_it_under_its_key(tm
     kept = archive.keep(run, tmp_path / "results" / "paper", "students")
     assert kept.name == run.name and archive.check_record(kept) is None  # the same run key: still usable
     assert [int(r["success"]) for r in read_csv(kept / "episodes.csv")] == [0, 1]
+    assert list(read_csv(kept / "episodes.csv")[0]) == list(EPISODE_CORE)  # its own columns, no empty new ones
     config, result = (json.loads((kept / f).read_text()) for f in ("config.json", "result.json"))
     assert config["format"] == 3 and "re-read as completion" in result["success_reread"]
     assert not needs_reread(config)

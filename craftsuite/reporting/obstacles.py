@@ -1,0 +1,214 @@
+"""Where training got stuck: how often a run's training episodes ended, and how far along its
+task they got, from ``episodes.csv`` (its ``seen`` and ``states`` columns: ``craftsuite.reached``).
+
+For a task no method learns, a success curve is flat at 0 and says nothing; what the
+episodes reached does: the propositions that ever held, the automaton states visited, and
+the furthest of them, the visited state fewest automaton edges from acceptance.
+``episode_progress`` reads one run, ``pool`` the seeds of one method (the results page
+shows one line per method).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..reached import bits
+from ..runs import EPISODE_CORE, RunError, read_config, read_log
+
+
+@dataclass(frozen=True)
+class Furthest:
+    """The visited automaton state closest to acceptance."""
+    state: int
+    distance: int  # automaton edges to an accepting state (0: accepting)
+    share: float  # of the episodes, those that visited a state this close
+
+
+@dataclass(frozen=True)
+class Progress:
+    """What one run's training episodes (or several seeds', ``pool``) reached.
+
+    Shares are over the ``marked`` episodes, those whose row carries ``seen`` and
+    ``states`` (all of them but those logged, before the columns came, by an earlier session
+    of a resumed run)."""
+    task: str
+    runs: int  # seeds pooled (1: one run)
+    budget: int  # transitions (config.json's steps), summed over the runs
+    episodes: int  # training episodes that ended
+    completed: int  # of them, those that completed the task
+    completed_per_100k: float  # completed episodes per 100k transitions (pooled: the runs' mean)
+    marked: int
+    seen_share: dict[str, float]  # proposition -> share of episodes in which it held
+    state_share: dict[int, float]  # automaton state -> share of episodes that visited it
+    closest_share: dict[int, float]  # distance -> share of episodes whose closest visited state is that far
+    distance: tuple[int | None, ...]  # per state, edges to acceptance (None: it cannot get there)
+    depth: tuple[int | None, ...]  # per state, edges from the initial state (None: the sink)
+    furthest: Furthest | None  # None: no marked episode
+
+
+def distances(automaton, forward: bool = False) -> list[int | None]:
+    """Each state's fewest DFA edges to an accepting state (``forward``: from the initial
+    state), over the transitions some label takes, not counting self-loops nor the rejecting
+    sink (None: out of reach)."""
+    links: dict[int, list[int]] = {}
+    for source, target in automaton.edges():  # (the sink's edges are left out)
+        if source != target:
+            a, b = (source, target) if forward else (target, source)
+            links.setdefault(a, []).append(b)
+    if forward:
+        out: list[int | None] = [0 if q == automaton.initial else None for q in range(automaton.n_states)]
+    else:
+        out = [0 if a else None for a in automaton.accepting.tolist()]
+    frontier = [q for q, d in enumerate(out) if d == 0]
+    while frontier:  # breadth first
+        nxt = []
+        for q in frontier:
+            for other in links.get(q, ()):
+                if out[other] is None:
+                    out[other] = out[q] + 1
+                    nxt.append(other)
+        frontier = nxt
+    return out
+
+
+def _mask(text) -> int | None:
+    """A ``seen`` or ``states`` cell: None where the row has none (logged before the column)."""
+    return None if text in (None, "") else int(text)
+
+
+def episode_progress(run) -> Progress | None:
+    """What the training episodes of the run at ``run`` reached; None for a record made before
+    ``episodes.csv`` had its ``seen`` and ``states`` columns (no episode carries them).
+
+    Raises:
+        RunError: a record that does not read (the file named), of a task unknown here or of
+            other rules than the task's now (its bits would name other propositions).
+    """
+    run = Path(run)
+    config = read_config(run)
+    budget = config.get("steps")
+    if not isinstance(budget, int) or isinstance(budget, bool) or budget <= 0:
+        raise RunError(f"{run / 'config.json'} records no transitions budget (steps): not a student's record")
+    spec = _spec(run, config)
+    path = run / "episodes.csv"  # (or the archive's episodes.csv.gz: read_log reads either)
+    # (completed, seen, states) per episode; a log without the columns reads as None in them
+    episodes = read_log(path, EPISODE_CORE, lambda r: (int(float(r["success"])), _mask(r.get("seen")),
+                                                        _mask(r.get("states"))))
+    if episodes and all(seen is None or states is None for _, seen, states in episodes):
+        return None
+    try:
+        return summarize(spec.automaton, spec.name, budget, episodes)
+    except ValueError as err:
+        raise RunError(f"{path}: {err}: the record was made with another automaton") from None
+
+
+def summarize(automaton, task: str, budget: int, episodes: list[tuple[int, int | None, int | None]]) -> Progress:
+    """The ``Progress`` of one run of ``budget`` transitions from its episodes' (completed,
+    seen, states), in the bits of ``automaton`` (a None: a row logged before the columns).
+
+    Raises:
+        ValueError: an episode with bits the automaton has no proposition or state for.
+    """
+    n_props, n_states = len(automaton.propositions), automaton.n_states
+    far = distances(automaton)
+    seen_counts, state_counts, closest_counts = [0] * n_props, [0] * n_states, {}
+    marked = 0
+    for number, (_, seen, states) in enumerate(episodes, start=1):
+        if seen is None or states is None:
+            continue
+        if seen < 0 or states < 0 or seen >> n_props or states >> n_states:
+            raise ValueError(f"episode {number} (line {number + 1}: seen {seen}, states {states}) names "
+                             f"propositions or states that task {task!r} does not have ({n_props} propositions, "
+                             f"{n_states} states)")
+        marked += 1
+        for i in bits(seen):
+            seen_counts[i] += 1
+        visited = bits(states)
+        for q in visited:
+            state_counts[q] += 1
+        near = [far[q] for q in visited if far[q] is not None]
+        if near:
+            closest_counts[min(near)] = closest_counts.get(min(near), 0) + 1
+    completed = sum(won for won, _, _ in episodes)
+    return _progress(task, 1, budget, len(episodes), completed, completed * 100_000 / budget, marked,
+                     automaton.propositions, seen_counts, state_counts, closest_counts, tuple(far),
+                     tuple(distances(automaton, forward=True)))
+
+
+def _spec(run: Path, config: dict):
+    from ..task_registry import resolve_task
+
+    try:
+        spec = resolve_task(config["task"])
+    except (KeyError, ValueError) as err:
+        raise RunError(f"{run / 'config.json'}: task {config['task']!r} is unknown here ({err}): register it to "
+                       "read what its episodes reached") from None
+    recorded = config.get("effective", {}).get("world", {}).get("rules")
+    if recorded is not None and recorded != spec.digest():
+        raise RunError(f"{run / 'config.json'}: task {spec.name!r} ran under other rules (digest {recorded}) than "
+                       f"this version's ({spec.digest()}): its episodes' bits may name another automaton's "
+                       "propositions and states; read it with the version that trained it")
+    return spec
+
+
+def _progress(task, runs, budget, episodes, completed, per_100k, marked, propositions, seen_counts, state_counts,
+              closest_counts, far, depth) -> Progress:
+    def share(count):
+        return count / marked if marked else 0.0
+
+    furthest = None
+    if closest_counts:
+        d = min(closest_counts)
+        # of the visited states that close, the one furthest from the start (where a label no
+        # world makes, two events at once, skips a state, the start and the state after it
+        # are as close), then the one more episodes visited, then the lower number
+        state = max((q for q, dq in enumerate(far) if dq == d and state_counts[q]),
+                    key=lambda q: (depth[q], state_counts[q], -q))
+        furthest = Furthest(state, d, share(closest_counts[d]))
+    return Progress(task, runs, budget, episodes, completed, per_100k, marked,
+                    {p: share(c) for p, c in zip(propositions, seen_counts)},
+                    {q: share(c) for q, c in enumerate(state_counts)},
+                    {d: share(c) for d, c in sorted(closest_counts.items())}, far, depth, furthest)
+
+
+def pool(progress: list[Progress]) -> Progress:
+    """Several seeds' ``Progress`` of one method as one: the mean of their completed episodes
+    per 100k transitions, their episodes' shares pooled (each episode counts once).
+
+    Raises:
+        ValueError: no runs, or runs of different tasks.
+    """
+    if not progress:
+        raise ValueError("pool() needs at least one run's progress")
+    tasks = sorted({p.task for p in progress})
+    if len(tasks) > 1:
+        raise ValueError(f"pool() pools the seeds of one task's runs, got the tasks {tasks}")
+    first = progress[0]
+    marked = sum(p.marked for p in progress)
+
+    def counts(field: str) -> dict:
+        out: dict = {}
+        for p in progress:
+            for key, s in getattr(p, field).items():
+                out[key] = out.get(key, 0) + round(s * p.marked)  # shares of whole episodes: exact counts
+        return out
+
+    seen, states, closest = counts("seen_share"), counts("state_share"), counts("closest_share")
+    return _progress(first.task, sum(p.runs for p in progress), sum(p.budget for p in progress),
+                     sum(p.episodes for p in progress), sum(p.completed for p in progress),
+                     sum(p.completed_per_100k * p.runs for p in progress) / sum(p.runs for p in progress), marked,
+                     tuple(first.seen_share), [seen[k] for k in first.seen_share],
+                     [states[q] for q in first.state_share], {d: c for d, c in closest.items() if c}, first.distance,
+                     first.depth)
+
+
+def method_progress(runs) -> Progress | None:
+    """The pooled ``Progress`` of one method's seeds (run directories or archived records),
+    over those whose records carry the columns; None where none does.
+
+    Raises:
+        RunError: as ``episode_progress``, for any of them.
+    """
+    found = [p for p in (episode_progress(run) for run in runs) if p is not None]
+    return pool(found) if found else None

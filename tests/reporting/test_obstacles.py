@@ -1,0 +1,135 @@
+"""What training episodes reached, read back from episodes.csv: the shares of propositions
+and automaton states, the furthest state, completed episodes per 100k transitions; old
+records (without the columns) and archived ones (gzipped)."""
+
+import gzip
+import json
+
+import numpy as np
+import pytest
+
+from craftsuite.automata import Automaton
+from craftsuite.reporting.obstacles import distances, episode_progress, method_progress, pool, summarize
+from craftsuite.runs import EPISODE_CORE, EPISODE_FIELDS, RunError, write_csv
+from craftsuite.task_registry import resolve_task
+
+from .fakes import fake_run
+
+
+def _hand_made() -> Automaton:
+    """Propositions a (bit 0) and b (bit 1). 0 -a-> 1 -b-> 2 (accepting); 0 -b-> 4 -a-> 1 (a
+    detour); a and b together from 0 or 4: 3, the rejecting sink."""
+    delta = np.array([[0, 1, 4, 3],   # 0: nothing stays, a, b, a & b
+                      [1, 1, 2, 2],   # 1
+                      [2, 2, 2, 2],   # 2: accepting
+                      [3, 3, 3, 3],   # 3: the sink
+                      [4, 1, 4, 3]],  # 4
+                     dtype=np.int16)
+    return Automaton("hand-made", ("a", "b"), delta, np.array([False, False, True, False, False]))
+
+
+def test_distances_count_edges_to_acceptance_without_self_loops_or_the_sink():
+    automaton = _hand_made()
+    assert automaton.rejecting.tolist() == [False, False, False, True, False]
+    assert distances(automaton) == [2, 1, 0, None, 2]
+    assert distances(automaton, forward=True) == [0, 1, 2, None, 1]  # from the start
+
+
+def test_furthest_is_the_visited_state_closest_to_acceptance():
+    automaton = _hand_made()
+    # (completed, seen, states): one reached 1, one wandered to 4 and died in the sink, one stayed at 0
+    episodes = [(0, 0b01, 0b00011), (0, 0b11, 0b11001), (0, 0b00, 0b00001)]
+    progress = summarize(automaton, "hand-made", 1_000, episodes)
+    assert (progress.furthest.state, progress.furthest.distance) == (1, 1)
+    assert progress.furthest.share == pytest.approx(1 / 3)
+    assert progress.closest_share == pytest.approx({1: 1 / 3, 2: 2 / 3})
+    assert progress.state_share == pytest.approx({0: 1.0, 1: 1 / 3, 2: 0.0, 3: 1 / 3, 4: 1 / 3})
+    assert progress.seen_share == pytest.approx({"a": 2 / 3, "b": 1 / 3})
+    # the sink, whatever it is next to, is never the furthest: it cannot get to acceptance
+    stuck = summarize(automaton, "hand-made", 1_000, [(0, 0b11, 0b01001)])
+    assert (stuck.furthest.state, stuck.furthest.distance, stuck.furthest.share) == (0, 2, 1.0)
+    # an accepted episode: distance 0, whatever the others reached
+    done = summarize(automaton, "hand-made", 1_000, [(1, 0b11, 0b00111), (0, 0b10, 0b10001), (0, 0b10, 0b10001)])
+    assert (done.furthest.state, done.furthest.distance) == (2, 0) and done.furthest.share == pytest.approx(1 / 3)
+    assert done.completed_per_100k == pytest.approx(100.0)
+    # 0 and 4 are both 2 away: 4, a step from the start, is further along
+    tie = summarize(automaton, "hand-made", 1_000, [(0, 0b10, 0b10001)])
+    assert (tie.furthest.state, tie.furthest.distance, tie.furthest.share) == (4, 2, 1.0)
+    with pytest.raises(ValueError, match="episode 1 .*states 32"):
+        summarize(automaton, "hand-made", 1_000, [(0, 0, 0b100000)])  # a state the automaton does not have
+
+
+def _run(root, task="Reach", world="Grid10", budget=1_000, rows=(), fields=EPISODE_FIELDS, seed=0, **config):
+    run = fake_run(root, "dqn", seed, [(budget, 0.0)], [], budget=budget, task=task, world=world, **config)
+    write_csv(run / "episodes.csv", fields, [dict(zip(EPISODE_FIELDS, r)) for r in rows])
+    return run
+
+
+REACH = [(300, -20.0, 200, 0, 0, 0b01), (420, 95.0, 120, 1, 1, 0b11), (800, -20.0, 200, 0, 0, 0b01),
+         (990, 90.0, 150, 1, 1, 0b11)]
+
+
+def test_a_run_reads_from_its_log_and_from_the_archives_gzipped_one(tmp_path):
+    run = _run(tmp_path, rows=REACH)
+    progress = episode_progress(run)
+    assert (progress.task, progress.runs, progress.budget, progress.episodes, progress.completed) == \
+        ("Reach", 1, 1_000, 4, 2)
+    assert progress.completed_per_100k == pytest.approx(200.0)
+    assert progress.seen_share == {"wood": 0.5} and progress.state_share == {0: 1.0, 1: 0.5}
+    assert (progress.furthest.state, progress.furthest.distance, progress.furthest.share) == (1, 0, 0.5)
+    packed = run / "episodes.csv.gz"
+    packed.write_bytes(gzip.compress((run / "episodes.csv").read_bytes(), mtime=0))
+    (run / "episodes.csv").unlink()
+    assert episode_progress(run) == progress
+
+
+def test_a_record_made_before_the_columns_reads_as_none(tmp_path):
+    old = _run(tmp_path, rows=[r[:4] for r in REACH], fields=EPISODE_CORE)
+    assert episode_progress(old) is None
+    assert method_progress([old]) is None
+    # a run resumed since: the first session's rows have the columns empty, and are not counted in the shares
+    resumed = _run(tmp_path, rows=[r[:4] for r in REACH[:2]] + REACH[2:], seed=1)
+    progress = episode_progress(resumed)
+    assert (progress.episodes, progress.completed, progress.marked) == (4, 2, 2)
+    assert progress.seen_share == {"wood": 0.5}
+    # no episode at all (a budget shorter than one): nothing reached, nothing unknown
+    empty = episode_progress(_run(tmp_path, rows=[], seed=2))
+    assert (empty.episodes, empty.marked, empty.furthest, empty.completed_per_100k) == (0, 0, None, 0.0)
+
+
+def test_the_seeds_of_a_method_pool(tmp_path):
+    a = _run(tmp_path, rows=REACH)  # 2 completed in 1,000 transitions
+    b = _run(tmp_path, rows=[(500, -20.0, 200, 0, 0, 0b01), (1000, -20.0, 200, 0, 0, 0b01)], seed=1)  # none
+    pooled = method_progress([a, b])
+    assert (pooled.runs, pooled.budget, pooled.episodes, pooled.completed, pooled.marked) == (2, 2_000, 6, 2, 6)
+    assert pooled.completed_per_100k == pytest.approx(100.0)  # the mean of 200 and 0
+    assert pooled.seen_share == pytest.approx({"wood": 1 / 3})
+    assert pooled.state_share == pytest.approx({0: 1.0, 1: 1 / 3})
+    assert (pooled.furthest.state, pooled.furthest.distance) == (1, 0) and pooled.furthest.share == pytest.approx(1 / 3)
+    assert pool([episode_progress(b)]).furthest.state == 0  # alone, b never got past the start
+    with pytest.raises(ValueError, match="one task"):
+        pool([episode_progress(a), episode_progress(_run(tmp_path, task="FirstWood", rows=REACH))])
+
+
+def test_bad_records_are_named(tmp_path):
+    wrong = _run(tmp_path, rows=[(300, -20.0, 200, 0, 0b10, 0b01)])  # Reach has one proposition
+    with pytest.raises(RunError, match=r"episodes.csv: episode 1 .*another automaton"):
+        episode_progress(wrong)
+    garbled = _run(tmp_path, rows=[(300, -20.0, 200, 0, "x", 0b01)], seed=1)
+    with pytest.raises(RunError, match=r"episodes.csv does not read as a run's log"):
+        episode_progress(garbled)
+    unknown = _run(tmp_path, task="NoSuchTask", rows=REACH, seed=2)
+    with pytest.raises(RunError, match=r"config.json: task 'NoSuchTask' is unknown here"):
+        episode_progress(unknown)
+    rules = resolve_task("Reach").digest()
+    other = _run(tmp_path, rows=REACH, seed=3, effective={"world": {"rules": "0" * len(rules)}})
+    with pytest.raises(RunError, match="ran under other rules"):
+        episode_progress(other)
+    same = _run(tmp_path, rows=REACH, seed=4, effective={"world": {"rules": rules}})
+    assert episode_progress(same).completed == 2
+    teacher = _run(tmp_path, rows=REACH, seed=5)
+    record = json.loads((teacher / "config.json").read_text())
+    del record["steps"]
+    (teacher / "config.json").write_text(json.dumps({**record, "max_steps": 1_000}))
+    with pytest.raises(RunError, match="no transitions budget"):
+        episode_progress(teacher)

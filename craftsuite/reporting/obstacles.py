@@ -22,7 +22,7 @@ class Furthest:
     """The visited automaton state closest to acceptance."""
     state: int
     distance: int  # automaton edges to an accepting state (0: accepting)
-    share: float  # of the episodes, those that visited a state this close
+    share: float  # of the episodes, those that visited it
 
 
 @dataclass(frozen=True)
@@ -165,7 +165,7 @@ def _progress(task, runs, budget, episodes, completed, per_100k, marked, proposi
         # are as close), then the one more episodes visited, then the lower number
         state = max((q for q, dq in enumerate(far) if dq == d and state_counts[q]),
                     key=lambda q: (depth[q], state_counts[q], -q))
-        furthest = Furthest(state, d, share(closest_counts[d]))
+        furthest = Furthest(state, d, share(state_counts[state]))
     return Progress(task, runs, budget, episodes, completed, per_100k, marked,
                     {p: share(c) for p, c in zip(propositions, seen_counts)},
                     {q: share(c) for q, c in enumerate(state_counts)},
@@ -212,3 +212,14 @@ def method_progress(runs) -> Progress | None:
     """
     found = [p for p in (episode_progress(run) for run in runs) if p is not None]
     return pool(found) if found else None
+
+
+def completed_per_100k(run) -> float:
+    """A run's completed training episodes per 100k transitions of its budget, from its log's
+    ``success`` column (every record has it, old ones too)."""
+    run = Path(run)
+    budget = read_config(run).get("steps")
+    if not isinstance(budget, int) or isinstance(budget, bool) or budget <= 0:
+        raise RunError(f"{run / 'config.json'} records no transitions budget (steps): not a student's record")
+    won = read_log(run / "episodes.csv", EPISODE_CORE, lambda r: int(float(r["success"])))
+    return sum(won) * 100_000 / budget

@@ -18,6 +18,7 @@ from ..regimes import describe
 from ..archive import size as archive_size
 from .board import (
     METRICS,
+    THRESHOLD,
     SELF_REPORTED,
     SMALLEST_DIFFERENCE,
     Aggregate,
@@ -142,6 +143,7 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
             lines += ["", "Against scratch, final greedy success (the difference of the means with Welch's "
                       "95% t-interval; the probability that a run beats a scratch run, with its bootstrap interval): "
                       + "; ".join(_comparison_text(e, base) for e, base in pairs) + "."]
+        lines += obstacles_markdown(rows)
         notes = [f"*{e.label}: " + "; ".join(f"{k} = {json.dumps(v)}" for k, v in e.differs.items()) + "*"
                  for e in rows if e.variant]
         if notes:
@@ -169,6 +171,50 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
               for m in shown]
     lines.append("")
     return "\n".join(lines)
+
+
+def obstacles_markdown(rows: list[Entry]) -> list[str]:
+    """Where no method of one task's table learned it (mean final greedy success below
+    ``THRESHOLD`` for every row), what each method's training episodes reached
+    (``craftsuite.reporting.obstacles``): completions per 100k transitions, the visited
+    automaton state closest to acceptance, and the share of episodes each proposition held in."""
+    from ..runs import RunError
+    from .obstacles import completed_per_100k, method_progress
+
+    if not rows or any(_finite_mean(e.values["success"]) >= THRESHOLD for e in rows):
+        return []
+    found, unread = [], []
+    for e in ranked(rows):
+        try:
+            progress = method_progress(e.runs)
+            per_100k = (progress.completed_per_100k if progress is not None
+                        else float(np.mean([completed_per_100k(run) for run in e.runs])))
+        except (RunError, OSError, ValueError) as err:
+            unread.append(f"- not read: {e.label}: {err}")
+            continue
+        found.append((e, progress, per_100k))
+    intro = (f"No method learned it (mean final greedy success below {THRESHOLD:.0%}). Where the training episodes "
+             "stopped: completed training episodes per 100k transitions (mean over seeds)")
+    if not any(p is not None and p.furthest is not None for _, p, _ in found):
+        return ["", intro + " (what the episodes reached on the way is not in these records: they were made before "
+                "episodes.csv recorded it):", "", "| method | seeds | completed per 100k |", "|---|---|---|",
+                *[f"| {e.label} | {len(e.seeds)} | {per_100k:.1f} |" for e, _, per_100k in found], *unread]
+    lines = []
+    for e, progress, per_100k in found:
+        if progress is None or progress.furthest is None:
+            furthest = reached = "not recorded"
+        else:
+            f = progress.furthest
+            furthest = (f"state {f.state}, {f.distance} edge{'s' if f.distance != 1 else ''} from acceptance "
+                        f"({f.share:.0%} of episodes)")
+            reached = ", ".join(f"{p} {share:.0%}" for p, share in progress.seen_share.items())
+        lines.append(f"| {e.label} | {len(e.seeds)} | {per_100k:.1f} | {furthest} | {reached} |")
+    return ["", intro + "; of the automaton states the episodes visited, the one fewest edges from acceptance (of "
+            "those as close, the one furthest from the start) and the share of episodes that visited it; the share "
+            "of episodes in which each proposition held at "
+            "some step (seeds pooled):", "",
+            "| method | seeds | completed per 100k | furthest automaton state | propositions reached |",
+            "|---|---|---|---|---|", *lines, *unread]
 
 
 def _comparison_text(entry: Entry, baseline: Entry) -> str:

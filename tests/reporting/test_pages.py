@@ -118,3 +118,31 @@ def test_a_results_page_lists_its_teachers_and_names_a_damaged_one(tmp_path):
     assert "| GoldMine | `CraftSuite/GoldMine-Grid7-v0` | fixed (0) | 55,000 / 53,999 | 1.00 | yes (90%) |" in text
     assert f"- not read: {torn} (JSONDecodeError" in text
     assert teachers_markdown(tmp_path / "nowhere") == []
+
+
+def test_a_task_no_method_learned_says_where_its_episodes_stopped(tmp_path):
+    from craftsuite.reporting.board import build
+    from craftsuite.reporting.pages import obstacles_markdown
+    from craftsuite.runs import EPISODE_FIELDS, write_csv
+    from craftsuite.task_registry import resolve_task
+
+    automaton = resolve_task("BlindCraftsman").automaton
+    wood = 1 << automaton.propositions.index("wood")
+    start = 1 << automaton.initial
+    root = tmp_path / "students"
+    for seed in range(3):
+        for method in ("td3", "td3-dynamic"):
+            run = fake_run(root, method, seed, [(1000, 0.0)], [], budget=1000)
+            # every episode saw wood; td3-dynamic's half of them also the automaton's next state
+            moved = start | (1 << automaton.step(automaton.initial, wood))
+            write_csv(run / "episodes.csv", EPISODE_FIELDS,
+                      [{"step": 500 * (i + 1), "return": 0.0, "length": 10, "success": 0, "seen": wood,
+                        "states": moved if method == "td3-dynamic" and i == 0 else start} for i in range(2)])
+    rows = list(build(root))
+    text = "\n".join(obstacles_markdown(rows))
+    assert "| method | seeds | completed per 100k | furthest automaton state | propositions reached |" in text
+    assert "| td3 | 3 | 0.0 | state 0," in text and "wood 100%" in text and "home 0%" in text
+    assert "(50% of episodes)" in text  # td3-dynamic: one episode of two moved on
+    # a task some method learned needs no such table
+    learned = fake_run(tmp_path / "other", "td3", 0, [(1000, 1.0)], [(995, 1.0, 1)])
+    assert obstacles_markdown(list(build(learned.parent))) == []

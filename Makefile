@@ -28,9 +28,11 @@ test-slow: $(STAMP)
 	$(PY) -m pytest -q -m slow --nbmake tests notebooks
 
 # The pages generated from data: the tasks page from the specs and the results archive,
+# the record format's page from its table (craftsuite.record_format),
 # the results and reproduction pages from the archive (results/)
 docs: $(STAMP)
 	$(PY) -m craftsuite tasks --markdown docs/tasks.md
+	$(PY) -m craftsuite records --markdown docs/records.md
 	$(PY) -m craftsuite leaderboard results/standard results/hard --page docs/results.md
 	$(PY) -m craftsuite leaderboard results/paper --reproduction docs/reproduction.md
 

@@ -71,6 +71,18 @@ class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
         return super()._get_help_string(action)
 
 
+def _records(args) -> int:
+    from .files import file_to_write
+    from .record_format import markdown, write_markdown
+
+    if args.markdown:
+        file_to_write(args.markdown, "--markdown", "records.md")
+        print(f"wrote {write_markdown(args.markdown)}")
+    else:
+        print(markdown())
+    return 0
+
+
 def _tasks(args) -> int:
     from .ids import parse_id
     from .registration import registered_ids
@@ -521,6 +533,10 @@ def build_parser() -> argparse.ArgumentParser:
     names = ", ".join(s.name for s in ladder())
     task_help = f"a task: {names}; or a task spec file (path/to/task{SPEC_SUFFIX}), registered for this command"
     worlds = ", ".join(_known_worlds())
+
+    p = sub.add_parser("records", help="the run record format (config, result, evaluations, episodes)")
+    p.add_argument("--markdown", metavar="PATH", help="write it as a docs page to PATH, e.g. docs/records.md")
+    p.set_defaults(run=_records)
 
     p = sub.add_parser("tasks", help="list the tasks (the ladder's rungs, easiest first), formulas, automata, ids")
     p.add_argument("--tag", nargs="+", default=(), help="only the tasks with any of these tags: "

@@ -40,6 +40,7 @@ import numpy as np
 
 from .. import stats
 from ..completion import needs_reread
+from ..record_format import RecordError, check_config, check_episodes, check_evals, check_result
 from ..runs import RunError, flatten, read_config, read_log, run_settings
 
 # metrics with a mean and an interval per task and method; a rate lies in [0, 1]
@@ -118,14 +119,21 @@ def run_metrics(run: Path) -> dict | None:
         raise RunError(f"{run}: its success counted the automaton's acceptance on the kinematic board (record "
                        f"format {config.get('format', 1)}); keep it in a results archive (craftsuite archive "
                        "RUNS --suite S), which re-reads it as completion")
-    budget = int(config["steps"])
-    # (step, return, won) per training episode; (step, greedy success) per evaluation
-    episodes = read_log(run / "episodes.csv", ("step", "return", "success"),
-                    lambda e: (int(e["step"]), float(e["return"]), int(e["success"])))
+    # the record as the format has it (craftsuite.record_format): one line naming what breaks it
+    raw_episodes = read_log(run / "episodes.csv", ("step", "return", "success"))
     # no episodes.csv is no episode yet (a budget shorter than an episode); no evals.csv, damage
-    evals = read_log(run / "evals.csv", ("step", "success"), lambda e: (int(e["step"]), float(e["success"]),
-                                                                        float(e.get("length") or "nan")),
-                     required=True)
+    raw_evals = read_log(run / "evals.csv", ("step", "success"), required=True)
+    try:
+        check_config(config, run / "config.json")
+        check_result(result, config, run / "result.json")
+        check_evals(raw_evals, result["steps"], run / "evals.csv")
+        check_episodes(raw_episodes, result["steps"], run / "episodes.csv")
+    except RecordError as err:
+        raise RunError(str(err)) from None
+    budget = int(config["steps"])
+    # (step, return, won) per training episode; (step, greedy success, mean length) per evaluation
+    episodes = [(int(e["step"]), float(e["return"]), int(e["success"])) for e in raw_episodes]
+    evals = [(int(float(e["step"])), float(e["success"]), float(e.get("length") or "nan")) for e in raw_evals]
     tail = [e for e in episodes if e[0] > 0.9 * budget]
     if not tail and episodes:  # fewer episodes than the window: the last one
         tail = episodes[-1:]

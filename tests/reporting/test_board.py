@@ -221,8 +221,16 @@ def test_interval_verdicts_follow_the_intervals(tmp_path):
     ("result.json", "{torn", "is not valid JSON"),
     ("result.json", json.dumps({"steps": 1000}), "holds no student's or teacher's result"),
     ("result.json", json.dumps({"kind": "student"}), "holds no transitions"),
-    ("evals.csv", "step,success,return,episodes\nlate,1.0,0.0,10\n", "does not read as a run's log"),
-    ("episodes.csv", "step,return,length,success\n995,high,10,1\n", "does not read as a run's log"),
+    ("evals.csv", "step,success,return,episodes\nlate,1.0,0.0,10\n", "line 2: step 'late' is not a number"),
+    ("episodes.csv", "step,return,length,success\n995,high,10,1\n", "line 2: return 'high' is not a number"),
+    # the record format's checks (craftsuite.record_format)
+    ("evals.csv", "step,success,return,episodes\n1000,1.0,nan,10\n", "line 2: return is nan: a record holds finite"),
+    ("evals.csv", "step,success,return,episodes\n1000,1.5,0.0,10\n", "line 2: success 1.5 is not a rate in [0, 1]"),
+    ("evals.csv", "step,success,return,episodes\n5000,1.0,0.0,10\n", "line 2: step 5000 is not a step of the run"),
+    ("episodes.csv", "step,return,length,success\n995,nan,10,1\n", "return is nan"),
+    ("result.json", json.dumps({"kind": "student", "steps": 500}), "steps 500 is short of the budget in config.json"),
+    ("result.json", json.dumps({"kind": "student", "steps": 1000, "task": "DungeonQuest"}),
+     "task 'DungeonQuest' is not config.json's ('BlindCraftsman'): the result of another run"),
     ("config.json", json.dumps({"world": "Cont"}), "holds no run configuration"),
     ("config.json", None, "is missing beside its result.json"),
 ])

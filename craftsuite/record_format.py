@@ -1,0 +1,179 @@
+"""The record format of a student run, as data: the fields of ``config.json`` and
+``result.json`` and the columns of ``evals.csv`` and ``episodes.csv``, what each means and
+takes, at the record format ``runs.FORMAT``. CraftSuite's trainers write it, and so does
+``craftsuite.Recorder`` for a run trained elsewhere; ``docs/records.md`` is generated from
+it (``craftsuite records --markdown``), and every reader of a record checks it here
+(``check_config``, ``check_result``, ``check_evals``, ``check_episodes``): a record that
+breaks it is refused in one line naming the file, the field and the problem.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+
+@dataclass(frozen=True)
+class Field:
+    name: str
+    kind: str  # as the docs say it: "string", "integer >= 0", "number in [0, 1]", ...
+    required: bool
+    meaning: str
+
+
+CONFIG = (
+    Field("task", "string", True, "the task's name: a rung of the ladder, or a task registered with "
+          "`craftsuite.register_task`"),
+    Field("world", "string", True, "`Cont` (MuJoCo), `Kinematic` or `Grid<size>`, e.g. `Grid10`"),
+    Field("method", "string", True, "a row of `craftsuite.methods.METHODS`, or a self-reported run's own name"),
+    Field("seed", "integer >= 0", True, "the run's seed"),
+    Field("steps", "integer > 0", True, "the budget in transitions (env steps over all its envs)"),
+    Field("eval_every", "integer > 0", False, "transitions between greedy evaluations"),
+    Field("eval_episodes", "integer > 0", False, "episodes per greedy evaluation"),
+    Field("layout_seed", "integer >= 0 or null", False, "a grid world's fixed instance (null: a new one per episode)"),
+    Field("world_kwargs", "object", False, "`gymnasium.make` keywords of the world beyond its id"),
+    Field("hyperparameters", "object", False, "CraftSuite's learner: settings beyond its algorithm's defaults"),
+    Field("effective", "object", False, "CraftSuite's learner: every setting it ran with (method row, algorithm, "
+          "world and the digest of its task's rules)"),
+    Field("n_envs", "integer > 0", False, "envs stepped side by side"),
+    Field("engine", "string", False, "what trained it: `population` or `sb3`"),
+    Field("self_reported", "boolean", False, "true: trained outside CraftSuite (`craftsuite.Recorder`)"),
+    Field("suite", "string", False, "self-reported: the suite whose protocol it followed"),
+    Field("library", "string", False, "self-reported: what trained it"),
+    Field("settings", "object", False, "self-reported: the learner's settings, as given"),
+    Field("commit", "string or null", False, "self-reported: the commit of the code that trained it"),
+    Field("format", "integer", False, "the record format (absent: 1)"),
+    Field("provenance", "list", False, "per session that wrote it: time, versions, commit, machine"),
+)
+RESULT = (
+    Field("kind", "`student`", True, "what ran (a teacher's record says `teacher`)"),
+    Field("steps", "integer >= the budget", True, "the transitions collected"),
+    Field("updates", "integer >= 0", False, "the gradient updates made"),
+    Field("task", "string", False, "the task, as config.json says it"),
+    Field("seed", "integer", False, "the seed, as config.json says it"),
+    Field("method", "string", False, "the method, as config.json says it"),
+    Field("self_reported", "boolean", False, "as config.json says it"),
+)
+EVALS = (
+    Field("step", "integer in [0, steps]", True, "the transitions at the evaluation"),
+    Field("success", "number in [0, 1]", True, "the share of its greedy episodes that completed the task"),
+    Field("return", "finite number", False, "their mean return"),
+    Field("episodes", "integer > 0", False, "how many episodes"),
+    Field("length", "finite number", False, "their mean length in decisions"),
+)
+EPISODES = (
+    Field("step", "integer in [0, steps]", True, "the transitions when the training episode ended"),
+    Field("return", "finite number", True, "its return"),
+    Field("length", "integer > 0", True, "its decisions"),
+    Field("success", "0 or 1", True, "whether it completed the task"),
+    Field("seen", "integer >= 0 or empty", False, "the propositions that held at some step, as bits (bit i: the "
+          "automaton's i-th proposition); empty in rows written before the column"),
+    Field("states", "integer >= 0 or empty", False, "the automaton states it visited, as bits (bit q: state q)"),
+)
+FILES = {"config.json": CONFIG, "result.json": RESULT, "evals.csv": EVALS, "episodes.csv": EPISODES}
+
+
+class RecordError(ValueError):
+    """A record that breaks the format: its message names the file, the field and the problem."""
+
+
+def _int(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def check_config(config: dict, path) -> None:
+    """``config.json``'s required fields, and the types of those a reader uses."""
+    missing = [f.name for f in CONFIG if f.required and f.name not in config]
+    if missing:
+        raise RecordError(f"{path}: lacks {', '.join(missing)} (the record format: docs/records.md)")
+    for name in ("task", "world", "method"):
+        if not isinstance(config[name], str) or not config[name]:
+            raise RecordError(f"{path}: {name} must be a non-empty string, got {config[name]!r}")
+    if not _int(config["seed"]) or config["seed"] < 0:
+        raise RecordError(f"{path}: seed must be an integer >= 0, got {config['seed']!r}")
+    if not _int(config["steps"]) or config["steps"] <= 0:
+        raise RecordError(f"{path}: steps (the budget in transitions) must be an integer > 0, got {config['steps']!r}")
+
+
+def check_result(result: dict, config: dict, path) -> None:
+    """``result.json`` of a finished student: its transitions at least the budget, and its
+    run the run ``config.json`` names."""
+    if not _int(result.get("steps")):
+        raise RecordError(f"{path}: steps (the transitions collected) must be an integer, got {result.get('steps')!r}")
+    if result["steps"] < config["steps"]:
+        raise RecordError(f"{path}: steps {result['steps']:,} is short of the budget in config.json "
+                          f"({config['steps']:,}): a finished run collects its budget")
+    if "updates" in result and result["updates"] is not None and (not _int(result["updates"]) or result["updates"] < 0):
+        raise RecordError(f"{path}: updates must be an integer >= 0, got {result['updates']!r}")
+    for name in ("task", "seed", "method"):
+        if name in result and result[name] != config[name]:
+            raise RecordError(f"{path}: {name} {result[name]!r} is not config.json's ({config[name]!r}): the result "
+                              "of another run")
+
+
+def check_evals(rows: list[dict], steps: int, path) -> None:
+    """``evals.csv``'s rows (as read: strings): steps within the run, success a rate, the
+    means finite."""
+    for line, row in enumerate(rows, start=2):
+        step = _number(row, "step", path, line)
+        if step != int(step) or not 0 <= step <= steps:
+            raise RecordError(f"{path}: line {line}: step {row['step']} is not a step of the run (0 to {steps:,} "
+                              "transitions)")
+        success = _number(row, "success", path, line)
+        if not 0 <= success <= 1:
+            raise RecordError(f"{path}: line {line}: success {row['success']} is not a rate in [0, 1]")
+        for name in ("return", "length"):
+            if row.get(name) not in (None, ""):
+                _number(row, name, path, line)
+
+
+def check_episodes(rows: list[dict], steps: int, path) -> None:
+    """``episodes.csv``'s rows (as read: strings): steps within the run, returns finite."""
+    for line, row in enumerate(rows, start=2):
+        step = _number(row, "step", path, line)
+        if not 0 <= step <= steps:
+            raise RecordError(f"{path}: line {line}: step {row['step']} is not a step of the run (0 to {steps:,} "
+                              "transitions)")
+        _number(row, "return", path, line)
+
+
+def _number(row: dict, name: str, path, line: int) -> float:
+    try:
+        value = float(row[name])
+    except (KeyError, TypeError, ValueError):
+        raise RecordError(f"{path}: line {line}: {name} {row.get(name)!r} is not a number") from None
+    if not math.isfinite(value):
+        raise RecordError(f"{path}: line {line}: {name} is {row[name]}: a record holds finite numbers")
+    return value
+
+
+def markdown() -> str:
+    """The format as a docs page (``docs/records.md``)."""
+    from .runs import FORMAT
+
+    lines = ["# Run records", "",
+             "<!-- generated by `craftsuite records --markdown docs/records.md`; do not edit -->", "",
+             f"A run is a directory of four files, at record format {FORMAT}. CraftSuite's trainers write them, and "
+             "`craftsuite.Recorder` writes them for a run trained elsewhere (marked `self_reported`); "
+             "`craftsuite leaderboard` reads any directory of them and refuses a record that breaks this format, "
+             "naming the file, the field and the problem. The archive keeps `episodes.csv` gzipped "
+             "(`episodes.csv.gz`). A run directory's name is `student-<task>-<world>-<method>-s<seed>-<key>`, the key "
+             "a hash of its settings: two runs of equal settings are one run.", ""]
+    for name, fields in FILES.items():
+        kind = "columns" if name.endswith(".csv") else "fields"
+        lines += [f"## `{name}`", "", f"| {kind[:-1]} | takes | required | meaning |", "|---|---|---|---|"]
+        lines += [f"| `{f.name}` | {f.kind} | {'yes' if f.required else ''} | {f.meaning} |" for f in fields]
+        lines.append("")
+    lines += ["Format 3 made kinematic success mean completion (format 2 counted the automaton's acceptance: "
+              "`craftsuite archive` re-reads such records). `seen` and `states` came within format 3; rows "
+              "written before them leave them empty.", ""]
+    return "\n".join(lines)
+
+
+def write_markdown(path) -> Path:
+    from .files import atomic_write
+
+    path = Path(path)
+    atomic_write(path, markdown())
+    return path

@@ -1,0 +1,52 @@
+"""The record format is data: its docs page is generated from it and current, and the
+checks every reader makes name the file, the line and the field they refuse."""
+
+from pathlib import Path
+
+import pytest
+
+from craftsuite.cli import main
+from craftsuite.record_format import (FILES, RecordError, check_config, check_episodes, check_evals, check_result,
+                                      markdown)
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_the_docs_page_is_the_format_as_it_is():
+    assert (ROOT / "docs" / "records.md").read_text() == markdown()
+    for name, fields in FILES.items():
+        assert f"## `{name}`" in markdown() and all(f"| `{f.name}` |" in markdown() for f in fields)
+
+
+def test_the_command_writes_the_page(tmp_path, capsys):
+    assert main(["records", "--markdown", str(tmp_path / "records.md")]) == 0
+    assert (tmp_path / "records.md").read_text() == markdown()
+    assert main(["records", "--markdown", str(tmp_path)]) == 2  # a directory: named, with the file to give
+    assert "records.md" in capsys.readouterr().err
+
+
+CONFIG = {"task": "Reach", "world": "Cont", "method": "my-sac", "seed": 0, "steps": 1000}
+
+
+@pytest.mark.parametrize("check, message", [
+    (lambda: check_config({**CONFIG, "steps": None}, "c.json"), "c.json: steps .* must be an integer > 0"),
+    (lambda: check_config({k: v for k, v in CONFIG.items() if k != "world"}, "c.json"), "c.json: lacks world"),
+    (lambda: check_config({**CONFIG, "seed": -1}, "c.json"), "seed must be an integer >= 0, got -1"),
+    (lambda: check_result({"kind": "student", "steps": 999}, CONFIG, "r.json"), "steps 999 is short of the budget"),
+    (lambda: check_result({"kind": "student", "steps": 1000, "updates": -2}, CONFIG, "r.json"), "updates must be"),
+    (lambda: check_result({"kind": "student", "steps": 1000, "seed": 4}, CONFIG, "r.json"),
+     "seed 4 is not config.json's \\(0\\): the result of another run"),
+    (lambda: check_evals([{"step": "1000", "success": "inf"}], 1000, "e.csv"), "e.csv: line 2: success is inf"),
+    (lambda: check_evals([{"step": "500.5", "success": "1"}], 1000, "e.csv"), "step 500.5 is not a step of the run"),
+    (lambda: check_episodes([{"step": "10", "return": ""}], 1000, "p.csv"), "p.csv: line 2: return '' is not a"),
+])
+def test_a_record_that_breaks_the_format_is_named(check, message):
+    with pytest.raises(RecordError, match=message):
+        check()
+
+
+def test_a_good_record_passes():
+    check_config(CONFIG, "c.json")
+    check_result({"kind": "student", "steps": 1010, "updates": 3, "task": "Reach"}, CONFIG, "r.json")
+    check_evals([{"step": "1000", "success": "0.5", "return": "1.5", "length": ""}], 1010, "e.csv")
+    check_episodes([{"step": "10", "return": "-3.0"}], 1010, "p.csv")

@@ -69,8 +69,11 @@ class RecordedConfig:
 
 
 def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "standard", library: str = "",
-                    settings: dict | None = None, commit: str | None = None) -> RecordedConfig:
-    """The record of a run of ``method`` on ``env_id`` under ``suite``'s protocol.
+                    settings: dict | None = None, commit: str | None = None,
+                    steps: int | None = None) -> RecordedConfig:
+    """The record of a run of ``method`` on ``env_id`` under ``suite``'s protocol
+    (``steps``: another budget than the suite's for the rung, evaluated on the suite's
+    schedule for it; the leaderboard never compares it with runs of another budget).
 
     Raises:
         ValueError: a method named as one of CraftSuite's (its runs would pool with the
@@ -86,9 +89,17 @@ def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "stand
                          "so that its runs never pool with the archive's")
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+    from .suites import SUITES
+
     suite_config, _ = protocol(env_id, suite)
+    if steps is not None:
+        if not isinstance(steps, int) or isinstance(steps, bool) or steps < 1:
+            raise ValueError(f"steps (the budget in transitions) must be a positive integer, got {steps!r}")
+        eval_every = SUITES[suite].eval_interval(steps, suite_config.world)
+    else:
+        steps, eval_every = suite_config.steps, suite_config.eval_every
     return RecordedConfig(task=suite_config.task, method=method, world=suite_config.world, seed=seed,
-                          steps=suite_config.steps, eval_every=suite_config.eval_every,
+                          steps=steps, eval_every=eval_every,
                           eval_episodes=suite_config.eval_episodes, suite=suite, library=library,
                           settings=dict(settings or {}), commit=commit, layout_seed=suite_config.layout_seed,
                           world_kwargs=dict(suite_config.world_kwargs))
@@ -100,11 +111,11 @@ class Recorder(gym.Wrapper):
 
     def __init__(self, env_id: str, out, *, method: str, seed: int = 0, suite: str = "standard",
                  library: str = "", settings: dict | None = None, commit: str | None = None,
-                 product: bool = False):
+                 product: bool = False, steps: int | None = None):
         from .reached import Reached
         from .task_registry import resolve_task
 
-        self.config = recorded_config(env_id, method, seed, suite, library, settings, commit)
+        self.config = recorded_config(env_id, method, seed, suite, library, settings, commit, steps)
         self.path = Path(out) / self.config.run_name()
         if self.path.exists():  # a recording is one session: a second would mix two runs' logs
             state = "finished" if (self.path / "result.json").exists() else "unfinished"

@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 HERE = Path(__file__).parent
-SLOW = {"transfer.ipynb"}  # trains a transfer suite end to end: the longest test of all
+SLOW = {"transfer.ipynb", "your_agent.ipynb"}  # train end to end: transfer.ipynb the longest test of all
 
 
 @pytest.hookimpl(tryfirst=True)  # before ``-m`` deselects by marker

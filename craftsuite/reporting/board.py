@@ -492,6 +492,12 @@ def aggregates(entries) -> list[Aggregate]:
         mine = [e for e in entries if e.world_label == label and (e.regime == regime or e.self_reported)]
         world, world_kwargs = mine[0].world, mine[0].world_kwargs
         left_out = []
+        # a self-reported run at another budget than the task's own runs is shown, never pooled with them
+        budgets = {e.task: e.budget for e in mine if not e.self_reported}
+        apart = sorted({e.method for e in mine if e.self_reported and budgets.get(e.task, e.budget) != e.budget})
+        if apart:
+            left_out.append(f"{', '.join(apart)}: another budget than the other methods'")
+            mine = [e for e in mine if e.method not in apart]
         variants = sorted({e.method for e in mine if e.variant})
         if variants:
             left_out.append(f"{', '.join(variants)}: runs of more than one setting")

@@ -135,11 +135,14 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
         rows = ranked([e for e in entries if (e.task, e.world_label) == (task, world)])
         lines += [f"{h} {task} ({world})", "", *task_table(rows)]
         pairs = distilled_against_scratch(rows, self_reported=True)
-        if pairs:
+        # the target reads transitions: a self-reported run at another budget is not set against it
+        same = [(e, base) for e, base in pairs if not e.self_reported or e.budget == base.budget]
+        if same:
             lines += ["", f"Transfer target (80% greedy success in at most half the transitions "
-                      f"`{pairs[0][1].method}` needs; median over seeds, a seed that never reached 80% counting "
+                      f"`{same[0][1].method}` needs; median over seeds, a seed that never reached 80% counting "
                       "as never): " + "; ".join(f"`{e.label}` {verdict(e, base, 'steps_to_80')}"
-                                                 for e, base in pairs) + "."]
+                                                 for e, base in same) + "."]
+        if pairs:
             lines += ["", "Against scratch, final greedy success (the difference of the means with Welch's "
                       "95% t-interval; the probability that a run beats a scratch run, with its bootstrap interval): "
                       + "; ".join(_comparison_text(e, base) for e, base in pairs) + "."]

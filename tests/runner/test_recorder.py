@@ -86,6 +86,13 @@ def test_finishing_before_the_budget_is_refused_and_a_second_recording_too(tmp_p
         craftsuite.Recorder(ENV, tmp_path, method="my-short")
 
 
+def test_another_budget_keeps_the_suites_schedule_for_it():
+    config = recorded_config("CraftSuite/ToolHome-Cont-v0", "my-sac", steps=4_000)
+    assert (config.steps, config.eval_every) == (4_000, SUITES["standard"].eval_interval(4_000, "Cont"))
+    with pytest.raises(ValueError, match="steps .* must be a positive integer, got 0"):
+        recorded_config("CraftSuite/ToolHome-Cont-v0", "my-sac", steps=0)
+
+
 def test_the_record_is_the_suites_protocol_for_the_rung():
     config = recorded_config("CraftSuite/ToolHome-Cont-v0", "my-sac", seed=1)
     suite = SUITES["standard"]
@@ -112,6 +119,7 @@ def test_the_leaderboard_sets_self_reported_runs_beside_every_regimes_own(tmp_pa
         assert "| my-sac *(self-reported)* | 3 | 1.00" in part
         assert "`my-long` not compared: 2,000 transitions against 1,000" in part
     assert "`my-sac` +1.00 [+1.00, +1.00], P(> `td3`) 1.00" in one_step
+    assert "Not in this aggregate: my-long: another budget than the other methods'" in one_step
     assert "`my-sac` +0.50 [+0.50, +0.50], P(> `td3`) 1.00" in n_step
     rows = read_csv(out / "seeds.csv")
     assert {(r["method"], r["regime"], r["self_reported"]) for r in rows} == {

@@ -71,7 +71,26 @@ def check_record(run: Path, kind: str | None = None) -> str | None:
     if other:
         return (f"{result} is another run's result ({', '.join(f'{f} {outcome[f]!r}' for f in other)}, where "
                 f"config.json records {', '.join(repr(record[f]) for f in other)}): a record from elsewhere")
-    return _check_evals(run / "evals.csv") or _check_success(run, record)
+    return _check_evals(run / "evals.csv") or _check_format(run, record, outcome) or _check_success(run, record)
+
+
+def _check_format(run: Path, record: dict, outcome: dict) -> str | None:
+    """Why a student's record breaks the record format (``craftsuite.record_format``; None:
+    it keeps it). A teacher's result follows its own rules: it stops at its target."""
+    from .record_format import RecordError, check_config, check_episodes, check_evals, check_result
+
+    if outcome.get("kind") != "student":
+        return None
+    try:
+        check_config(record, run / "config.json")
+        check_result(outcome, record, run / "result.json")
+        check_evals(read_csv(run / "evals.csv"), outcome["steps"], run / "evals.csv")
+        check_episodes(read_csv(run / "episodes.csv"), outcome["steps"], run / "episodes.csv")
+    except RecordError as err:
+        return f"{err}: the record breaks the record format (docs/records.md)"
+    except (ValueError, OSError, EOFError) as err:
+        return f"{run / 'episodes.csv'} does not read as a run's log ({err}): the record is damaged"
+    return None
 
 
 def _check_success(run: Path, record: dict) -> str | None:

@@ -196,3 +196,19 @@ def test_a_run_given_for_its_directory_names_the_directory(tmp_path, capsys):
     assert f"{run} is a run, not a directory of runs: give the directory that holds it ({run.parent})" in (
         capsys.readouterr().err)
     assert not (tmp_path / "results").exists()
+
+
+@pytest.mark.parametrize("file, text, problem", [
+    ("evals.csv", "step,success,return,episodes\n1000,0.5,nan,4\n", "evals.csv: line 2: return is nan"),
+    ("evals.csv", "step,success,return,episodes\n9000,0.5,1.0,4\n", "step 9000 is not a step of the run"),
+    ("result.json", json.dumps({"kind": "student", "steps": 10}), "steps 10 is short of the budget"),
+    ("result.json", json.dumps({"kind": "student", "steps": 1000, "task": "DungeonQuest"}), "another run's result"),
+])
+def test_a_record_that_breaks_the_format_is_named_and_not_archived(tmp_path, capsys, file, text, problem):
+    source = tmp_path / "out"
+    run = _run(source / "students")
+    (run / file).write_text(text)
+    assert _archive(tmp_path, source) == 2
+    out = capsys.readouterr().out
+    assert problem in out and str(run) in out
+    assert not (tmp_path / "results").exists()

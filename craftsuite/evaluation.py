@@ -76,15 +76,24 @@ def evaluate(policy, env: str, *, suite: str = "standard", step: int | None = No
     kwargs = config.env_kwargs
     if product is None:
         product = _sees_automaton(policy, config.env_id, kwargs)
-    envs = [gym.make(config.env_id, product=product, **kwargs) for _ in range(n)]
-    try:
-        act = _batched(policy, envs[0].action_space)
-        played = rollout(envs, act, n, eval_seed(step))
-    finally:
-        for e in envs:
-            e.close()
+    played = play(lambda space: _batched(policy, space), config.env_id, kwargs, product, n, eval_seed(step))
     return Evaluation(float(np.mean([e.success for e in played])), float(np.mean([e.total_reward for e in played])),
                       float(np.mean([e.length for e in played])), tuple(played), config.env_id, kwargs, step)
+
+
+def play(policy_for, env_id: str, env_kwargs: dict, product: bool, episodes: int, seed: int,
+         on_step=None) -> list[Episode]:
+    """The greedy episodes of an evaluation, the one loop every evaluation of a single policy
+    runs (the population engine steps its members' together, on the same seeds): ``episodes``
+    fresh envs played side by side on reset seeds ``seed``, ``seed + 1``, ..., so that the
+    policy sees one batch per decision. ``policy_for(action_space)`` gives the batch policy;
+    ``on_step(episode, reward, info)`` sees every step."""
+    envs = [gym.make(env_id, product=product, **env_kwargs) for _ in range(episodes)]
+    try:
+        return rollout(envs, policy_for(envs[0].action_space), episodes, seed, on_step=on_step)
+    finally:
+        for env in envs:
+            env.close()
 
 
 def _sees_automaton(policy, env_id: str, kwargs: dict) -> bool:

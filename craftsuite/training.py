@@ -18,7 +18,6 @@ import time
 from pathlib import Path
 from typing import NamedTuple
 
-import gymnasium as gym
 import numpy as np
 import torch
 from stable_baselines3.common.callbacks import BaseCallback
@@ -41,15 +40,10 @@ def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kw
     batch per step (an untrained policy that never finishes costs one batched call per
     decision of the episode limit, not ``episodes`` times as many). ``on_step(episode,
     reward, info)``, if given, sees every step (for measures beyond an ``Evaluation``'s)."""
-    from .episodes import rollout
+    from .evaluation import play
 
-    envs = [gym.make(env_id, product=product, **(env_kwargs or {})) for _ in range(episodes)]
-    try:
-        played = rollout(envs, lambda obs: agent.predict(obs, deterministic=True)[0], episodes, seed,
-                         on_step=on_step)
-    finally:
-        for env in envs:
-            env.close()
+    played = play(lambda _: lambda obs: agent.predict(obs, deterministic=True)[0], env_id, env_kwargs or {},
+                  product, episodes, seed, on_step)
     returns = np.array([e.total_reward for e in played])
     lengths = np.array([e.length for e in played], dtype=float)
     wins = np.array([e.success for e in played])

@@ -35,7 +35,7 @@ import numpy as np
 
 from .completion import needs_reread, reread_in_place, reread_logs
 from .files import atomic_path, atomic_write
-from .runs import RunError, in_use, read_config, read_csv, record_key
+from .runs import RunError, in_use, read_config, read_csv, read_result, record_key
 
 RECORDS = ("config.json", "result.json", "evals.csv", "table.npz")  # kept as they are (table.npz: teachers)
 COMPRESSED = ("episodes.csv",)  # kept as <name>.gz
@@ -251,10 +251,10 @@ def _same(run: Path, archived_run: Path) -> bool:
     if not theirs.exists():
         return False
     try:
-        mine, held = (json.loads((p / "result.json").read_text()) for p in (run, archived_run))
-        return (isinstance(mine, dict) and isinstance(held, dict) and _unmarked(mine) == _unmarked(held)
+        mine, held = read_result(run), read_result(archived_run)
+        return (_unmarked(mine) == _unmarked(held)
                 and not needs_reread(read_config(archived_run)))
-    except (ValueError, RunError):  # unreadable there: keeping it again is what mends it
+    except RunError:  # unreadable there: keeping it again is what mends it
         return False
 
 

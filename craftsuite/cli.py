@@ -295,9 +295,11 @@ def _distill(args) -> int:
 
 
 def _student(args) -> int:
-    from .methods import METHODS
+    from .methods import METHODS, resolve_method
     from .configs import StudentConfig
     from .training import train_student
+
+    args.method = resolve_method(args.method)  # a row of the user's own (module:name): its module registers it
 
     config = StudentConfig(task=args.task, method=args.method, world=args.world, seed=args.seed, steps=args.steps,
                            table=str(Path(args.table).resolve()) if args.table else None, eval_every=args.eval_every,
@@ -317,6 +319,7 @@ def _transfer(args) -> int:
     import dataclasses
 
     from .ids import CONT, KINEMATIC, world_kind
+    from .methods import resolve_method
     from .provenance import command_line
     from .suite_runner import transfer
     from .suites import SUITES
@@ -328,7 +331,8 @@ def _transfer(args) -> int:
         suite = dataclasses.replace(suite, tags=tuple(args.tags or ()), tasks=tuple(map(_task, args.tasks or ())))
     changes = {k: v for k, v in (("worlds", tuple(args.worlds) if args.worlds else None), ("seeds", args.seeds),
                                  ("student_steps", args.steps),
-                                 ("methods", tuple(args.methods) if args.methods else None),
+                                 # a row of the user's own (module:name) is registered by its module's import
+                                 ("methods", tuple(map(resolve_method, args.methods)) if args.methods else None),
                                  ("teacher_max_steps", args.teacher_steps), ("eval_every", args.eval_every))
                if v is not None}
     worlds = list(changes.get("worlds", suite.worlds))
@@ -449,16 +453,6 @@ def _leaderboard(args) -> int:
     print(path.read_text())
     print(f"wrote {path}, {out / 'leaderboard.csv'}, {out / 'seeds.csv'}" + "".join(f", {p}" for p in plots))
     return 0
-
-
-def _method(text: str) -> str:
-    """A method's name, or ``module:name`` (the module registers the row: ``methods.resolve_method``)."""
-    from .methods import resolve_method
-
-    try:
-        return resolve_method(text)
-    except (KeyError, ValueError) as err:
-        raise argparse.ArgumentTypeError(err.args[0]) from None
 
 
 def _positive(text: str) -> int:
@@ -588,7 +582,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("student", help="train one student or baseline run (any method, one seed)")
     p.add_argument("task", help=task_help)
-    p.add_argument("--method", default="td3-dynamic", type=_method, metavar="METHOD",
+    p.add_argument("--method", default="td3-dynamic", metavar="METHOD",
                    help=f"one of {methods} (craftsuite.methods.METHODS; default: td3-dynamic), or module:name, a "
                    "row the module registers (craftsuite.methods.register_method)")
     p.add_argument("--world", default="Cont", type=_world,
@@ -623,7 +617,7 @@ def build_parser() -> argparse.ArgumentParser:
                    f"each {task_help}")
     p.add_argument("--worlds", nargs="+", choices=_known_worlds(),
                    help="override the student worlds (Cont, Kinematic: TD3 methods; Grid10, Grid7: DQN methods)")
-    p.add_argument("--methods", nargs="+", metavar="METHOD", type=_method,
+    p.add_argument("--methods", nargs="+", metavar="METHOD",
                    help=f"override the suite's methods: any of {methods}, or module:name (a row of your own)")
     p.add_argument("--seeds", type=_positive, help="override the number of seeds")
     p.add_argument("--steps", type=_positive, help="one student budget for every rung (transitions)")

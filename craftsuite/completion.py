@@ -24,7 +24,8 @@ import json
 from pathlib import Path
 
 from .files import atomic_write
-from .runs import EPISODE_CORE, EVAL_FIELDS, FORMAT, RunError, counts_acceptance, csv_text, read_config, read_log
+from .runs import (EPISODE_CORE, EVAL_FIELDS, FORMAT, RunError, counts_acceptance, csv_text, read_config, read_log,
+                   read_result)
 
 REREAD = ("success re-read as completion from a record that counted the automaton's acceptance: "
           "a training episode completed if accepted and ended before its time limit")
@@ -107,7 +108,7 @@ def reread_in_place(run: Path) -> bool:
                                                            compresslevel=9, mtime=0))
     atomic_write(run / "evals.csv", csv_text(EVAL_FIELDS, evals))
     atomic_write(run / "config.json", json.dumps({**config, "format": FORMAT}, indent=2, sort_keys=True) + "\n")
-    result = json.loads((run / "result.json").read_text())
+    result = read_result(run)
     atomic_write(run / "result.json", json.dumps({**result, "success_reread": REREAD}, indent=2) + "\n")
     return True
 

@@ -86,7 +86,7 @@ def check_config(config: dict, path) -> None:
     """``config.json``'s required fields, and the types of those a reader uses."""
     missing = [f.name for f in CONFIG if f.required and f.name not in config]
     if missing:
-        raise RecordError(f"{path}: lacks {', '.join(missing)} (the record format: docs/records.md)")
+        raise RecordError(f"{path}: lacks {', '.join(missing)}")
     for name in ("task", "world", "method"):
         if not isinstance(config[name], str) or not config[name]:
             raise RecordError(f"{path}: {name} must be a non-empty string, got {config[name]!r}")

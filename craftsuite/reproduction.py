@@ -20,6 +20,7 @@ import numpy as np
 from .files import atomic_path, atomic_write
 from .ids import CONT, KINEMATIC
 from .reporting.board import world_label
+from .runs import RunError, read_result
 
 MIN_SEEDS_FOR_CLAIM = 5  # what a panel needs before its verdict is a claim
 
@@ -212,7 +213,7 @@ def _what_ran(runs) -> list[str]:
                                                   + " gradient updates" for b, u in budgets)
                  + "; the paper's: 2M steps of 10 envs, i.e. 20M transitions and 2M updates, 20 seeds.")
     for teacher in sorted((run_dir / "teachers").glob("teacher-*/result.json")):
-        r = json.loads(teacher.read_text())
+        r = read_result(teacher.parent)
         lines.append(f"- Teacher `{teacher.parent.name}`: {r['steps']:,} transitions, {r.get('updates', 0):,} "
                      f"updates, greedy success {r['success']:.2f} "
                      f"({'reached' if r['reached_target'] else 'did not reach'} its target)")
@@ -227,8 +228,8 @@ def reread_note(students: Path) -> list[str]:
     reread = 0
     for path in sorted(students.glob("*/result.json")):
         try:
-            reread += "success_reread" in json.loads(path.read_text())
-        except ValueError:  # a damaged result: the board names it among the runs not read
+            reread += "success_reread" in read_result(path.parent)
+        except RunError:  # a damaged result: the board names it among the runs not read
             continue
     if not reread:
         return []

@@ -150,6 +150,26 @@ def read_config(run) -> dict:
     return data
 
 
+def read_result(run) -> dict:
+    """A finished run's ``result.json`` (a student's or a teacher's), the one reader of it.
+
+    Raises:
+        RunError: missing, not JSON, or not a run's result, naming the file.
+    """
+    path = Path(run) / "result.json"
+    try:
+        result = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise RunError(f"{path} is missing: the run is not finished") from None
+    except (ValueError, OSError) as err:
+        raise RunError(f"{path} is not valid JSON ({err}): the run's result is damaged") from None
+    if not isinstance(result, dict) or result.get("kind") not in ("student", "teacher"):
+        raise RunError(f"{path} holds no student's or teacher's result (no kind): the run's result is damaged")
+    if result["kind"] == "student" and not isinstance(result.get("steps"), int):
+        raise RunError(f"{path} holds no transitions (steps): the run's result is damaged")
+    return result
+
+
 def config_from(cls, record: dict):
     """The config dataclass (``cls``) of a ``config.json`` record of any layout: its fields
     (the effective settings and the provenance are left out; a field a record predates

@@ -30,6 +30,7 @@ from .files import atomic_write
 from .ids import file_stem
 from .methods import METHODS, methods_for
 from .progress import progress_bar
+from .runs import read_result
 from .suites import Suite
 from .task_registry import carried, resolve_task
 from .worker_pool import WorkerPool
@@ -154,7 +155,7 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                 for future in [f for f in pending if f.done()]:
                     task = pending.pop(future)
                     path = Path(future.result())  # re-raises a teacher's error
-                    result = json.loads((path / "result.json").read_text())
+                    result = read_result(path)
                     reached = "reached" if result["reached_target"] else "did NOT reach"
                     (bar.write if progress else log)(
                         f"teacher {task}: {result['steps']:,} steps, greedy success {result['success']:.2f} "
@@ -441,7 +442,7 @@ def _best_student_video(students: list[Path], out: Path, log=print) -> Path | No
     if best is None:
         return None
     run = best[0]
-    r = json.loads((run / "result.json").read_text())
+    r = read_result(run)
     if not (run / r["model"]).exists():
         log(f"no video: the best student, {run.name}, has its records but not its model (restored from the "
             "results archive, which keeps no models)")

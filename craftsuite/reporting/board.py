@@ -41,7 +41,7 @@ import numpy as np
 from .. import stats
 from ..completion import needs_reread
 from ..record_format import RecordError, check_config, check_episodes, check_evals, check_result
-from ..runs import RunError, flatten, read_config, read_log, run_settings
+from ..runs import RunError, flatten, read_config, read_log, read_result, run_settings
 
 # metrics with a mean and an interval per task and method; a rate lies in [0, 1]
 METRICS = {"success": (0.0, 1.0), "return": (-math.inf, math.inf), "train_success": (0.0, 1.0),
@@ -84,24 +84,6 @@ def world_label(world: str, kwargs: dict) -> str:
     return f"{world}: " + ", ".join(f"{k}={json.dumps(v)}" for k, v in sorted(kwargs.items()))
 
 
-def _result(run: Path) -> dict:
-    """A run's ``result.json``.
-
-    Raises:
-        RunError: not JSON, or not a run's result, naming the file.
-    """
-    path = run / "result.json"
-    try:
-        result = json.loads(path.read_text())
-    except ValueError as err:
-        raise RunError(f"{path} is not valid JSON ({err}): the run's result is damaged") from None
-    if not isinstance(result, dict) or result.get("kind") not in ("student", "teacher"):
-        raise RunError(f"{path} holds no student's or teacher's result (no kind): the run's result is damaged")
-    if result["kind"] == "student" and not isinstance(result.get("steps"), int):
-        raise RunError(f"{path} holds no transitions (steps): the run's result is damaged")
-    return result
-
-
 def run_metrics(run: Path) -> dict | None:
     """The metrics of one finished student run directory (None: a teacher's, or not finished).
 
@@ -112,7 +94,7 @@ def run_metrics(run: Path) -> dict | None:
     if not (run / "result.json").exists():
         return None
     config = read_config(run)
-    result = _result(run)
+    result = read_result(run)
     if result["kind"] != "student":
         return None  # a teacher run
     if needs_reread(config):  # its logs say another thing than success: the archive reads them again
@@ -129,7 +111,7 @@ def run_metrics(run: Path) -> dict | None:
         check_evals(raw_evals, result["steps"], run / "evals.csv")
         check_episodes(raw_episodes, result["steps"], run / "episodes.csv")
     except RecordError as err:
-        raise RunError(str(err)) from None
+        raise RunError(f"{err}: the record breaks the record format (docs/records.md)") from None
     budget = int(config["steps"])
     # (step, return, won) per training episode; (step, greedy success, mean length) per evaluation
     episodes = [(int(e["step"]), float(e["return"]), int(e["success"])) for e in raw_episodes]

@@ -15,6 +15,7 @@ from .. import stats
 from ..files import atomic_write
 from ..ids import CONT, world_kind
 from ..regimes import describe
+from ..runs import RunError, read_config, read_result
 from ..archive import size as archive_size
 from .board import (
     METRICS,
@@ -181,7 +182,6 @@ def obstacles_markdown(rows: list[Entry]) -> list[str]:
     ``THRESHOLD`` for every row), what each method's training episodes reached
     (``craftsuite.reporting.obstacles``): completions per 100k transitions, the visited
     automaton state closest to acceptance, and the share of episodes each proposition held in."""
-    from ..runs import RunError
     from .obstacles import completed_per_100k, method_progress
 
     if not rows or any(_finite_mean(e.values["success"]) >= THRESHOLD for e in rows):
@@ -420,14 +420,14 @@ def teachers_markdown(root: Path) -> list[str]:
     rows, problems = [], []
     for run in sorted(root.glob("teacher-*")) if root.is_dir() else []:
         try:
-            config = json.loads((run / "config.json").read_text())
-            result = json.loads((run / "result.json").read_text())
+            config = read_config(run)
+            result = read_result(run)
             seed = config.get("layout_seed")
             layout = "new every episode" if seed is None else f"fixed ({seed})"
             rows.append((rung_order(config["task"]), f"| {config['task']} | `{result['env_id']}` | {layout} "
                          f"| {result['steps']:,} / {result['updates']:,} | {result['success']:.2f} "
                          f"| {'yes' if result['reached_target'] else 'no'} ({config['target_success']:.0%}) |"))
-        except (OSError, ValueError, KeyError, TypeError) as err:
+        except (RunError, OSError, ValueError, KeyError, TypeError) as err:
             problems.append(f"- not read: {run} ({type(err).__name__}: {err})")
     if not rows and not problems:
         return []

@@ -109,14 +109,15 @@ def test_a_results_page_lists_its_teachers_and_names_a_damaged_one(tmp_path):
     good = tmp_path / "teachers" / "teacher-GoldMine-Grid7-s0-abc"
     good.mkdir(parents=True)
     (good / "config.json").write_text(json.dumps({"task": "GoldMine", "layout_seed": 0, "target_success": 0.9}))
-    (good / "result.json").write_text(json.dumps({"env_id": "CraftSuite/GoldMine-Grid7-v0", "steps": 55000,
-                                                 "updates": 53999, "success": 1.0, "reached_target": True}))
+    (good / "result.json").write_text(json.dumps({"kind": "teacher", "env_id": "CraftSuite/GoldMine-Grid7-v0",
+                                                 "steps": 55000, "updates": 53999, "success": 1.0,
+                                                 "reached_target": True}))
     torn = tmp_path / "teachers" / "teacher-Reach-Grid7-s0-def"
     torn.mkdir()
     (torn / "config.json").write_text("{torn")
     text = "\n".join(teachers_markdown(tmp_path / "teachers"))
     assert "| GoldMine | `CraftSuite/GoldMine-Grid7-v0` | fixed (0) | 55,000 / 53,999 | 1.00 | yes (90%) |" in text
-    assert f"- not read: {torn} (JSONDecodeError" in text
+    assert f"- not read: {torn} (RunError: {torn / 'config.json'} is not valid JSON" in text
     assert teachers_markdown(tmp_path / "nowhere") == []
 
 

@@ -72,7 +72,8 @@ def test_a_record_that_counted_acceptance_is_re_read_as_completion():
 
 
 def _old_kinematic_run(root, name="student-BlindCraftsman-Kinematic-td3-s0"):
-    config = {**record(), "method": "td3", "seed": 0, "steps": 2000, "provenance": [{"commit": "abc"}]}
+    config = {**record(), "world": "Kinematic", "method": "td3", "seed": 0, "steps": 2000,
+              "provenance": [{"commit": "abc"}]}
     run = root / f"{name}-{record_key(config)}"
     run.mkdir(parents=True)
     (run / "config.json").write_text(json.dumps(config))

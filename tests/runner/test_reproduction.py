@@ -36,8 +36,8 @@ def transfer_dir(tmp_path):
                                                 "students_see_automaton": False}))
     teacher = out / "teachers" / "teacher-DungeonQuest-Grid7-s0-abc"
     teacher.mkdir(parents=True)
-    (teacher / "result.json").write_text(json.dumps({"steps": 100_000, "updates": 9_900, "success": 0.3,
-                                                     "reached_target": False}))
+    (teacher / "result.json").write_text(json.dumps({"kind": "teacher", "steps": 100_000, "updates": 9_900,
+                                                     "success": 0.3, "reached_target": False}))
     return out
 
 

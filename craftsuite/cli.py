@@ -441,6 +441,8 @@ def _leaderboard(args) -> int:
         path = write_results_page(args.runs, args.page)
         print(f"wrote {path}")
         return 0
+    if len(args.runs) > 1 and not args.out:  # never written into one of them (an archive, maybe)
+        raise ValueError("several run directories are one leaderboard: give --out DIR for it")
     if args.out:
         directory_to_write(args.out, "--out")
     # several directories are one board: a user's runs beside the archive's, on the same rungs
@@ -658,7 +660,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("runs", nargs="+", help="a transfer output directory, or a directory of student runs; several "
                    "are one leaderboard (e.g. your runs from craftsuite.Recorder beside results/standard), or, with "
                    "--page, a section each")
-    p.add_argument("--out", help="where to write (default: the first RUNS)")
+    p.add_argument("--out", help="where to write (default: RUNS, if one)")
     p.add_argument("--page", metavar="PATH", help="write a results page (Markdown with provenance, tables, plots) "
                    "from the RUNS directories to PATH, e.g. docs/results.md")
     p.add_argument("--reproduction", metavar="PATH", help="write the paper's Figure 5 panels, each beside the "

@@ -51,7 +51,13 @@ def protocol(env: str, suite: str = "standard", step: int | None = None):
     if suite not in SUITES:
         raise ValueError(f"unknown suite {suite!r}; suites: {sorted(SUITES)}")
     task, world = parse_id(env)
-    config = SUITES[suite].student_config(resolve_task(task), world, scratch(world))
+    spec = resolve_task(task)
+    try:
+        config = SUITES[suite].student_config(spec, world, scratch(world))
+    except ValueError:  # no budget for its level: the rung is another suite's
+        theirs = [name for name, s in SUITES.items() if spec.name in {r.name for r in s.rungs()}]
+        raise ValueError(f"{task} is not a rung of the {suite!r} suite, whose protocol (budget, evaluations) an "
+                         f"evaluation follows: give suite= one of {theirs or sorted(SUITES)}") from None
     return config, config.steps if step is None else step
 
 
@@ -127,9 +133,14 @@ def _batched(policy, space):
         actions = act(batch)
         out = []
         for action in actions:
-            a = np.asarray(action, dtype=space.dtype)
+            if hasattr(action, "detach"):  # a torch tensor, maybe still in its graph
+                action = action.detach().cpu().numpy()
+            raw = np.asarray(action)
+            a = raw.astype(space.dtype)
             if isinstance(space, gym.spaces.Discrete):
                 a = a.reshape(()) if a.size == 1 else a
+                if raw.size != 1 or raw.reshape(()) != a:  # 2.7 is no move: never cast silently
+                    a = raw
             if not space.contains(a):
                 raise ValueError(f"the policy returned {np.asarray(action).tolist()!r}, outside the action space "
                                  f"{space}: return actions in it (clip a continuous output to its bounds)")
@@ -153,8 +164,16 @@ def _module_policy(module, space):
     device = next(module.parameters(), torch.empty(0)).device
 
     def act(batch):
-        with torch.no_grad():
-            out = module(torch.as_tensor(np.asarray(batch), dtype=torch.float32, device=device))
+        training = module.training
+        module.eval()  # evaluated as a policy is: no dropout, no batch statistics updated
+        try:
+            with torch.no_grad():
+                out = module(torch.as_tensor(np.asarray(batch), dtype=torch.float32, device=device))
+        finally:
+            module.train(training)
+        if not isinstance(out, torch.Tensor):
+            raise ValueError(f"the torch module returned {type(out).__name__}, not a tensor of actions or of "
+                             "values per action: give a module (or a callable) that returns one")
         out = out.cpu().numpy()
         if isinstance(space, gym.spaces.Discrete) and out.ndim == 2 and out.shape[1] == space.n:
             return out.argmax(axis=1)  # Q-values or logits: the greedy action

@@ -221,11 +221,18 @@ def load_entry_points() -> None:
     them (a package's rows then need no import on the command line)."""
     from importlib.metadata import entry_points
 
+    import warnings
+
     for point in entry_points(group=ENTRY_POINTS):
-        rows = point.load()
-        rows = rows() if callable(rows) and not isinstance(rows, Method) else rows
-        for row in [rows] if isinstance(rows, Method) else list(rows):
-            register_method(row)
+        try:
+            rows = point.load()
+            rows = rows() if callable(rows) and not isinstance(rows, Method) else rows
+            for row in [rows] if isinstance(rows, Method) else list(rows):
+                register_method(row)
+        except Exception as err:  # one package's broken rows never stop CraftSuite: named, and left out
+            package = getattr(point.dist, "name", None) or "an installed package"
+            warnings.warn(f"{package}'s craftsuite.methods entry point {point.value!r} was not loaded "
+                          f"({type(err).__name__}: {err})", stacklevel=2)
 
 
 def methods_for(world: str) -> list[str]:

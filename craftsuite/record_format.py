@@ -94,6 +94,9 @@ def check_config(config: dict, path) -> None:
         raise RecordError(f"{path}: seed must be an integer >= 0, got {config['seed']!r}")
     if not _int(config["steps"]) or config["steps"] <= 0:
         raise RecordError(f"{path}: steps (the budget in transitions) must be an integer > 0, got {config['steps']!r}")
+    for name in ("eval_every", "eval_episodes"):
+        if name in config and (not _int(config[name]) or config[name] <= 0):
+            raise RecordError(f"{path}: {name} must be an integer > 0, got {config[name]!r}")
 
 
 def check_result(result: dict, config: dict, path) -> None:

@@ -25,6 +25,7 @@ marked ``self_reported``: CraftSuite did not train them, and says so wherever it
 
 from __future__ import annotations
 
+import operator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -105,6 +106,9 @@ def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "stand
                           world_kwargs=dict(suite_config.world_kwargs))
 
 
+_RECORDING: set[Path] = set()  # the runs being recorded in this process
+
+
 class Recorder(gym.Wrapper):
     """The suite's env of a rung, recording a user's training run into ``out`` (see the
     module's docstring). The run's directory is ``out/<run name>``, as the suites' runs'."""
@@ -117,6 +121,9 @@ class Recorder(gym.Wrapper):
 
         self.config = recorded_config(env_id, method, seed, suite, library, settings, commit, steps)
         self.path = Path(out) / self.config.run_name()
+        if self.path.resolve() in _RECORDING:
+            raise RunError(f"{self.path} is being recorded by another Recorder in this process: a Recorder records "
+                           "one run from one env (to collect from several envs, record each seed's run apart)")
         if self.path.exists():  # a recording is one session: a second would mix two runs' logs
             state = "finished" if (self.path / "result.json").exists() else "unfinished"
             raise RunError(f"{self.path} holds a recording already ({state}): choose another seed or output "
@@ -124,6 +131,7 @@ class Recorder(gym.Wrapper):
         super().__init__(gym.make(self.config.env_id, product=product, **self.config.env_kwargs))
         self.product = product
         self.run = RunDir(self.path, self.config).__enter__()  # held until finish() or close()
+        _RECORDING.add(self.path.resolve())
         self.transitions = 0
         self.evaluated: list[int] = []  # the steps evaluated so far
         self._episode = None  # (return, length) of the episode being played
@@ -137,6 +145,8 @@ class Recorder(gym.Wrapper):
         return self.env.reset(**kwargs)
 
     def step(self, action):
+        if self.run is None:
+            raise RuntimeError(f"{self.path}: the recording is finished (or closed): a Recorder records one run")
         if self._episode is None:
             raise RuntimeError("step() before reset(): reset the env first, as gymnasium envs need")
         obs, reward, terminated, truncated, info = self.env.step(action)
@@ -175,9 +185,11 @@ class Recorder(gym.Wrapper):
 
     def _due_step(self) -> int:
         """The latest step of the schedule that the transitions have reached: an evaluation
-        called late is that step's (a step skipped is missing from the run's curve, as the
-        board's AUC then shows)."""
-        return min(self.budget, self.transitions // self.config.eval_every * self.config.eval_every)
+        called late is that step's (a step skipped leaves the run's curve short: the board
+        reads its AUC as not measured)."""
+        if self.transitions >= self.budget:  # the last evaluation is the budget's, a multiple of the interval or not
+            return self.budget
+        return self.transitions // self.config.eval_every * self.config.eval_every
 
     def evaluate(self, policy):
         """The suite's evaluation at the schedule's step now due (its seeds are that
@@ -206,10 +218,16 @@ class Recorder(gym.Wrapper):
         Raises:
             ValueError: the budget not collected yet, or a bad count of gradient updates.
         """
+        if self.run is None:
+            raise RuntimeError(f"{self.path}: the recording is finished (or closed) already")
         if not self.done:
             raise ValueError(f"{self.transitions:,} transitions of the budget's {self.budget:,}: a run is finished "
                              "at its budget (step the env until done)")
-        if not isinstance(updates, int) or isinstance(updates, bool) or updates < 0:
+        try:
+            updates = operator.index(updates)  # numpy's and torch's integers too
+        except TypeError:
+            updates = -1
+        if isinstance(updates, bool) or updates < 0:
             raise ValueError(f"updates must be the count of gradient updates made (an integer >= 0), got {updates!r}")
         if self.budget not in self.evaluated:  # the last evaluation, at the budget
             self.evaluate(policy)
@@ -226,6 +244,7 @@ class Recorder(gym.Wrapper):
             self._flush()
             self.run.__exit__(None, None, None)
             self.run = None
+            _RECORDING.discard(self.path.resolve())
         super().close()
 
     def _flush(self) -> None:

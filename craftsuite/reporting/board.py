@@ -68,9 +68,11 @@ def regime_of(config: dict) -> str:
     from ..methods import METHODS
     from ..regimes import regime_of as named
 
-    if config.get("self_reported"):  # a learner of its own: its settings are not CraftSuite's to read
-        return SELF_REPORTED
     algorithm = (config.get("effective") or {}).get("method", {}).get("algorithm")
+    # a learner of its own (a recorded run, or a record of the format without CraftSuite's
+    # settings): they are not CraftSuite's to read
+    if config.get("self_reported") or (algorithm is None and config["method"] not in METHODS):
+        return SELF_REPORTED
     if algorithm is None:
         algorithm = METHODS[config["method"]].algorithm
     return named(algorithm, config.get("hyperparameters") or {})
@@ -116,6 +118,13 @@ def run_metrics(run: Path) -> dict | None:
     # (step, return, won) per training episode; (step, greedy success, mean length) per evaluation
     episodes = [(int(e["step"]), float(e["return"]), int(e["success"])) for e in raw_episodes]
     evals = [(int(float(e["step"])), float(e["success"]), float(e.get("length") or "nan")) for e in raw_evals]
+    auc = float(np.mean([s for _, s, _ in evals])) if evals else float("nan")
+    every = config.get("eval_every")
+    if regime_of(config) == SELF_REPORTED and isinstance(every, int) and every > 0:
+        # its loop chose when to evaluate: a curve short of the suite's schedule has no comparable area
+        schedule = {*range(every, budget, every), budget}
+        if not schedule <= {step for step, _, _ in evals}:
+            auc = float("nan")
     tail = [e for e in episodes if e[0] > 0.9 * budget]
     if not tail and episodes:  # fewer episodes than the window: the last one
         tail = episodes[-1:]
@@ -129,7 +138,7 @@ def run_metrics(run: Path) -> dict | None:
         "success": success[-1] if success else float("nan"),
         "return": float(np.mean([r for _, r, _ in tail])) if tail else float("nan"),
         "train_success": float(np.mean([won for _, _, won in tail])) if tail else float("nan"),
-        "auc": float(np.mean(success)) if success else float("nan"),
+        "auc": auc,
         "steps_to_80": reached,
         "length": evals[-1][2] if evals else float("nan"),  # mean decisions of the last evaluation's episodes
     }
@@ -235,15 +244,17 @@ def build(students_root, *more) -> Board:
     groups: dict[tuple, list[tuple[dict, dict]]] = {}
     board = Board([])
     found: dict[str, Path] = {}
-    runs = []
     for root in map(Path, (students_root, *more)):
         for run in sorted(root.iterdir()) if root.is_dir() else []:
-            if run.name in found and (run / "result.json").exists():  # one run key, one run: never counted twice
-                board.unreadable.append(f"{run}: the same run as {found[run.name]}, counted once")
+            held = found.get(run.name)
+            if held is None:
+                found[run.name] = run
                 continue
-            found.setdefault(run.name, run)
-            runs.append(run)
-    for run in runs:
+            # one run key, one run: never counted twice; a finished copy before an unfinished one
+            if (run / "result.json").exists() and not (held / "result.json").exists():
+                found[run.name], run, held = run, held, run
+            board.unreadable.append(f"{run}: the same run as {held}, counted once")
+    for run in found.values():
         if not (run / "config.json").exists():
             if (run / "result.json").exists():  # a result of no known run
                 board.unreadable.append(f"{run / 'config.json'} is missing beside its result.json: "
@@ -466,19 +477,17 @@ def aggregates(entries) -> list[Aggregate]:
         return x[np.isfinite(x)]
 
     out = []
-    # self-reported runs join every regime's aggregate of their world (their learner is their own)
-    own = {(e.world_label, e.regime) for e in entries if not e.self_reported}
-    worlds = {label for label, _ in own}
-    own |= {(e.world_label, e.regime) for e in entries if e.self_reported and e.world_label not in worlds}
-    for label, regime in sorted(own):
-        mine = [e for e in entries if e.world_label == label and (e.regime == regime or e.self_reported)]
+    for label, regime in sorted({(e.world_label, e.regime) for e in entries}):
+        mine = [e for e in entries if (e.world_label, e.regime) == (label, regime)]
         world, world_kwargs = mine[0].world, mine[0].world_kwargs
         left_out = []
-        # a self-reported run at another budget than the task's own runs is shown, never pooled with them
-        budgets = {e.task: e.budget for e in mine if not e.self_reported}
-        apart = sorted({e.method for e in mine if e.self_reported and budgets.get(e.task, e.budget) != e.budget})
+        if regime != SELF_REPORTED and any(e.self_reported for e in entries if e.world_label == label):
+            left_out.append("self-reported runs: compared with these per rung, not aggregated with them")
+        # a method at another budget on a task than the task's scratch runs is another benchmark
+        budgets = {e.task: e.budget for e in mine if e.method == scratch(world) and not e.variant}
+        apart = sorted({e.method for e in mine if not e.variant and budgets.get(e.task, e.budget) != e.budget})
         if apart:
-            left_out.append(f"{', '.join(apart)}: another budget than the other methods'")
+            left_out.append(f"{', '.join(apart)}: another budget than the scratch runs' on some task")
             mine = [e for e in mine if e.method not in apart]
         variants = sorted({e.method for e in mine if e.variant})
         if variants:

@@ -57,6 +57,8 @@ def test_a_torch_module_acts_by_its_best_output():
     (lambda obs: 7, "CraftSuite/Reach-Grid10-v0", r"the policy returned 7, outside the action space Discrete\(\d\)"),
     (lambda obs: np.array([2.0, 0.0]), "CraftSuite/Reach-Kinematic-v0", r"outside the action space Box.*clip"),
     (lambda obs: 0, "Reach-Grid10", "is not a CraftSuite id"),
+    (lambda obs: 2.7, "CraftSuite/Reach-Grid10-v0", r"the policy returned 2.7, outside the action space"),
+    (th.nn.Sequential(), "CraftSuite/Reach-Grid10-v0", "outside the action space"),  # the observation itself
     ("not a policy", "CraftSuite/Reach-Grid10-v0", "policy must be an SB3 model, a torch module or a callable"),
 ])
 def test_bad_input_is_one_line_naming_the_problem(policy, env, message):
@@ -67,3 +69,23 @@ def test_bad_input_is_one_line_naming_the_problem(policy, env, message):
 def test_an_unknown_suite_is_named():
     with pytest.raises(ValueError, match=r"unknown suite 'nope'; suites: \["):
         craftsuite.evaluate(lambda obs: 0, "CraftSuite/Reach-Grid10-v0", suite="nope")
+
+
+def test_a_module_is_evaluated_in_eval_mode_and_left_as_it_was():
+    class Seen(th.nn.Module):
+        def __init__(self):
+            super().__init__()
+            self.modes = set()
+
+        def forward(self, x):
+            self.modes.add(self.training)
+            return th.zeros(len(x), dtype=th.long)
+
+    module = Seen().train()
+    craftsuite.evaluate(module, "CraftSuite/Reach-Grid10-v0", episodes=1)
+    assert module.modes == {False} and module.training
+
+
+def test_a_rung_of_another_suite_names_the_suites_it_is_in():
+    with pytest.raises(ValueError, match=r"DiamondMine is not a rung of the 'standard' suite.*'hard'"):
+        craftsuite.evaluate(lambda obs: 0, "CraftSuite/DiamondMine-Grid10-v0", step=1000)

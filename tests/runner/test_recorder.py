@@ -119,10 +119,61 @@ def test_the_leaderboard_sets_self_reported_runs_beside_every_regimes_own(tmp_pa
         assert "| my-sac *(self-reported)* | 3 | 1.00" in part
         assert "`my-long` not compared: 2,000 transitions against 1,000" in part
     assert "`my-sac` +1.00 [+1.00, +1.00], P(> `td3`) 1.00" in one_step
-    assert "Not in this aggregate: my-long: another budget than the other methods'" in one_step
+    assert "self-reported runs: compared with these per rung, not aggregated with them" in one_step
     assert "`my-sac` +0.50 [+0.50, +0.50], P(> `td3`) 1.00" in n_step
     rows = read_csv(out / "seeds.csv")
     assert {(r["method"], r["regime"], r["self_reported"]) for r in rows} == {
         ("my-sac", "self-reported", "1"), ("my-long", "self-reported", "1"), ("td3", "one-step", "0"),
         ("td3", "n-step", "0")}
     assert {r["budget_transitions"] for r in rows if r["method"] == "my-long"} == {"2000"}
+
+
+def test_a_budget_off_the_schedule_is_evaluated_at_the_budget_once(tmp_path):
+    env = craftsuite.Recorder(ENV, tmp_path, method="my-odd", steps=1_234)
+    env.reset(seed=0)
+    while not env.done:
+        _, _, terminated, truncated, _ = env.step(0)
+        if terminated or truncated:
+            env.reset()
+        if env.evaluation_due:
+            env.evaluate(lambda obs: 0)
+    assert env.evaluated[-1] == 1_234 and not env.evaluation_due and len(set(env.evaluated)) == len(env.evaluated)
+    path = env.finish(lambda obs: 0, updates=np.int64(5))  # numpy's integers are counts too
+    assert json.loads((path / "result.json").read_text())["updates"] == 5
+    with pytest.raises(RuntimeError, match="finished \\(or closed\\) already"):
+        env.finish(lambda obs: 0, updates=5)
+    with pytest.raises(RuntimeError, match="a Recorder records one run"):
+        env.step(0)
+    (entry,) = build(tmp_path)
+    assert np.isfinite(entry.values["auc"][0])  # every scheduled evaluation made
+
+
+def test_a_run_that_skipped_scheduled_evaluations_has_no_auc(tmp_path):
+    env = craftsuite.Recorder(ENV, tmp_path, method="my-lazy", steps=1_000)
+    env.reset(seed=0)
+    while not env.done:
+        _, _, terminated, truncated, _ = env.step(0)
+        if terminated or truncated:
+            env.reset()
+    env.finish(lambda obs: 0, updates=0)  # only the last evaluation
+    (entry,) = build(tmp_path)
+    assert np.isnan(entry.values["auc"][0]) and np.isfinite(entry.values["success"][0])
+
+
+def test_two_recorders_of_one_run_are_refused(tmp_path):
+    first = craftsuite.Recorder(ENV, tmp_path, method="my-vec")
+    with pytest.raises(RunError, match="being recorded by another Recorder in this process"):
+        craftsuite.Recorder(ENV, tmp_path, method="my-vec")
+    first.close()
+
+
+def test_several_directories_need_an_output_of_their_own(tmp_path, capsys):
+    from craftsuite.cli import main
+
+    from ..reporting.fakes import fake_run
+
+    for root in ("a", "b"):
+        fake_run(tmp_path / root, "td3", 0, [(1000, 1.0)], [(995, 1.0)])
+    assert main(["leaderboard", str(tmp_path / "a"), str(tmp_path / "b")]) == 2
+    assert "give --out DIR" in capsys.readouterr().err
+    assert not (tmp_path / "a" / "leaderboard.md").exists()

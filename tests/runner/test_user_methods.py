@@ -74,3 +74,12 @@ def test_an_installed_packages_entry_point_registers_its_rows(user_module, monke
                         lambda group: [point] if group == methods.ENTRY_POINTS else [])
     methods.load_entry_points()
     assert METHODS["dqn-mine"].description == "my DQN from scratch"
+
+
+def test_a_broken_entry_point_is_named_and_left_out(monkeypatch):
+    point = importlib.metadata.EntryPoint(name="broken", value="no_such_package.rows:ROWS", group=methods.ENTRY_POINTS)
+    monkeypatch.setattr(importlib.metadata, "entry_points",
+                        lambda group: [point] if group == methods.ENTRY_POINTS else [])
+    with pytest.warns(UserWarning, match="entry point 'no_such_package.rows:ROWS' was not loaded"):
+        methods.load_entry_points()
+    assert set(METHODS) == set(methods.BUILTIN)

@@ -159,7 +159,7 @@ _ROWS = {m.name: m for m in (
 METHODS = MappingProxyType(_ROWS)
 BUILTIN = tuple(_ROWS)  # the package's own rows, in table order
 ENTRY_POINTS = "craftsuite.methods"  # the entry-point group of installed packages' rows
-_MODULES: list[str] = []  # the user modules whose rows were registered (``resolve_method``), for spawned workers
+_MODULES: list[str] = []  # the user modules ``resolve_method`` imported
 _NAME = re.compile(r"[a-z0-9][a-z0-9.]*(-[a-z0-9.]+)*\Z")  # as the package's rows: lowercase, digits, dashes
 
 
@@ -210,9 +210,17 @@ def resolve_method(text: str) -> str:
     return name
 
 
-def user_modules() -> tuple[str, ...]:
-    """The modules ``resolve_method`` imported: a spawned worker imports them too."""
-    return tuple(_MODULES)
+def external_rows() -> list[dict]:
+    """The rows registered from outside the package, as plain data (a spawned worker starts
+    with the package's rows alone, and registers these: ``register_rows``)."""
+    return [{**{f: getattr(row, f) for f in row.__dataclass_fields__}, "target": dict(row.target)}
+            for name, row in _ROWS.items() if name not in BUILTIN]
+
+
+def register_rows(rows: list[dict]) -> None:
+    """Register ``external_rows``' rows (in a worker)."""
+    for fields in rows:
+        register_method(Method(**fields))
 
 
 def load_entry_points() -> None:

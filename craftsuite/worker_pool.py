@@ -13,7 +13,7 @@ import threading
 import time
 from concurrent.futures import Future, ProcessPoolExecutor
 
-from .methods import user_modules
+from .methods import external_rows, register_rows
 
 
 def _exit_with(driver: int, period: float = 0.5) -> None:
@@ -30,19 +30,16 @@ def _exit_with(driver: int, period: float = 0.5) -> None:
     threading.Thread(target=watch, name="craftsuite-driver-watch", daemon=True).start()
 
 
-def _report_and_watch(driver: int, started, stopping, modules=()) -> None:
+def _report_and_watch(driver: int, started, stopping, rows=()) -> None:
     """A local worker's initializer: report this process's pid to the pool (``started``, a
     queue), then watch the driver. A worker that reports after the pool began to stop
-    (``stopping``, an event, set before the pool reads the pids) runs nothing. ``modules``:
-    the user modules whose method rows the driver registered (a spawned worker starts
-    with the package's rows alone)."""
-    import importlib
-
+    (``stopping``, an event, set before the pool reads the pids) runs nothing. ``rows``:
+    the method rows the driver registered from outside the package (a spawned worker
+    starts with the package's rows alone)."""
     started.put(os.getpid())
     if stopping.is_set():
         os._exit(1)
-    for module in modules:
-        importlib.import_module(module)
+    register_rows(rows)
     _exit_with(driver)
 
 
@@ -106,7 +103,7 @@ class WorkerPool:
             self.pool = ProcessPoolExecutor(workers or max(1, min(jobs, os.cpu_count() or 1)), mp_context=context,
                                             initializer=_report_and_watch,
                                             initargs=(os.getpid(), self._reported, self._stopping,
-                                                      user_modules()))
+                                                      external_rows()))
 
     def submit(self, job, *args) -> Future:
         if self.ray is not None:

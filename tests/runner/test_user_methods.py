@@ -34,14 +34,26 @@ def user_module(tmp_path, monkeypatch):
 
 def test_a_users_module_registers_a_row_the_suites_run(user_module):
     assert resolve_method(f"{user_module}:dqn-mine") == "dqn-mine"
-    assert "dqn-mine" in methods_for("Grid10") and methods.user_modules() == (user_module,)
+    assert "dqn-mine" in methods_for("Grid10")
+    assert methods.external_rows() == [{"name": "dqn-mine", "world": "Grid", "algorithm": "dqn", "product": False,
+                                        "distill": None, "crm": False, "target": {},
+                                        "description": "my DQN from scratch", "shaping": None}]
     register_method(METHODS["dqn-mine"])  # the same row again: nothing
 
 
-def test_transfer_trains_a_users_row_in_a_spawned_worker(user_module, tmp_path):
+@pytest.fixture
+def clean_rows():
+    yield
+    for name in [n for n in METHODS if n not in methods.BUILTIN]:
+        del methods._ROWS[name]
+
+
+def test_transfer_trains_a_users_row_in_a_spawned_worker(tmp_path, clean_rows):
+    # registered from Python (a notebook, say), not by a module a worker could import
+    register_method(Method("dqn-mine", "Grid", "dqn", False, description="my DQN from scratch"))
     out = tmp_path / "out"
     code = main(["transfer", "--suite", "standard", "--worlds", "Grid10", "--tasks", "Reach", "--methods",
-                 f"{user_module}:dqn-mine", "--seeds", "1", "--steps", "2000", "--workers", "1", "--no-video",
+                 "dqn-mine", "--seeds", "1", "--steps", "2000", "--workers", "1", "--no-video",
                  "--no-archive", "--out", str(out)])
     assert code == 0
     (run,) = (out / "students").glob("student-Reach-Grid10-dqn-mine-s0-*")

@@ -40,7 +40,7 @@ def needs_reread(record: dict) -> bool:
     if not counts_acceptance(record):
         return False
     env_id = record["effective"]["world"]["id"]
-    from .envs.board import BoardRules
+    from .envs.tiles import BoardRules
     from .labelling import Labeller
     from .task_registry import resolve_task
 

@@ -6,7 +6,7 @@ moves by ``3.0 * action`` on a ``size`` x ``size`` board ``[0, size)^2`` (7 or 1
 that would leave the board is rejected (the agent stays, -0.1) and touches nothing; objects
 sit on the board's integer points, a ``corner`` place at (0, 0), the others anywhere but
 (0, 0); the agent starts anywhere. What touching does is the board's own rules
-(``envs/board.py``), not the grid and MuJoCo worlds': see ``KinematicWorldEnv``. The
+(``envs/tiles.py``), not the grid and MuJoCo worlds': see ``KinematicWorldEnv``. The
 automaton is the task's, shared with every world. This module must not import MuJoCo (nor
 dm_control): it is the continuous world for machines without it.
 """
@@ -20,7 +20,7 @@ import numpy as np
 from ..rendering.frames import frame_side
 from ..rendering.panel import add_status_panel, hex_to_rgb
 from ..spec import KINEMATIC_CONFIG, TaskSpec
-from .board import BoardRules
+from .tiles import BoardRules
 from .planar import PlanarWorld, obstacle_boxes, within_boxes
 
 # The authors' values (``spec.KinematicConfig``); the pickup radius and off-board penalty
@@ -41,7 +41,7 @@ class KinematicWorldEnv(PlanarWorld):
     rejected: the agent stays, pays ``continuous.boundary_reward`` and touches nothing.
     After an accepted move, the first object (board order) within ``pickup_radius`` (0.4,
     strictly less) whose requirements the inventory meets acts, as the authors' tiles do
-    (``envs/board.py``): once per step, on every step in reach; its inventory change is
+    (``envs/tiles.py``): once per step, on every step in reach; its inventory change is
     clipped to capacity (an item touched at capacity is used up all the same); it pays its
     reward (the spec's item reward, a place's ``kinematic.reward``), leaves the board if
     consumable and ends the episode if its ``kinematic.ends_episode`` says so.

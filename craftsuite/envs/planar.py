@@ -4,7 +4,7 @@ The MuJoCo world (``ContinuousWorldEnv``) and the kinematic board (``KinematicWo
 share their object slots, actions, obstacle geometry and views here. What a touch does
 differs: the MuJoCo world reads it through the task's ``Rules`` (``touch_slots``, shared
 with its vector env, as the grids read theirs); the kinematic board follows the authors'
-tiles (``envs/board.py``).
+tiles (``envs/tiles.py``).
 """
 
 from __future__ import annotations

@@ -14,7 +14,7 @@ import pytest
 import craftsuite  # noqa: F401  (registers the ids)
 from craftsuite import archive
 from craftsuite.completion import needs_reread, reread, reread_in_place
-from craftsuite.envs.board import BoardRules
+from craftsuite.envs.tiles import BoardRules
 from craftsuite.labelling import Labeller
 from craftsuite.runs import (EPISODE_CORE, EVAL_FIELDS, RunDir, RunError, read_config, read_csv, record_key, settings,
                              write_csv)

@@ -130,13 +130,7 @@ def test_the_leaderboard_sets_self_reported_runs_beside_every_regimes_own(tmp_pa
 
 def test_a_budget_off_the_schedule_is_evaluated_at_the_budget_once(tmp_path):
     env = craftsuite.Recorder(ENV, tmp_path, method="my-odd", steps=1_234)
-    env.reset(seed=0)
-    while not env.done:
-        _, _, terminated, truncated, _ = env.step(0)
-        if terminated or truncated:
-            env.reset()
-        if env.evaluation_due:
-            env.evaluate(lambda obs: 0)
+    _random_loop(env, np.random.default_rng(0))
     assert env.evaluated[-1] == 1_234 and not env.evaluation_due and len(set(env.evaluated)) == len(env.evaluated)
     path = env.finish(lambda obs: 0, updates=np.int64(5))  # numpy's integers are counts too
     assert json.loads((path / "result.json").read_text())["updates"] == 5
@@ -150,11 +144,7 @@ def test_a_budget_off_the_schedule_is_evaluated_at_the_budget_once(tmp_path):
 
 def test_a_run_that_skipped_scheduled_evaluations_has_no_auc(tmp_path):
     env = craftsuite.Recorder(ENV, tmp_path, method="my-lazy", steps=1_000)
-    env.reset(seed=0)
-    while not env.done:
-        _, _, terminated, truncated, _ = env.step(0)
-        if terminated or truncated:
-            env.reset()
+    _random_loop(env, np.random.default_rng(0), evaluate=False)
     env.finish(lambda obs: 0, updates=0)  # only the last evaluation
     (entry,) = build(tmp_path)
     assert np.isnan(entry.values["auc"][0]) and np.isfinite(entry.values["success"][0])

@@ -1,0 +1,85 @@
+"""Part 2 of the plan (this folder's README): each middle rung's MuJoCo budget under the
+adopted regime, read from TD3-from-scratch learning curves by the rule fixed before.
+
+    python experiments/learner-regime/budgets.py --setting n3 [--wave 1] [--n 3 3] [--winners ...]
+
+A TD3 run's curve at t transitions stands for a run of budget t (no schedule of TD3's
+depends on the budget; its replay holds every transition either way), so the curves of
+the regime's scratch runs give each rung's budget without new runs. DQN anneals its
+exploration over a tenth of its budget: its curves do not, and its budgets need runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+
+from craftsuite.runs import read_csv
+
+LOW, HIGH = 0.3, 0.6  # the rule's band for scratch's mean greedy success: inside the 20-80% zone, below its middle
+GRID = 50_000  # budgets are multiples of this
+
+
+def _driver():
+    """The experiment's run.py (by path: every experiment has one), which owns the settings."""
+    spec = importlib.util.spec_from_file_location("learner_regime_run", Path(__file__).with_name("run.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def mean_curve(runs: list[Path]) -> list[tuple[int, float]]:
+    """The seeds' mean greedy success at each evaluation step they all have."""
+    curves = [{int(float(r["step"])): float(r["success"]) for r in read_csv(run / "evals.csv")} for run in runs]
+    steps = sorted(set.intersection(*(set(c) for c in curves))) if curves else []
+    return [(s, float(np.mean([c[s] for c in curves]))) for s in steps]
+
+
+def choose(curve: list[tuple[int, float]], budget: int) -> tuple[int, str]:
+    """The rule: the largest evaluation step within ``budget`` at which the mean lies in
+    [LOW, HIGH], rounded down to ``GRID`` (at least one GRID); where the mean never does,
+    the current budget when scratch stays below LOW, and where it jumps past HIGH between
+    two evaluations, the last step below LOW. Returns the budget and why."""
+    inside = [s for s, m in curve if s <= budget and LOW <= m <= HIGH]
+    if inside:
+        return max(GRID, inside[-1] // GRID * GRID), f"mean {dict(curve)[inside[-1]]:.2f} at {inside[-1]:,}"
+    if all(m < LOW for _, m in curve):
+        return budget, "scratch stays below the band: the budget stays"
+    below = [s for s, m in curve if m < LOW]
+    step = below[-1] if below else curve[0][0]
+    return max(GRID, step // GRID * GRID), f"the mean jumps past the band after {step:,}"
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--setting", required=True, help="the adopted setting's name in run.py, e.g. n3")
+    parser.add_argument("--wave", type=int, default=1, help="the wave whose settings name it")
+    parser.add_argument("--n", type=int, nargs=2, metavar=("TD3_N", "DQN_N"))
+    parser.add_argument("--winners", nargs=2, metavar=("TD3", "DQN"))
+    parser.add_argument("--runs", type=Path, nargs="+",
+                        default=[Path("results/learner-regime"), Path(__file__).parent / "results",
+                                 Path("results/n-step-returns"), Path("results")])
+    args = parser.parse_args(argv)
+    driver = _driver()
+    ns = {"Cont": args.n[0], "Grid10": args.n[1]} if args.n else {"Cont": None, "Grid10": None}
+    winners = dict(zip(("Cont", "Grid10"), map(driver.parse_winners, args.winners or ("none", "none")), strict=True))
+    found = {run.name: run for root in args.runs if root.is_dir() for run in root.glob("*/students/*")
+             if (run / "result.json").exists()}
+    print("| rung | budget now | seeds | mean greedy success at the evaluations | budget by the rule | why |")
+    print("|---|---|---|---|---|---|")
+    for name, c in driver.configs("standard", args.wave, ns, winners):
+        if name != args.setting or c.world != "Cont" or c.seed != 0:
+            continue
+        seeds = [found[s.run_name()] for _, s in driver.configs("standard", args.wave, ns, winners)
+                 if _ == name and s.world == "Cont" and s.task == c.task and s.run_name() in found]
+        curve = mean_curve(seeds)
+        shown = " ".join(f"{m:.2f}" for _, m in curve)
+        budget, why = choose(curve, c.steps) if curve else (c.steps, "no runs found")
+        print(f"| {c.task} | {c.steps:,} | {len(seeds)} | {shown} | {budget:,} | {why} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -51,3 +51,12 @@ def test_the_learner_regime_wave_3_combines_wave_2s_winners_beside_wave_1s():
     assert run.factors(3, "Grid10", 3, []) == []  # no wave-2 winner: nothing to confirm
     with pytest.raises(SystemExit, match="Grid10 has no wave-2 setting \\['gaussian'\\]"):
         run.wave_3("Grid10", 3, ["gaussian"])
+
+
+def test_the_learner_regime_budget_rule_reads_the_curve_as_fixed():
+    budgets = _load(Path(__file__).resolve().parents[1] / "experiments" / "learner-regime" / "budgets.py")
+    curve = [(100_000, 0.0), (200_000, 0.35), (300_000, 0.55), (400_000, 0.9)]
+    assert budgets.choose(curve, 400_000) == (300_000, "mean 0.55 at 300,000")
+    assert budgets.choose(curve, 250_000)[0] == 200_000  # never beyond today's budget
+    assert budgets.choose([(100_000, 0.1), (200_000, 0.2)], 200_000)[0] == 200_000  # below the band: kept
+    assert budgets.choose([(100_000, 0.1), (200_000, 0.9)], 200_000)[0] == 100_000  # jumps past it

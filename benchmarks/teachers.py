@@ -24,8 +24,9 @@ import json
 import tempfile
 
 import craftsuite  # noqa: F401
+from craftsuite.configs import TeacherConfig
 from craftsuite.runs import read_csv
-from craftsuite.training import TeacherConfig, train_teacher
+from craftsuite.training import train_teacher
 from _page import Report, add_page_argument  # benchmarks/ is on sys.path as a script
 
 PAPER_TASKS = ["BlindCraftsman", "DungeonQuest", "DiamondMine"]

@@ -258,7 +258,7 @@ def _distill(args) -> int:
         source = Path(args.source)
         env_id, env_kwargs = args.env_id or _registered(args.task, "Grid7"), {}
         if source.is_dir():  # a teacher run directory: its config names the env, its checkpoint the replay
-            from .training import TeacherConfig
+            from .configs import TeacherConfig
             from .runs import RunDir, load_config
 
             if not (source / "config.json").is_file():

@@ -3,7 +3,8 @@
 The tasks themselves live in ``task_registry`` (names, ladder, user specs), the id format in
 ``ids``; this module registers each task's ids with gymnasium and holds their entry points
 (``make_grid``, ``make_continuous``, ``make_kinematic``; ``make_grid_vector``) and ``make_vec``,
-gymnasium's with ``num_envs`` checked in every mode. Their names stay importable from here.
+gymnasium's with ``num_envs`` checked in every mode. The task and id names are imported from
+their own modules, not from here.
 """
 
 from __future__ import annotations
@@ -14,10 +15,10 @@ from pathlib import Path
 
 import gymnasium as gym
 
-from .ids import CONT, NAMESPACE, WORLD_KINDS, cont_id, grid_id, grid_size, kinematic_id, parse_id, world_kind  # noqa: F401  (re-exported)
+from .ids import CONT, NAMESPACE, cont_id, grid_id, grid_size, kinematic_id, parse_id, world_kind
 from .ids import KINEMATIC as KINEMATIC_WORLD
 from .spec import KINEMATIC_CONFIG, TaskSpec
-from .task_registry import add_task, carried, ladder, resolve_task, tasks  # noqa: F401  (re-exported)
+from .task_registry import add_task, carried, tasks
 
 # gymnasium.make's own keywords: it takes them itself, so a world's entry point never sees them
 MAKE_KEYWORDS = ("max_episode_steps", "disable_env_checker")

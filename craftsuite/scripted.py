@@ -320,14 +320,5 @@ def scripted_policy(env):
     return GridScriptedPolicy(env) if isinstance(env.unwrapped, GridWorldEnv) else ContinuousScriptedPolicy(env)
 
 
-def run_episode(env, policy, seed: int | None = None, max_steps: int = 10_000):
-    """Roll out ``policy`` until the episode ends: (total reward, steps, last info)."""
-    from .episodes import rollout
-
-    episode = rollout(env, policy, 1, seed, max_steps=max_steps)[0]
-    return episode.total_reward, episode.length, episode.info
-
-
 __all__ = ["ObjectivePlanner", "GridScriptedPolicy", "ContinuousScriptedPolicy", "KinematicScriptedPolicy",
-           "scripted_policy",
-           "run_episode"]
+           "scripted_policy"]

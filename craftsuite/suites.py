@@ -23,7 +23,7 @@ from .task_registry import ladder, resolve_task
 class Suite:
     name: str
     description: str
-    tags: tuple[str, ...] = ()  # rungs: every task with any of these tags (registration.ladder)
+    tags: tuple[str, ...] = ()  # rungs: every task with any of these tags (task_registry.ladder)
     tasks: tuple[str, ...] = ()  # rungs by name, besides those by tag
     worlds: tuple[str, ...] = ("Cont",)  # student worlds: "Cont" (MuJoCo), "Grid10", "Grid7"
     methods: tuple[str, ...] = ("td3",)  # each runs in the worlds its METHODS row is for

@@ -22,10 +22,9 @@ import numpy as np
 import torch
 from stable_baselines3.common.callbacks import BaseCallback
 
-from .configs import StudentConfig, TeacherConfig, student_result  # noqa: F401  (defined there, torch-free; re-exported)
+from .configs import StudentConfig, TeacherConfig, student_result
 from .files import atomic_path
-from .runs import (EPISODE_FIELDS, EVAL_FIELDS, CheckpointError, RunDir, RunError, eval_seed,  # noqa: F401  (re-exported)
-                   machine_errors, read_csv)
+from .runs import EPISODE_FIELDS, EVAL_FIELDS, CheckpointError, RunDir, eval_seed, machine_errors, read_csv
 
 
 class Evaluation(NamedTuple):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from ..rendering.frames import MAX_FRAME_SIDE, frame_side  # noqa: F401  (MAX_FRAME_SIDE re-exported)
+from ..rendering.frames import frame_side
 from ..rendering.gl import gl_error_hint
 from ..rendering.panel import add_status_panel
 from ..spec import TaskSpec

@@ -29,8 +29,9 @@ def job(run: Path, sigma: float) -> str:
     from craftsuite.agents import AutomatonQTable
     from craftsuite.agents.factory import make_agent
     from craftsuite.agents.noise import make_action_noise
+    from craftsuite.configs import StudentConfig
     from craftsuite.runs import load_config
-    from craftsuite.training import StudentConfig, evaluate
+    from craftsuite.training import evaluate
 
     cfg = load_config(StudentConfig, run)
     env_id, world = cfg.env_id, cfg.env_kwargs

@@ -25,8 +25,8 @@ import numpy as np
 def _load(run: Path):
     """A run's config, its last checkpoint's model, and whether it sees the automaton state."""
     from craftsuite.agents.factory import load_agent
+    from craftsuite.configs import StudentConfig
     from craftsuite.runs import RunDir, load_config
-    from craftsuite.training import StudentConfig
 
     config = load_config(StudentConfig, run)
     saved = RunDir(run, config).last_checkpoint()

@@ -23,7 +23,7 @@ def main(paths):
         cells[task, regime].append(sorted(evals, key=lambda e: e["seconds"]))
     checkpoints = sorted({int(round(e["seconds"] / 10) * 10) for r in rows for e in [r]})
     marks = [m for m in (30, 60, 120, 180, 300) if m <= max(checkpoints)]
-    from craftsuite.registration import ladder
+    from craftsuite.task_registry import ladder
 
     order = [s.name for s in ladder()]
     for task in sorted(dict.fromkeys(t for t, _ in cells), key=lambda t: order.index(t) if t in order else 99):

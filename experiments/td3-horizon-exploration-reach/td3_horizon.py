@@ -34,11 +34,12 @@ def scripted_steps(task: str, frame_skip: int, episodes: int = 10) -> float:
     import gymnasium as gym
 
     import craftsuite  # noqa: F401
-    from craftsuite.scripted import run_episode, scripted_policy
+    from craftsuite.episodes import rollout
+    from craftsuite.scripted import scripted_policy
 
     env = gym.make(f"CraftSuite/{task}-Cont-v0", frame_skip=frame_skip, max_episode_steps=5_000)
     policy = scripted_policy(env)
-    return sum(run_episode(env, policy, seed=s)[1] for s in range(episodes)) / episodes
+    return sum(rollout(env, policy, 1, s)[0].length for s in range(episodes)) / episodes
 
 
 def main():

@@ -19,7 +19,7 @@ from craftsuite.agents.dqn import AutomatonDQN
 from craftsuite.agents.factory import load_agent, make_agent, recorded_algorithm
 from craftsuite.agents.td3 import AutomatonTD3
 from craftsuite.hyperparameters import HyperparameterError
-from craftsuite.registration import resolve_task
+from craftsuite.task_registry import resolve_task
 
 GRID, CONT = "CraftSuite/DungeonQuest-Grid7-v0", "CraftSuite/DungeonQuest-Cont-v0"
 SMALL_DQN = dict(learning_starts=20, buffer_size=500, policy_kwargs={"net_arch": [16]})

@@ -13,8 +13,10 @@ import pytest
 import craftsuite
 from craftsuite.cli import main as cli
 from craftsuite.envs import continuous
-from craftsuite.envs.continuous import MAX_FRAME_SIDE, TOP_SPEED, ContinuousWorldEnv
-from craftsuite.scripted import ContinuousScriptedPolicy, run_episode
+from craftsuite.envs.continuous import TOP_SPEED, ContinuousWorldEnv
+from craftsuite.episodes import rollout
+from craftsuite.rendering.frames import MAX_FRAME_SIDE
+from craftsuite.scripted import ContinuousScriptedPolicy
 
 from .test_video import read_video
 
@@ -347,7 +349,7 @@ def test_video_command_writes_a_readable_mp4(tmp_path, env_id, gl_available, cap
     meta, frames = read_video(out)
     per_decision = round(meta["fps"] / env.metadata["render_fps"])  # MuJoCo's: its motion, drawn between decisions
     assert per_decision == (1 if "Grid" in env_id else 5)
-    expected = sum(per_decision * run_episode(env, policy, seed=s)[1] + 1 for s in range(2))  # + reset frames
+    expected = sum(per_decision * rollout(env, policy, 1, s)[0].length + 1 for s in range(2))  # + reset frames
     assert meta["codec"] == "h264" and meta["pix_fmt"].startswith("yuv420p")
     rows, columns, _ = env.unwrapped.frame_shape
     assert meta["size"] == (columns, rows) and len(frames) == expected

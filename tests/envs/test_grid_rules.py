@@ -9,7 +9,8 @@ import pytest
 import craftsuite
 from craftsuite.labelling import Labeller
 from craftsuite.rules import Rules
-from craftsuite.scripted import GridScriptedPolicy, run_episode
+from craftsuite.episodes import rollout
+from craftsuite.scripted import GridScriptedPolicy
 from craftsuite.spec import builtin_specs
 
 IDS = [i for i in craftsuite.registered_ids() if "-Grid" in i]
@@ -41,11 +42,11 @@ def test_scripted_policy_completes_every_task(env_id):
     env = gym.make(env_id)
     policy = GridScriptedPolicy(env)
     for seed in range(10):
-        total, steps, info = run_episode(env, policy, seed=seed)
-        assert info["is_success"], (seed, steps)
+        episode = rollout(env, policy, 1, seed)[0]
+        assert episode.success, (seed, episode.length)
         a = env.unwrapped.automaton
-        assert a.accepting[info["automaton_state"]]
-        assert total > 100 + env.unwrapped.task.step_reward * steps  # +100 earned, items on top
+        assert a.accepting[episode.info["automaton_state"]]
+        assert episode.total_reward > 100 + env.unwrapped.task.step_reward * episode.length  # +100 earned, items on top
 
 
 def test_completion_reward_exactly_on_the_accepting_step():

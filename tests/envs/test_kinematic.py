@@ -12,8 +12,9 @@ import pytest
 
 import craftsuite
 from craftsuite.envs.kinematic import KinematicWorldEnv
+from craftsuite.episodes import rollout
 from craftsuite.ids import world_kind
-from craftsuite.scripted import KinematicScriptedPolicy, run_episode
+from craftsuite.scripted import KinematicScriptedPolicy
 
 BC = "CraftSuite/BlindCraftsman-Kinematic-v0"
 
@@ -167,8 +168,8 @@ def test_random_play_completes_blind_craftsman_as_often_as_the_authors_board(mod
             over |= ended
     else:
         env = gym.make(BC)
-        success = np.array([run_episode(env, lambda obs: rng.uniform(-1, 1, 2).astype(np.float32), seed=s)[2]
-                            ["is_success"] for s in range(n)])
+        success = np.array([rollout(env, lambda obs: rng.uniform(-1, 1, 2).astype(np.float32), 1, s)[0].success
+                            for s in range(n)])
     half_width = 2.5 * np.sqrt(0.12 * 0.88 / n)  # 2.5 standard errors around the authors' figure
     assert 0.119 - half_width <= success.mean() <= 0.124 + half_width, success.mean()
 
@@ -341,7 +342,7 @@ def test_importing_the_world_does_not_import_mujoco():
 def test_the_scripted_policy_completes_blind_craftsman():
     env = gym.make(BC)
     policy = KinematicScriptedPolicy(env)
-    wins = sum(bool(run_episode(env, policy, seed=s)[2].get("is_success")) for s in range(10))
+    wins = sum(rollout(env, policy, 1, s)[0].success for s in range(10))
     assert wins == 10
 
 

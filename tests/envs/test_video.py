@@ -126,15 +126,16 @@ def test_continuous_worlds_play_their_motion_between_decisions(tmp_path, env_id,
     import cv2
     import gymnasium as gym
 
+    from craftsuite.episodes import rollout
     from craftsuite.rollouts import record_video
-    from craftsuite.scripted import run_episode, scripted_policy
+    from craftsuite.scripted import scripted_policy
 
     if "Cont" in env_id and not gl_available:
         pytest.skip(gl_available.reason)
     out = tmp_path / "motion.mp4"
     recording = record_video(env_id, "scripted", 1, str(out), seed=3, progress=False)
     env = gym.make(env_id)
-    decisions = run_episode(env, scripted_policy(env), seed=3)[1]
+    decisions = rollout(env, scripted_policy(env), 1, 3)[0].length
     video = cv2.VideoCapture(str(out))
     fps, count = video.get(cv2.CAP_PROP_FPS), int(video.get(cv2.CAP_PROP_FRAME_COUNT))
     frames = []

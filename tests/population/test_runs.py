@@ -128,7 +128,7 @@ def test_a_checkpoint_written_but_not_committed_is_committed_when_resumed(tmp_pa
 
 
 def test_a_population_that_cannot_resume_says_so_and_deletes_nothing(tmp_path, monkeypatch):
-    from craftsuite.training import CheckpointError
+    from craftsuite.runs import CheckpointError
 
     configs = _cell(seeds=(0, 1))
     _killed_at_the_second_evaluation(configs, tmp_path, monkeypatch)

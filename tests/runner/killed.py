@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import pytest
 
+from craftsuite.configs import StudentConfig
 from craftsuite.runs import RunDir
-from craftsuite.training import StudentConfig, train_student
+from craftsuite.training import train_student
 
 TINY = {"learning_starts": 50, "buffer_size": 2_000, "policy_kwargs": {"net_arch": [16]}}
 CONFIG = StudentConfig(method="dqn", world="Grid7", steps=300, eval_every=100, eval_episodes=1, hyperparameters=TINY)

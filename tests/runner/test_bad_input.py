@@ -10,9 +10,10 @@ import warnings
 import pytest
 
 from craftsuite.cli import main
+from craftsuite.configs import StudentConfig, TeacherConfig
 from craftsuite.hyperparameters import HyperparameterError
-from craftsuite.runs import RunDir, read_csv
-from craftsuite.training import CheckpointError, StudentConfig, TeacherConfig, train_student, train_teacher
+from craftsuite.runs import CheckpointError, RunDir, read_csv
+from craftsuite.training import train_student, train_teacher
 from .killed import CONFIG, TINY, killed_run
 
 

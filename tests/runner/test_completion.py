@@ -14,12 +14,12 @@ import pytest
 import craftsuite  # noqa: F401  (registers the ids)
 from craftsuite import archive
 from craftsuite.completion import needs_reread, reread, reread_in_place
+from craftsuite.configs import StudentConfig
 from craftsuite.envs.tiles import BoardRules
 from craftsuite.labelling import Labeller
 from craftsuite.runs import (EPISODE_CORE, EVAL_FIELDS, RunDir, RunError, read_config, read_csv, record_key, settings,
                              write_csv)
 from craftsuite.task_registry import resolve_task
-from craftsuite.training import StudentConfig
 
 ENDING = ("BlindCraftsman", "DungeonQuest", "GoldMine")  # the tasks whose board has a tile that ends the episode
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import subprocess
 import sys
 
-from craftsuite import configs, ids, training
+from craftsuite import configs, ids
 
 
 def test_importing_the_configs_imports_no_torch():
@@ -15,10 +15,6 @@ def test_importing_the_configs_imports_no_torch():
             "print(heavy); sys.exit(1 if heavy else 0)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stdout + out.stderr
-
-
-def test_training_re_exports_the_configs():
-    assert training.StudentConfig is configs.StudentConfig and training.TeacherConfig is configs.TeacherConfig
 
 
 def test_a_configs_env_id_is_built_by_the_id_module():

@@ -13,10 +13,10 @@ from pathlib import Path
 import pytest
 
 from craftsuite.cli import main
+from craftsuite.configs import StudentConfig
 from craftsuite.runs import FORMAT, read_csv
 from craftsuite.suite_runner import run_students
 from craftsuite.suites import SUITES
-from craftsuite.training import StudentConfig
 
 TINY = '{"learning_starts": 100, "buffer_size": 5000}'
 
@@ -128,7 +128,7 @@ def test_suites_are_well_formed(tmp_path):
     from itertools import product
 
     from craftsuite.methods import METHODS
-    from craftsuite.registration import ladder
+    from craftsuite.task_registry import ladder
 
     assert {"quick", "standard", "paper"} <= set(SUITES)
     quick = SUITES["quick"].student_configs(tmp_path)
@@ -258,8 +258,8 @@ def test_students_on_a_local_ray_instance(tmp_path):
 
 _DRIVER = """
 import sys
+from craftsuite.configs import StudentConfig
 from craftsuite.suite_runner import run_students
-from craftsuite.training import StudentConfig
 configs = [StudentConfig(method="dqn", world="Grid7", seed=s, steps=1_000_000, eval_every=100_000,
                          hyperparameters={"learning_starts": 100, "buffer_size": 1000}) for s in (0, 1)]
 run_students(configs, sys.argv[1], workers=2, progress=False)

@@ -11,9 +11,10 @@ import pytest
 from tqdm import tqdm
 
 import craftsuite.progress
+from craftsuite.configs import StudentConfig
 from craftsuite.progress import LineProgress, progress_bar
 from craftsuite.runs import RunDir
-from craftsuite.training import StudentConfig, train_student
+from craftsuite.training import train_student
 
 from .killed import CONFIG, TINY, killed_run
 

@@ -50,7 +50,7 @@ def test_a_session_is_on_record_from_its_start_and_updated_when_it_ends(tmp_path
 def test_a_run_records_its_effective_settings_and_the_code_that_trained_it(tmp_path, monkeypatch):
     from craftsuite.hyperparameters import TD3_DEFAULTS
     from craftsuite.runs import FORMAT, RunDir, load_config, read_config, run_settings, settings
-    from craftsuite.training import StudentConfig
+    from craftsuite.configs import StudentConfig
 
     config = StudentConfig(method="td3-dynamic-edges", steps=500, table="t.npz",
                            hyperparameters={"batch_size": 32})
@@ -76,7 +76,7 @@ def test_a_run_records_its_effective_settings_and_the_code_that_trained_it(tmp_p
 
 
 def craftsuite_task_digest(task: str) -> str:
-    from craftsuite.registration import resolve_task
+    from craftsuite.task_registry import resolve_task
 
     return resolve_task(task).digest()
 
@@ -85,7 +85,7 @@ def test_a_change_of_a_default_or_of_the_rules_gives_a_new_run_key(monkeypatch):
     import dataclasses
 
     from craftsuite import hyperparameters, task_registry
-    from craftsuite.training import StudentConfig, TeacherConfig
+    from craftsuite.configs import StudentConfig, TeacherConfig
 
     student, teacher = StudentConfig(method="td3"), TeacherConfig()
     keys = student.run_name(), teacher.run_name()
@@ -112,7 +112,7 @@ def test_a_change_of_a_default_or_of_the_rules_gives_a_new_run_key(monkeypatch):
 
 def test_where_the_teachers_table_lies_is_recorded_but_not_hashed(tmp_path):
     from craftsuite.runs import RunDir, read_config
-    from craftsuite.training import StudentConfig
+    from craftsuite.configs import StudentConfig
 
     here = StudentConfig(method="td3-dynamic", table="/mnt/a/runs/teachers/teacher-X-k1/table.npz")
     moved = StudentConfig(method="td3-dynamic", table="/home/b/runs/teachers/teacher-X-k1/table.npz")

@@ -8,10 +8,11 @@ import numpy as np
 import pytest
 
 import craftsuite  # noqa: F401
+from craftsuite.configs import StudentConfig
 from craftsuite.runs import read_csv
 from craftsuite.task_registry import resolve_task
 from craftsuite.tracking import ObjectiveTracker
-from craftsuite.training import StudentConfig, train_student
+from craftsuite.training import train_student
 
 # learning never starts: every action is a seeded random one, so that some episodes complete the task
 RANDOM = {"learning_starts": 100_000, "policy_kwargs": {"net_arch": [8]}}

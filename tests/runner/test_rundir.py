@@ -7,9 +7,9 @@ import sys
 
 import pytest
 
+from craftsuite.configs import StudentConfig
 from craftsuite.files import atomic_write
 from craftsuite.runs import EPISODE_FIELDS, RunDir, RunError, read_csv
-from craftsuite.training import StudentConfig
 
 
 def test_two_live_runs_never_share_a_directory(tmp_path):
@@ -23,7 +23,7 @@ def test_two_live_runs_never_share_a_directory(tmp_path):
 
 
 def test_a_dead_owners_lock_is_taken_over(tmp_path):
-    holder = ("import sys, time; from craftsuite.runs import RunDir; from craftsuite.training import StudentConfig\n"
+    holder = ("import sys, time; from craftsuite.runs import RunDir; from craftsuite.configs import StudentConfig\n"
               "with RunDir(sys.argv[1], StudentConfig(steps=10)):\n    print('held', flush=True); time.sleep(60)")
     proc = subprocess.Popen([sys.executable, "-c", holder, str(tmp_path / "r")], stdout=subprocess.PIPE, text=True)
     try:

@@ -10,8 +10,9 @@ import zipfile
 
 import pytest
 
+from craftsuite.configs import StudentConfig, TeacherConfig
 from craftsuite.runs import RunDir, RunError, load_config, read_csv, settings
-from craftsuite.training import StudentConfig, TeacherConfig, train_student, train_teacher
+from craftsuite.training import train_student, train_teacher
 
 TINY_DQN = {"learning_starts": 100, "buffer_size": 5_000}
 
@@ -86,7 +87,8 @@ def test_evaluate_reports_every_step_to_on_step():
 
 _KILLABLE = """
 import sys, craftsuite
-from craftsuite.training import StudentConfig, train_student
+from craftsuite.configs import StudentConfig
+from craftsuite.training import train_student
 config = StudentConfig(method="dqn", world="Grid7", steps=3_000, eval_every=500, eval_episodes=1,
                        hyperparameters={"learning_starts": 200, "buffer_size": 10_000})
 train_student(config, sys.argv[1], progress=False)

@@ -11,9 +11,10 @@ import pytest
 
 import craftsuite
 from craftsuite.cli import main
+from craftsuite.ids import parse_id
 from craftsuite.references import reference, tasks_page
-from craftsuite.registration import ladder, parse_id
 from craftsuite.spec import LEVELS, builtin_specs
+from craftsuite.task_registry import ladder
 
 BUILTIN = builtin_specs()
 BUILTIN_IDS = [i for i in craftsuite.registered_ids() if parse_id(i)[0] in BUILTIN]

@@ -17,11 +17,8 @@ from craftsuite.spec import SpecError, builtin_specs, load_spec
 from .test_load import GOOD, write
 
 
-def test_registration_re_exports_the_registry():
-    from craftsuite import registration
-
-    assert registration.tasks is task_registry.tasks and registration.resolve_task is task_registry.resolve_task
-    assert craftsuite.tasks is task_registry.tasks
+def test_the_package_exports_the_registry():
+    assert craftsuite.tasks is task_registry.tasks and craftsuite.resolve_task is task_registry.resolve_task
     assert set(task_registry.builtin_names()) == set(builtin_specs()) <= set(task_registry.tasks())
 
 

@@ -2,7 +2,7 @@
 
 A run directory holds
 
-* ``config.json``: the run's configuration (a dataclass, see ``craftsuite.training``),
+* ``config.json``: the run's configuration (a dataclass, see ``craftsuite.configs``),
   its effective settings (``effective``: the algorithm's defaults merged with the
   overrides, the method's row, the world and its task's rules digest), the record format
   and its provenance (``provenance``: per session that trained it, the time, the

@@ -377,6 +377,7 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
         lines += [f"## {name}" + (f": {suite['description']}" if suite.get("description") else ""), "",
                   f"Runs in `{runs.path.as_posix()}`." + _suite_scope(suite), ""]
         lines += [session_line(s, to_the_minute=True) for s in runs.sessions]
+        lines += wall_time_lines(runs.sessions)
         if not runs.sessions:
             lines.append(f"- runs in `{runs.path}` (no provenance.json: not made by `craftsuite transfer`)")
         # named after the directory, not the suite: two directories of one suite keep their own plots
@@ -412,6 +413,31 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
         shutil.copy(video, copy)
     atomic_write(path, "\n".join(lines))
     return path
+
+
+def wall_time_lines(sessions: list[dict]) -> list[str]:
+    """The directory's training time as its sessions measured it, summed per kind of machine
+    (its cores): what running the suite's cells here took. Sessions that did not finish are
+    counted apart (their time is not known)."""
+    import re
+
+    took: dict[str, float] = {}
+    unfinished = 0
+    for s in sessions:
+        if not s["command"].startswith("craftsuite transfer"):
+            continue  # archiving and the like train nothing
+        if s.get("seconds") is None:
+            unfinished += 1
+            continue
+        cores = re.search(r"(\d+) cores?", s.get("machine", ""))
+        kind = f"{cores.group(1)} cores" if cores else "machine unknown"
+        took[kind] = took.get(kind, 0.0) + s["seconds"]
+    if not took:
+        return []
+    parts = [f"{seconds / 3600:.1f} h on {kind}" for kind, seconds in sorted(took.items())]
+    return [f"- Wall time of the sessions that trained these runs: {', '.join(parts)}"
+            + (f" ({unfinished} session{'s' if unfinished > 1 else ''} not finished, not counted)" if unfinished
+               else "")]
 
 
 def teachers_markdown(root: Path) -> list[str]:

@@ -147,3 +147,16 @@ def test_a_task_no_method_learned_says_where_its_episodes_stopped(tmp_path):
     # a task some method learned needs no such table
     learned = fake_run(tmp_path / "other", "td3", 0, [(1000, 1.0)], [(995, 1.0, 1)])
     assert obstacles_markdown(list(build(learned.parent))) == []
+
+
+def test_the_wall_time_is_summed_per_kind_of_machine():
+    from craftsuite.reporting.pages import wall_time_lines
+
+    sessions = [{"command": "craftsuite transfer --suite standard", "seconds": 3600.0, "machine": "Linux, 2 cores"},
+                {"command": "craftsuite transfer --suite standard", "seconds": 1800.0, "machine": "Linux, 2 cores"},
+                {"command": "craftsuite transfer --suite standard", "seconds": 360.0, "machine": "Linux, 16 cores"},
+                {"command": "craftsuite transfer --suite standard", "seconds": None, "machine": "Linux, 2 cores"},
+                {"command": "craftsuite archive out --suite standard", "seconds": 0.0, "machine": "Linux, 2 cores"}]
+    assert wall_time_lines(sessions) == ["- Wall time of the sessions that trained these runs: 0.1 h on 16 cores, "
+                                         "1.5 h on 2 cores (1 session not finished, not counted)"]
+    assert wall_time_lines(sessions[-1:]) == []

@@ -114,6 +114,19 @@ def settings(config) -> dict:
     return out
 
 
+# the metrics a run's TensorBoard HParams entry names (SB3's evaluation tags)
+EVAL_METRICS = {"eval/mean_reward": 0.0, "eval/success_rate": 0.0}
+
+
+def hparams(config) -> dict:
+    """A run's settings as TensorBoard's HParams take them: one flat level of numbers,
+    strings and booleans (``hyperparameters.learning_rate``; lists and None as JSON text).
+    The effective settings come last: where they repeat a field (the overrides), theirs stand."""
+    data = settings(config)
+    flat = {**flatten({k: v for k, v in data.items() if k != "effective"}), **flatten(data.get("effective", {}))}
+    return {k: v if isinstance(v, (bool, int, float, str)) else json.dumps(v) for k, v in flat.items()}
+
+
 def config_key(config) -> str:
     """A short stable hash of a config's settings (not of its file locations): equal
     settings share a run directory."""

@@ -12,7 +12,6 @@ resumes from its last checkpoint.
 
 from __future__ import annotations
 
-import json
 import shutil
 import time
 from pathlib import Path
@@ -24,7 +23,8 @@ from stable_baselines3.common.callbacks import BaseCallback
 
 from .configs import StudentConfig, TeacherConfig, student_result
 from .files import atomic_path
-from .runs import EPISODE_FIELDS, EVAL_FIELDS, CheckpointError, RunDir, eval_seed, machine_errors, read_csv
+from .runs import (EPISODE_FIELDS, EVAL_FIELDS, EVAL_METRICS, CheckpointError, RunDir, eval_seed, hparams,
+                   machine_errors, read_csv)
 
 
 class Evaluation(NamedTuple):
@@ -77,8 +77,7 @@ class RunCallback(BaseCallback):
                 _purge_tensorboard(self.logger, 0)  # its scalars and HParams go: this session starts over
             from stable_baselines3.common.logger import HParam
 
-            self.logger.record("hparams", HParam(hparams(self.run.config),
-                                                 {"eval/mean_reward": 0.0, "eval/success_rate": 0.0}),
+            self.logger.record("hparams", HParam(hparams(self.run.config), dict(EVAL_METRICS)),
                                exclude=("stdout", "log", "json", "csv"))
         self.next_eval = (self.num_timesteps // self.eval_every + 1) * self.eval_every
         self.next_flush = self.num_timesteps + 1_000
@@ -127,17 +126,6 @@ class RunCallback(BaseCallback):
         if self.bar is not None:
             self.bar.set_postfix(success=f"{result.success:.2f}")
         return self.stop_at is None or result.success < self.stop_at
-
-
-def hparams(config) -> dict:
-    """A run's settings as TensorBoard's HParams take them: one flat level of numbers,
-    strings and booleans (``hyperparameters.learning_rate``; lists and None as JSON text).
-    The effective settings come last: where they repeat a field (the overrides), theirs stand."""
-    from .runs import flatten, settings
-
-    data = settings(config)
-    flat = {**flatten({k: v for k, v in data.items() if k != "effective"}), **flatten(data.get("effective", {}))}
-    return {k: v if isinstance(v, (bool, int, float, str)) else json.dumps(v) for k, v in flat.items()}
 
 
 def _purge_tensorboard(logger, step: int) -> None:

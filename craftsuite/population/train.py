@@ -9,7 +9,7 @@ does: ``config.json`` (its settings, ``engine`` among them, and provenance), ``e
 own state (``checkpoint/population.pt``: networks, optimizer moments, replay, counts,
 noise), after the step's updates; a killed population resumes from the newest step every
 member has a checkpoint of.
-A population writes no TensorBoard logs.
+Each member also logs to TensorBoard under SB3's tag names (``scalars.Scalars``).
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ from ..reached import Reached, check_automaton
 from ..runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, eval_seed
 from .engine import EngineError, Population, check_supported, sparse_width
 from .envs import make_envs, step_records
+from .scalars import Scalars
 
 CHECKPOINT, STEP = "population.pt", "step.json"  # a member's state, and the step it was saved at
 
@@ -115,11 +116,14 @@ def _train(todo, settings, table, spec, device, progress, desc) -> None:
                          spec.automaton, spec.completion_reward, config.steps, table, str(device),
                          sparse_width(spec, world_kind(config.world), config.product))
         _resume(pop, runs)
+        logs = [Scalars(run, pop.num_timesteps) for run in runs]
+        for log in logs:
+            stack.callback(log.close)
         total = config.steps
         eval_envs = make_envs(config.env_id, K * config.eval_episodes, config.env_kwargs, config.product)
         stack.callback(eval_envs.close)
         with progress_bar(K * total, desc, initial=K * pop.num_timesteps, enabled=progress) as bar:
-            _loop(pop, envs, eval_envs, configs, runs, bar, spec.automaton)
+            _loop(pop, envs, eval_envs, configs, runs, logs, bar, spec.automaton)
         for k, (c, run) in enumerate(todo):
             _finish(pop, k, c, run, table, time.perf_counter() - start, str(device))
     finally:
@@ -127,7 +131,7 @@ def _train(todo, settings, table, spec, device, progress, desc) -> None:
         th.set_num_threads(threads)
 
 
-def _loop(pop: Population, envs, eval_envs, configs, runs, bar, automaton) -> None:
+def _loop(pop: Population, envs, eval_envs, configs, runs, logs, bar, automaton) -> None:
     config = configs[0]
     K, n, total, every = pop.K, pop.n_envs, config.steps, config.eval_every
     seeds = [c.seed + j for c in configs for j in range(n)]  # as SB3's make_vec_env seeds each run's envs
@@ -156,22 +160,23 @@ def _loop(pop: Population, envs, eval_envs, configs, runs, bar, automaton) -> No
         bar.update(K * n)
         t = pop.num_timesteps
         if t >= next_flush:
-            _flush(runs, pending, t, total)
+            _flush(runs, logs, pending, t, total)
             next_flush = t + 1_000
         evaluate = t >= next_eval or t >= total
         if evaluate:  # before this step's updates, as SB3's callback runs before its train()
             next_eval += every
-            _flush(runs, pending, t, total)
-            _evaluate(pop, configs, runs, t, bar, eval_envs)
+            _flush(runs, logs, pending, t, total)
+            _evaluate(pop, configs, runs, logs, t, bar, eval_envs)
         pop.train()
         if evaluate:  # after them, so that a resumed population has taken every update of its steps
             _checkpoint(pop, runs)
 
 
-def _flush(runs, pending, step: int, total: int) -> None:
-    for run, rows in zip(runs, pending):
+def _flush(runs, logs, pending, step: int, total: int) -> None:
+    for run, log, rows in zip(runs, logs, pending):
         if rows:
             run.append("episodes.csv", EPISODE_FIELDS, rows)
+            log.episodes(rows, step)
             rows.clear()
         run.write_progress(step, total)
 
@@ -207,10 +212,11 @@ def evaluate_members(pop: Population, config: StudentConfig, seed: int, envs=Non
             for w, r, n in zip(wins.reshape(shape), returns.reshape(shape), lengths.reshape(shape))]
 
 
-def _evaluate(pop, configs, runs, step, bar, envs=None) -> None:
+def _evaluate(pop, configs, runs, logs, step, bar, envs=None) -> None:
     config = configs[0]
     results = evaluate_members(pop, config, seed=eval_seed(step), envs=envs)
-    for run, (success, ret, length) in zip(runs, results):
+    for run, log, (success, ret, length) in zip(runs, logs, results):
+        log.evaluation(step, success, ret, length)
         run.append("evals.csv", EVAL_FIELDS, [{"step": step, "success": success, "return": round(ret, 4),
                                                 "episodes": config.eval_episodes, "length": round(length, 2)}])
     bar.set_postfix(success=" ".join(f"{r[0]:.2f}" for r in results))

@@ -203,3 +203,32 @@ def test_suites_train_each_cell_as_one_population():
     assert {c.engine for c in configs} == {"population"}
     sb3 = SUITES["paper"].student_configs("teachers")
     assert {c.engine for c in sb3} == {"sb3"} and len(cells(sb3)) == len(sb3)  # one job per SB3 run
+
+
+def test_each_member_logs_to_tensorboard_as_an_sb3_run_and_a_resume_drops_what_the_kill_logged(tmp_path,
+                                                                                             monkeypatch):
+    from ..runner.test_training import _hparams, _scalar_steps
+
+    configs = _cell("dqn", "Grid7", "FirstTool", seeds=(0, 1), layout_seed=0)
+    checkpoint, calls = population_train._checkpoint, {"n": 0}
+
+    def dies_at_the_second(*args):  # after the evaluation at 800 is logged, before its checkpoint
+        calls["n"] += 1
+        if calls["n"] == 2:
+            raise KeyboardInterrupt
+        checkpoint(*args)
+
+    with monkeypatch.context() as patch:
+        patch.setattr(population_train, "_checkpoint", dies_at_the_second)
+        with pytest.raises(KeyboardInterrupt):
+            train_population(configs, tmp_path, progress=False)
+    killed = _scalar_steps(tmp_path / configs[0].run_name() / "tb" / "run_0")
+    assert killed["eval/success_rate"] == [400, 800]  # logged, then lost with the kill
+    paths = train_population(configs, tmp_path, progress=False)
+    for config, path in zip(configs, paths):
+        steps = _scalar_steps(path / "tb" / "run_0")
+        for tag in ("eval/mean_reward", "eval/success_rate", "eval/mean_ep_length"):  # SB3's tags
+            assert steps[tag] == [400, 800, 1200]  # each once: the killed session's 800 is dropped
+        assert steps["rollout/ep_rew_mean"] and all(s == sorted(set(s)) for s in steps.values())
+        [settings] = _hparams(path / "tb" / "run_0")  # once per run, by the session that started it
+        assert settings["method"] == "dqn" and settings["seed"] == config.seed and settings["engine"] == "population"

@@ -68,8 +68,13 @@ def check_device(device: str) -> th.device:
 
 
 def train_population(configs: list[StudentConfig], root, progress: bool = True, device: str = "cpu",
-                     desc: str | None = None) -> list[Path]:
-    """Train every seed of one cell together; returns each config's run directory."""
+                     desc: str | None = None, on_evaluation=None) -> list[Path]:
+    """Train every seed of one cell together; returns each config's run directory.
+
+    ``on_evaluation(population, step, results)``, if given, is called after each
+    evaluation (``results``: each member's (success, mean return, mean length), in seed
+    order): the hook an experiment measures more with, as an SB3 callback would (the
+    population's members, their networks and replay, are ``population``'s)."""
     from ..agents import AutomatonQTable
     from ..task_registry import resolve_task
 
@@ -93,11 +98,11 @@ def train_population(configs: list[StudentConfig], root, progress: bool = True, 
         todo = [(c, r) for c, r in zip(configs, runs) if not r.finished()]
         if todo:
             _train(todo, settings, table, spec, dev, progress,
-                   desc or f"{config.method} {config.task} {config.world} x{len(todo)}")
+                   desc or f"{config.method} {config.task} {config.world} x{len(todo)}", on_evaluation)
     return [root / n for n in names]
 
 
-def _train(todo, settings, table, spec, device, progress, desc) -> None:
+def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=None) -> None:
     from ..progress import progress_bar
 
     configs, runs = [c for c, _ in todo], [r for _, r in todo]
@@ -123,7 +128,7 @@ def _train(todo, settings, table, spec, device, progress, desc) -> None:
         eval_envs = make_envs(config.env_id, K * config.eval_episodes, config.env_kwargs, config.product)
         stack.callback(eval_envs.close)
         with progress_bar(K * total, desc, initial=K * pop.num_timesteps, enabled=progress) as bar:
-            _loop(pop, envs, eval_envs, configs, runs, logs, bar, spec.automaton)
+            _loop(pop, envs, eval_envs, configs, runs, logs, bar, spec.automaton, on_evaluation)
         for k, (c, run) in enumerate(todo):
             _finish(pop, k, c, run, table, time.perf_counter() - start, str(device))
     finally:
@@ -131,7 +136,7 @@ def _train(todo, settings, table, spec, device, progress, desc) -> None:
         th.set_num_threads(threads)
 
 
-def _loop(pop: Population, envs, eval_envs, configs, runs, logs, bar, automaton) -> None:
+def _loop(pop: Population, envs, eval_envs, configs, runs, logs, bar, automaton, on_evaluation=None) -> None:
     config = configs[0]
     K, n, total, every = pop.K, pop.n_envs, config.steps, config.eval_every
     seeds = [c.seed + j for c in configs for j in range(n)]  # as SB3's make_vec_env seeds each run's envs
@@ -166,7 +171,9 @@ def _loop(pop: Population, envs, eval_envs, configs, runs, logs, bar, automaton)
         if evaluate:  # before this step's updates, as SB3's callback runs before its train()
             next_eval += every
             _flush(runs, logs, pending, t, total)
-            _evaluate(pop, configs, runs, logs, t, bar, eval_envs)
+            results = _evaluate(pop, configs, runs, logs, t, bar, eval_envs)
+            if on_evaluation is not None:
+                on_evaluation(pop, t, results)
         pop.train()
         if evaluate:  # after them, so that a resumed population has taken every update of its steps
             _checkpoint(pop, runs)
@@ -212,7 +219,7 @@ def evaluate_members(pop: Population, config: StudentConfig, seed: int, envs=Non
             for w, r, n in zip(wins.reshape(shape), returns.reshape(shape), lengths.reshape(shape))]
 
 
-def _evaluate(pop, configs, runs, logs, step, bar, envs=None) -> None:
+def _evaluate(pop, configs, runs, logs, step, bar, envs=None) -> list[tuple[float, float, float]]:
     config = configs[0]
     results = evaluate_members(pop, config, seed=eval_seed(step), envs=envs)
     for run, log, (success, ret, length) in zip(runs, logs, results):
@@ -220,6 +227,7 @@ def _evaluate(pop, configs, runs, logs, step, bar, envs=None) -> None:
         run.append("evals.csv", EVAL_FIELDS, [{"step": step, "success": success, "return": round(ret, 4),
                                                 "episodes": config.eval_episodes, "length": round(length, 2)}])
     bar.set_postfix(success=" ".join(f"{r[0]:.2f}" for r in results))
+    return results
 
 
 def _checkpoint(pop: Population, runs) -> None:

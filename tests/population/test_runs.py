@@ -232,3 +232,16 @@ def test_each_member_logs_to_tensorboard_as_an_sb3_run_and_a_resume_drops_what_t
         assert steps["rollout/ep_rew_mean"] and all(s == sorted(set(s)) for s in steps.values())
         [settings] = _hparams(path / "tb" / "run_0")  # once per run, by the session that started it
         assert settings["method"] == "dqn" and settings["seed"] == config.seed and settings["engine"] == "population"
+
+
+def test_an_experiment_sees_each_evaluation_through_the_hook(tmp_path):
+    seen = []
+
+    def hook(pop, step, results):
+        seen.append((step, pop.K, [round(r[0], 2) for r in results]))
+
+    configs = _cell("dqn", "Grid7", "FirstTool", seeds=(0, 1), layout_seed=0)
+    paths = train_population(configs, tmp_path, progress=False, on_evaluation=hook)
+    assert [s for s, _, _ in seen] == [400, 800, 1200] and all(k == 2 for _, k, _ in seen)
+    for k, path in enumerate(paths):  # the results the hook saw are the ones each run recorded
+        assert [round(float(r["success"]), 2) for r in read_csv(path / "evals.csv")] == [s[2][k] for s in seen]

@@ -108,11 +108,11 @@ class ContinuousWorldEnv(PlanarWorld):
         self._geom_ids = np.array([self.model.geom(n).id for n in scene.object_bodies])
         self._rgba = self.model.geom_rgba[self._geom_ids].copy()
         self._lay_out(scene.object_kinds)
-        n_obj = len(self._kinds)
+        n_obj = len(self.kinds)
         # how far from the centre, on either axis, the agent touches the boundary wall
         self.wall_limit = self.half - AGENT_HALF - 0.02
         self._any_inside = False
-        self._radius2 = self.radius ** 2
+        self.radius2 = self.radius ** 2
         self._offset_scale = np.zeros((n_obj, 1))
         self._obs_objects = self._object_view()
         self._renderer = None
@@ -127,7 +127,7 @@ class ContinuousWorldEnv(PlanarWorld):
 
     def _object_view(self) -> np.ndarray:
         """(dx, dy, present) rows of the observation buffer, as a writable view."""
-        n_obj = len(self._kinds)
+        n_obj = len(self.kinds)
         return self._obs[4:4 + 3 * n_obj].reshape(n_obj, 3)
 
     # -- public views --------------------------------------------------------------------------
@@ -187,7 +187,7 @@ class ContinuousWorldEnv(PlanarWorld):
         super().reset(seed=seed)
         model, data = self.model, self.data
         mujoco.mj_resetData(model, data)
-        n_obj = len(self._kinds)
+        n_obj = len(self.kinds)
         points = self._sample_positions(n_obj + 1)
         self._positions = points[:n_obj].copy()
         data.qpos[:2] = points[n_obj]
@@ -234,13 +234,13 @@ class ContinuousWorldEnv(PlanarWorld):
         px, py = data.qpos[0], data.qpos[1]
         lim = self.wall_limit
         if (abs(px) >= lim and x * px > 0) or (abs(py) >= lim and y * py > 0):
-            reward += self._boundary_reward
+            reward += self.boundary_reward
 
         offsets = self._positions - data.qpos[:2]
         dist2 = np.einsum("ij,ij->i", offsets, offsets)
         mask = self._level_mask
-        if dist2.min() < self._radius2 or self._any_inside:
-            inside = dist2 < self._radius2
+        if dist2.min() < self.radius2 or self._any_inside:
+            inside = dist2 < self.radius2
             mask, reward = self._touch(inside, mask, reward)
             self._inside = inside
             self._any_inside = bool(inside.any())

@@ -49,7 +49,7 @@ class ContinuousVectorEnv(PlanarVectorEnv):
         kwargs.pop("render_mode", None)
         template = ContinuousWorldEnv(task, **kwargs)
         super().__init__(template, num_envs, product, max_episode_steps, autoreset_mode)
-        n_obj = len(template._kinds)
+        n_obj = len(template.kinds)
         self.model = template.model  # shared: the template's resets only move object bodies
         self._datas = [mujoco.MjData(self.model) for _ in range(num_envs)]
         # views into each MjData, made once (they stay valid while the data lives)
@@ -58,13 +58,13 @@ class ContinuousVectorEnv(PlanarVectorEnv):
         self._qvel = [d.qvel for d in self._datas]
         self.frame_skip = template.frame_skip
         self.dt = template.dt
-        self._kinds = list(template._kinds)
-        self._is_item = template._is_item
+        self.kinds = list(template.kinds)
+        self.is_item = template.is_item
         self.arena, self.half = template.arena, template.half
-        self._radius2 = template._radius2
+        self.radius2 = template.radius2
         self._wall_limit = template.wall_limit
-        self._boundary_reward = template._boundary_reward
-        self._inv_offset = template._inv_offset
+        self.boundary_reward = template.boundary_reward
+        self.inv_offset = template.inv_offset
         self._n_obj = n_obj
         self._position = np.zeros((num_envs, 2))  # qpos[:2] of each env's data
         self._velocity = np.zeros((num_envs, 2))  # qvel[:2]
@@ -98,10 +98,10 @@ class ContinuousVectorEnv(PlanarVectorEnv):
         rewards = np.full(self.num_envs, self._step_reward)
         lim = self._wall_limit
         pushing = ((np.abs(position) >= lim) & (actions * position > 0)).any(axis=1)
-        rewards[active & pushing] += self._boundary_reward
+        rewards[active & pushing] += self.boundary_reward
 
         offsets = self._positions - position[:, None, :]
-        inside = np.einsum("nij,nij->ni", offsets, offsets) < self._radius2
+        inside = np.einsum("nij,nij->ni", offsets, offsets) < self.radius2
         inside &= active[:, None]
         masks = self._levels.copy()
         for i in np.flatnonzero(inside.any(axis=1)).tolist():

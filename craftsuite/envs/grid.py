@@ -93,9 +93,9 @@ class GridWorldEnv(CraftWorld):
         self.size = size
         spec = self.task
         self._objects = spec.objects
-        self._obstacles = sorted({y * size + x for x, y in spec.grid.obstacles})
+        self.obstacles = sorted({y * size + x for x, y in spec.grid.obstacles})
         n_cells = size * size
-        free = n_cells - len(self._obstacles) - 1
+        free = n_cells - len(self.obstacles) - 1
         n_objects = sum(o.count for o in self._objects)
         if n_objects > free:
             raise ValueError(f"{spec.name}: {n_objects} objects do not fit a {size}x{size} grid")
@@ -103,11 +103,11 @@ class GridWorldEnv(CraftWorld):
             raise ValueError(f"{spec.name}: obstacles {spec.grid.obstacles} lie outside a {size}x{size} grid")
 
         self._n_channels = 2 + len(self._objects)
-        self._inv_offset = self._n_channels * n_cells
-        n_obs = self._inv_offset + len(self.rules.inventory_names)
+        self.inv_offset = self._n_channels * n_cells
+        n_obs = self.inv_offset + len(self.rules.inventory_names)
         self.observation_space = gym.spaces.Box(0.0, 1.0, (n_obs,), dtype=np.float32)
         self.action_space = gym.spaces.Discrete(4)
-        self._inv_scale = self.rules.scale
+        self.inv_scale = self.rules.scale
         self._step_reward = spec.step_reward
         self._cells: list[int] = []
         self._obs = np.zeros(n_obs, dtype=np.float32)
@@ -120,9 +120,9 @@ class GridWorldEnv(CraftWorld):
         return {
             "planes": (self._n_channels, self.size, self.size),
             "plane_names": ("agent", "obstacle") + tuple(o.name for o in self._objects),
-            "inventory": slice(self._inv_offset, self._inv_offset + len(self.inventory_counts)),
+            "inventory": slice(self.inv_offset, self.inv_offset + len(self.inventory_counts)),
             "inventory_names": self.rules.inventory_names,
-            "inventory_scale": tuple(self._inv_scale),
+            "inventory_scale": tuple(self.inv_scale),
         }
 
     @property
@@ -164,7 +164,7 @@ class GridWorldEnv(CraftWorld):
         super().reset(seed=seed)
         n_cells = self.size * self.size
         cells = [EMPTY] * n_cells
-        for c in self._obstacles:
+        for c in self.obstacles:
             cells[c] = WALL
         corner = [k for k, o in enumerate(self._objects) if getattr(o, "placement", "") == "corner"]
         for k in corner:
@@ -190,7 +190,7 @@ class GridWorldEnv(CraftWorld):
         obs = self._obs
         obs[:] = 0.0
         obs[self._agent] = 1.0
-        for c in self._obstacles:
+        for c in self.obstacles:
             obs[n_cells + c] = 1.0
         for c, k in enumerate(cells):
             if k >= 0:
@@ -239,7 +239,7 @@ class GridWorldEnv(CraftWorld):
                 if outcome.consumed:
                     self._cells[self._agent] = EMPTY
                     obs[(2 + kind) * size * size + self._agent] = 0.0
-                off, scale = self._inv_offset, self._inv_scale
+                off, scale = self.inv_offset, self.inv_scale
                 for s, count in enumerate(inv):
                     obs[off + s] = count / scale[s]
                 self._level_mask = self.labeller.levels(inv)

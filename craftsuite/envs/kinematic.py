@@ -111,18 +111,18 @@ class KinematicWorldEnv(PlanarWorld):
         corner = {k for k, obj in enumerate(spec.objects) if getattr(obj, "placement", "") == "corner"}
         kinds = [k for k, obj in enumerate(spec.objects) for _ in range(obj.count)]
         self._lay_out(sorted(kinds, key=lambda k: k not in corner))  # stable: fixed tiles first
-        n_obj = len(self._kinds)
-        self._fixed = np.array([k in corner for k in self._kinds])
+        n_obj = len(self.kinds)
+        self._fixed = np.array([k in corner for k in self.kinds])
         if observation == "authors":
             n_obs = 2 + n_obj + len(self.rules.inventory_names)
             high = np.concatenate([[1.0, 1.0], np.full(n_obj, np.sqrt(2.0)), self.rules.scale]).astype(np.float32)
             self.observation_space = gym.spaces.Box(0.0, high, (n_obs,), dtype=np.float32)
             self._obs = np.zeros(n_obs, dtype=np.float32)
-            self._inv_offset = 2 + n_obj
+            self.inv_offset = 2 + n_obj
         # the MuJoCo scene's obstacle boxes, scaled to this board and moved to its corner origin
         scale = self.arena / spec.continuous.arena
         boxes = np.array(obstacle_boxes(spec), dtype=float).reshape(-1, 3) * scale
-        self._obstacles = boxes + [self.half, self.half, 0.0]
+        self.obstacles = boxes + [self.half, self.half, 0.0]
         # the authors' object sites: the board's integer points but (0, 0), here also clear
         # of obstacles by a pickup radius (so no object hides in a wall)
         axis = np.arange(self.size, dtype=float)
@@ -132,14 +132,14 @@ class KinematicWorldEnv(PlanarWorld):
             raise ValueError(f"{spec.name}: {n_obj} objects do not fit the {self.size}x{self.size} kinematic "
                              f"board's {len(self._sites)} free integer points")
         # arrived propositions read from the agent's cell: (bit, slot) per slot of such a place
-        self._cell_bits = [(self.labeller.arrived_bits(k), j) for j, k in enumerate(self._kinds)
+        self.cell_bits = [(self.labeller.arrived_bits(k), j) for j, k in enumerate(self.kinds)
                            if self.board.tiles[k].by_cell and self.labeller.arrived_bits(k)]
         self._position = np.zeros(2)
         self._level_mask = 0
 
     def in_obstacle(self, points: np.ndarray, margin: float = 0.0) -> np.ndarray:
         """Which of the (n, 2) board points lie in an obstacle grown by ``margin``."""
-        return within_boxes(points, self._obstacles, margin)
+        return within_boxes(points, self.obstacles, margin)
 
     def on_board(self, point) -> bool:
         """Whether the agent may stand at ``point``: on the half-open board (the authors'
@@ -151,9 +151,9 @@ class KinematicWorldEnv(PlanarWorld):
     def observation_layout(self) -> dict:
         if self.observation == "craftsuite":
             return super().observation_layout
-        n_obj = len(self._kinds)
+        n_obj = len(self.kinds)
         return {"agent_position": slice(0, 2), "distances": slice(2, 2 + n_obj),
-                "object_names": tuple(self.task.objects[k].name for k in self._kinds),
+                "object_names": tuple(self.task.objects[k].name for k in self.kinds),
                 "inventory": slice(2 + n_obj, 2 + n_obj + len(self.inventory_counts)),
                 "inventory_names": self.rules.inventory_names}
 
@@ -188,7 +188,7 @@ class KinematicWorldEnv(PlanarWorld):
         return self._obs.copy(), self.tracker.reset()
 
     def _write_observation(self):
-        obs, n_obj = self._obs, len(self._kinds)
+        obs, n_obj = self._obs, len(self.kinds)
         offsets = self._positions - self._position
         if self.observation == "authors":
             obs[0:2] = self._position / self.arena
@@ -202,13 +202,13 @@ class KinematicWorldEnv(PlanarWorld):
     def _write_inventory(self) -> None:
         if self.observation == "craftsuite":
             return super()._write_inventory()
-        self._obs[self._inv_offset:] = self.inventory_counts
+        self._obs[self.inv_offset:] = self.inventory_counts
 
     def cell_mask(self) -> int:
         """The bits of the places labelled by their cell that hold at the agent's position."""
         cell = np.floor(self._position)
         mask = 0
-        for bit, j in self._cell_bits:
+        for bit, j in self.cell_bits:
             if self._present[j] and (np.floor(self._positions[j]) == cell).all():
                 mask |= bit
         return mask
@@ -227,7 +227,7 @@ class KinematicWorldEnv(PlanarWorld):
             inside = self._present & (np.einsum("ij,ij->i", offsets, offsets) < self.radius ** 2)
             if inside.any():
                 inv = self.inventory_counts
-                j, outcome = self.board.first_acting(inv, [(j, self._kinds[j]) for j in np.flatnonzero(inside)])
+                j, outcome = self.board.first_acting(inv, [(j, self.kinds[j]) for j in np.flatnonzero(inside)])
                 if outcome is not None:
                     reward += outcome.reward
                     ended = outcome.ends_episode
@@ -239,8 +239,8 @@ class KinematicWorldEnv(PlanarWorld):
                     self._write_inventory()
             self._inside = inside
         else:  # the authors reject the whole move: the agent stays and touches nothing
-            reward += self._boundary_reward
-        if self._cell_bits:
+            reward += self.boundary_reward
+        if self.cell_bits:
             mask |= self.cell_mask()
         self._write_observation()
         bonus, done, info = self.tracker.advance(mask)
@@ -272,17 +272,17 @@ class KinematicWorldEnv(PlanarWorld):
         """The board with the agent at ``position``."""
         frame = np.full((self.height, self.width, 3), 235, dtype=np.uint8)
         sx, sy = self.width / self.arena, self.height / self.arena
-        for x, y, h in self._obstacles:
+        for x, y, h in self.obstacles:
             c0, r0 = self.world_to_pixel(x - h, y + h)
             c1, r1 = self.world_to_pixel(x + h, y - h)
             cv2.rectangle(frame, (c0, r0), (c1, r1), (61, 89, 150), -1)
         objects = self.task.objects
-        for i, kind in enumerate(self._kinds):
+        for i, kind in enumerate(self.kinds):
             if not self._present[i]:
                 continue
             col, row = self.world_to_pixel(*self._positions[i])
             color = hex_to_rgb(objects[kind].color)
-            if self._is_item[i]:  # items small discs, places their pickup zone
+            if self.is_item[i]:  # items small discs, places their pickup zone
                 cv2.circle(frame, (col, row), max(1, int(0.2 * min(sx, sy))), color, -1, cv2.LINE_AA)
             else:
                 cv2.ellipse(frame, (col, row), (max(1, int(self.radius * sx)), max(1, int(self.radius * sy))),

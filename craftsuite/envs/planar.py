@@ -82,24 +82,26 @@ def _frozen(array: np.ndarray) -> np.ndarray:
 
 
 class PlanarWorld(CraftWorld):
-    """Base of the continuous worlds. Subclasses set, per object slot, ``_kinds`` (its
-    object kind), ``_is_item``, ``_present``, ``_inside`` (the agent was within reach at the
-    last step) and ``_positions``; ``_obs`` with the inventory from ``_inv_offset``; and
-    ``width`` and ``height`` of a frame. They define ``_remove(i)``: what consuming slot
-    ``i`` changes besides ``_present`` (the MuJoCo world hides its body)."""
+    """Base of the continuous worlds. Subclasses set, per object slot, ``kinds`` (its
+    object kind), ``is_item``, ``_present``, ``_inside`` (the agent was within reach at the
+    last step) and ``_positions``; ``_obs`` with the inventory from ``inv_offset``; and
+    ``width`` and ``height`` of a frame. What does not change between episodes (``kinds``,
+    ``is_item``, ``inv_offset``, ``boundary_reward``) is public: the vector envs read it.
+    They define ``_remove(i)``: what consuming slot ``i`` changes besides ``_present`` (the
+    MuJoCo world hides its body)."""
 
     def _lay_out(self, kinds: list[int]) -> None:
         """The object slots (one per object, of these kinds), the spaces and the buffers, in
         the shared layout: the agent's fields, (dx, dy, present) per slot, the inventory."""
-        self._kinds = list(kinds)
-        n_obj, first = len(self._kinds), max(f.stop for f in self.AGENT_FIELDS.values())
-        self._is_item = np.array([k < self.rules.n_items for k in self._kinds], dtype=bool)
-        self._inv_offset = first + 3 * n_obj
-        n_obs = self._inv_offset + len(self.rules.inventory_names)
+        self.kinds = list(kinds)
+        n_obj, first = len(self.kinds), max(f.stop for f in self.AGENT_FIELDS.values())
+        self.is_item = np.array([k < self.rules.n_items for k in self.kinds], dtype=bool)
+        self.inv_offset = first + 3 * n_obj
+        n_obs = self.inv_offset + len(self.rules.inventory_names)
         self.observation_space = gym.spaces.Box(-1.0, 1.0, (n_obs,), dtype=np.float32)
         self.action_space = gym.spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
         self._step_reward = self.task.step_reward
-        self._boundary_reward = self.task.continuous.boundary_reward
+        self.boundary_reward = self.task.continuous.boundary_reward
         self._obs = np.zeros(n_obs, dtype=np.float32)
         self._positions = np.zeros((n_obj, 2))
         self._present = np.zeros(n_obj, dtype=bool)
@@ -116,9 +118,9 @@ class PlanarWorld(CraftWorld):
         first = max(f.stop for f in self.AGENT_FIELDS.values())
         return {
             **self.AGENT_FIELDS,
-            "objects": slice(first, first + 3 * len(self._kinds)),
-            "object_names": tuple(self.task.objects[k].name for k in self._kinds),
-            "inventory": slice(self._inv_offset, self._inv_offset + len(self.inventory_counts)),
+            "objects": slice(first, first + 3 * len(self.kinds)),
+            "object_names": tuple(self.task.objects[k].name for k in self.kinds),
+            "inventory": slice(self.inv_offset, self.inv_offset + len(self.inventory_counts)),
             "inventory_names": self.rules.inventory_names,
         }
 
@@ -148,7 +150,7 @@ class PlanarWorld(CraftWorld):
     def remaining_counts(self) -> list[int]:
         """Objects of each kind still in the world (places are never used up)."""
         counts = [0] * len(self.task.objects)
-        for i, kind in enumerate(self._kinds):
+        for i, kind in enumerate(self.kinds):
             counts[kind] += bool(self._present[i])
         return counts
 
@@ -156,13 +158,13 @@ class PlanarWorld(CraftWorld):
     def objects(self) -> ObjectSlots:
         """The object slots now: kinds, positions, present, within reach. Built when asked
         for, never on a step."""
-        return ObjectSlots(_frozen(np.array(self._kinds)), _frozen(self._positions.copy()),
+        return ObjectSlots(_frozen(np.array(self.kinds)), _frozen(self._positions.copy()),
                            _frozen(self._present.copy()), _frozen(self._inside.copy()))
 
     def object_positions(self) -> dict[str, list[tuple[float, float]]]:
         """Positions of the objects still in the world, by object name."""
         out: dict[str, list[tuple[float, float]]] = {o.name: [] for o in self.task.objects}
-        for i, kind in enumerate(self._kinds):
+        for i, kind in enumerate(self.kinds):
             if self._present[i]:
                 out[self.task.objects[kind].name].append(tuple(float(v) for v in self._positions[i].round(4)))
         return out
@@ -171,7 +173,7 @@ class PlanarWorld(CraftWorld):
         """Apply the rules to every object whose zone the agent is in; return (label, reward).
         An item is touched while within reach, a place acts on entering its zone."""
         inv = self.inventory_counts
-        reward, gained, arrived, touched = touch_slots(self.rules, inv, self._kinds, self._is_item, inside,
+        reward, gained, arrived, touched = touch_slots(self.rules, inv, self.kinds, self.is_item, inside,
                                                        self._inside, reward, self._consume)
         if touched:
             self._write_inventory()
@@ -188,7 +190,7 @@ class PlanarWorld(CraftWorld):
         """What else consuming slot ``i`` changes (``_present`` is cleared already)."""
 
     def _write_inventory(self) -> None:
-        off, scale = self._inv_offset, self.rules.scale
+        off, scale = self.inv_offset, self.rules.scale
         for s, count in enumerate(self.inventory_counts):
             self._obs[off + s] = count / scale[s]
 

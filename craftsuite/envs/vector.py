@@ -313,12 +313,12 @@ class GridVectorEnv(CraftVectorEnv):
         super().__init__(template, num_envs, product, max_episode_steps, autoreset_mode)
         self.size = size
         self._n_cells = size * size
-        self._inv_offset = template._inv_offset
-        self._inv_scale = template._inv_scale
+        self.inv_offset = template.inv_offset
+        self.inv_scale = template.inv_scale
         self._cells = np.full((num_envs, self._n_cells), EMPTY, dtype=np.int16)
         self._agent = np.zeros(num_envs, dtype=np.int64)
         self._rows = np.arange(num_envs)
-        self._next_cell = self._move_table(size, template._obstacles)
+        self._next_cell = self._move_table(size, template.obstacles)
 
     @staticmethod
     def _move_table(size: int, obstacles: list[int]) -> np.ndarray:
@@ -375,7 +375,7 @@ class GridVectorEnv(CraftVectorEnv):
             if outcome.consumed:
                 self._cells[i, cell] = EMPTY
                 self._obs[i, (2 + kind) * self._n_cells + cell] = 0.0
-            off, scale = self._inv_offset, self._inv_scale
+            off, scale = self.inv_offset, self.inv_scale
             for s, count in enumerate(inv):
                 self._obs[i, off + s] = count / scale[s]
             self._levels[i] = labeller.levels(inv)
@@ -418,11 +418,11 @@ class PlanarVectorEnv(CraftVectorEnv):
             self._present[i, j] = False
             self._remove(i, j)
 
-        reward, gained, arrived, touched = touch_slots(rules, inv, self._kinds, self._is_item, inside,
+        reward, gained, arrived, touched = touch_slots(rules, inv, self.kinds, self.is_item, inside,
                                                        self._inside[i], float(rewards[i]), consume)
         rewards[i] = reward
         if touched:
-            scale, off = rules.scale, self._inv_offset
+            scale, off = rules.scale, self.inv_offset
             for s, count in enumerate(inv):
                 self._obs[i, off + s] = count / scale[s]
             self._levels[i] = labeller.levels(inv)
@@ -446,18 +446,18 @@ class KinematicVectorEnv(PlanarVectorEnv):
         kwargs.pop("render_mode", None)
         template = KinematicWorldEnv(task, **kwargs)
         super().__init__(template, num_envs, product, max_episode_steps, autoreset_mode)
-        n_obj = len(template._kinds)
+        n_obj = len(template.kinds)
         self.board = template.board
         self._objective_ends = not self.board.ends_by_tile
-        self._kinds = list(template._kinds)
-        self._cell_bits = template._cell_bits
-        self._boxes = template._obstacles
+        self.kinds = list(template.kinds)
+        self.cell_bits = template.cell_bits
+        self._boxes = template.obstacles
         self.arena, self.half = template.arena, template.half
         self._authors = template.observation == "authors"
-        self._radius2 = template.radius ** 2
+        self.radius2 = template.radius ** 2
         self._step_size = template.step_size
-        self._boundary_reward = template._boundary_reward
-        self._inv_offset = template._inv_offset
+        self.boundary_reward = template.boundary_reward
+        self.inv_offset = template.inv_offset
         self._scale = np.array(self.rules.scale)
         self._position = np.zeros((num_envs, 2))
         self._positions = np.zeros((num_envs, n_obj, 2))
@@ -480,12 +480,12 @@ class KinematicVectorEnv(PlanarVectorEnv):
         ended = self._world_ended
         ended[:] = False
         # the authors reject a move off the board: the agent stays and touches nothing
-        rewards[active & ~on] += self._boundary_reward
+        rewards[active & ~on] += self.boundary_reward
         self._position[on] = target[on]
         offsets = self._positions - self._position[:, None, :]
-        inside = self._present & (np.einsum("nij,nij->ni", offsets, offsets) < self._radius2)
+        inside = self._present & (np.einsum("nij,nij->ni", offsets, offsets) < self.radius2)
         inside &= on[:, None]
-        board, labeller, kinds = self.board, self.labeller, self._kinds
+        board, labeller, kinds = self.board, self.labeller, self.kinds
         for i in np.flatnonzero(inside.any(axis=1)).tolist():
             inv = self._inventories[i]
             j, outcome = board.first_acting(inv, [(j, kinds[j]) for j in np.flatnonzero(inside[i]).tolist()])
@@ -497,11 +497,11 @@ class KinematicVectorEnv(PlanarVectorEnv):
                 self._present[i, j] = False
             self._levels[i] = labeller.levels(inv)
             masks[i] = labeller(inv, outcome.gained, outcome.arrived)
-            off = self._inv_offset
+            off = self.inv_offset
             self._obs[i, off:off + len(inv)] = inv if self._authors else np.asarray(inv) / self._scale
-        if self._cell_bits:
+        if self.cell_bits:
             cell = np.floor(self._position)
-            for bit, j in self._cell_bits:
+            for bit, j in self.cell_bits:
                 here = self._present[:, j] & (np.floor(self._positions[:, j]) == cell).all(axis=1)
                 masks[here] |= bit
         self._write_observation(offsets)
@@ -510,7 +510,7 @@ class KinematicVectorEnv(PlanarVectorEnv):
     def _write_observation(self, offsets: np.ndarray) -> None:
         """``KinematicWorldEnv._write_observation`` for all envs (the inventory is written on
         acts and resets, the only times it changes)."""
-        obs, n_obj, present = self._obs, len(self._kinds), self._present
+        obs, n_obj, present = self._obs, len(self.kinds), self._present
         if self._authors:
             obs[:, 0:2] = self._position / self.arena
             obs[:, 2:2 + n_obj] = np.where(present, np.sqrt((offsets ** 2).sum(axis=2)) / self.arena, 0.0)

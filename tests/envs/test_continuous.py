@@ -71,7 +71,7 @@ def test_acceptance_exactly_when_blind_craftsman_is_done():
 def test_pickup_radius_is_0_4():
     env = make("DungeonQuest")
     env.reset(seed=0)
-    key = env._kinds.index([o.name for o in env.task.objects].index("key"))
+    key = env.kinds.index([o.name for o in env.task.objects].index("key"))
     kx, ky = env._positions[key]
     direction = -np.sign([kx, ky]) * np.array([1.0, 0.0])  # move towards the arena centre
     if not direction.any():
@@ -93,7 +93,7 @@ def test_places_act_on_arrival_only():
     env = make("DungeonQuest")
     env.reset(seed=0)
     env.inventory_counts[env.rules.inventory_names.index("key")] = 1
-    chest = env._kinds.index([o.name for o in env.task.objects].index("chest"))
+    chest = env.kinds.index([o.name for o in env.task.objects].index("chest"))
     place_agent(env, env._positions[chest] + [0.1, 0.0])
     env.step(np.zeros(2))
     assert env.inventory["sword"] == 1 and env.inventory["key"] == 0

@@ -66,7 +66,7 @@ def test_an_off_board_move_is_rejected_with_the_penalty(start, action):
 def test_a_rejected_move_touches_nothing_even_beside_an_object():
     env = fresh()
     clear_objects(env)
-    wood = env._kinds.index(0)
+    wood = env.kinds.index(0)
     env._position = np.array([6.5, 3.0])
     env._positions[wood] = (6.6, 3.0)  # within reach, but the move is rejected
     env.step(np.array([1.0, 0.0], dtype=np.float32))
@@ -77,7 +77,7 @@ def test_a_rejected_move_touches_nothing_even_beside_an_object():
 def test_pickup_within_0_4(gap, picked):
     env = fresh()
     clear_objects(env)
-    wood = env._kinds.index(0)  # BlindCraftsman's first item: wood, free to pick up
+    wood = env.kinds.index(0)  # BlindCraftsman's first item: wood, free to pick up
     env._position = np.array([2.0, 2.0])
     env._positions[wood] = (5.0 + gap, 2.0)
     env.step(np.array([1.0, 0.0], dtype=np.float32))
@@ -88,7 +88,7 @@ def test_pickup_within_0_4(gap, picked):
 def test_home_is_the_corner_and_the_first_slot():
     for seed in range(5):
         env = fresh(seed=seed)
-        home = env._kinds.index(env.task.objects.index(next(p for p in env.task.places if p.name == "home")))
+        home = env.kinds.index(env.task.objects.index(next(p for p in env.task.places if p.name == "home")))
         assert home == 0 and tuple(env._positions[0]) == (0.0, 0.0)
         assert not any((p == 0).all() for p in env._positions[1:])  # nothing else on (0, 0)
 
@@ -96,7 +96,7 @@ def test_home_is_the_corner_and_the_first_slot():
 def test_wood_touched_at_capacity_is_used_up_and_clipped():
     env = fresh()
     clear_objects(env)
-    woods = [j for j, k in enumerate(env._kinds) if k == 0]
+    woods = [j for j, k in enumerate(env.kinds) if k == 0]
     env.inventory_counts[0] = 2  # already carrying two
     env._position = np.array([1.0, 1.0])
     env._positions[woods[0]] = (4.0, 1.0)
@@ -108,7 +108,7 @@ def test_wood_touched_at_capacity_is_used_up_and_clipped():
 def test_the_factory_turns_one_wood_a_step_while_in_reach():
     env = fresh()
     clear_objects(env)
-    factory = env._kinds.index(1)
+    factory = env.kinds.index(1)
     env.inventory_counts[0] = 2
     env._position = np.array([3.0, 3.0])
     env._positions[factory] = (3.0, 3.0)
@@ -139,7 +139,7 @@ def test_a_tile_that_ends_the_episode_with_the_objective_unmet_is_no_success():
     env = gym.make("CraftSuite/GoldMine-Kinematic-v0").unwrapped
     env.reset(seed=0)
     clear_objects(env)
-    home = env._kinds.index(next(k for k, o in enumerate(env.task.objects) if o.name == "home"))
+    home = env.kinds.index(next(k for k, o in enumerate(env.task.objects) if o.name == "home"))
     env._positions[home] = (0.0, 0.0)
     env._position = np.array([0.9, 0.9])
     _, _, term, _, info = env.step(np.array([-0.1, -0.1], dtype=np.float32))  # in home's cell, no silver
@@ -254,7 +254,7 @@ def test_random_play_matches_a_reimplementation_of_the_authors_step():
     env = gym.make(BC)
     u = env.unwrapped
     rng = np.random.default_rng(0)
-    names = [env.unwrapped.task.objects[k].name for k in u._kinds]
+    names = [env.unwrapped.task.objects[k].name for k in u.kinds]
     completed, at_capacity_losses = 0, 0
     for seed in range(60):
         obs, _ = env.reset(seed=seed)

@@ -207,7 +207,7 @@ def test_suites_train_each_cell_as_one_population():
 
 def test_each_member_logs_to_tensorboard_as_an_sb3_run_and_a_resume_drops_what_the_kill_logged(tmp_path,
                                                                                              monkeypatch):
-    from ..runner.test_training import _hparams, _scalar_steps
+    from ..test_training import _hparams, _scalar_steps
 
     configs = _cell("dqn", "Grid7", "FirstTool", seeds=(0, 1), layout_seed=0)
     checkpoint, calls = population_train._checkpoint, {"n": 0}

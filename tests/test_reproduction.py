@@ -9,7 +9,7 @@ from craftsuite.cli import main
 from craftsuite.reporting.pages import PAPER_REFERENCE
 from craftsuite.reproduction import FIGURE_5, write_report
 
-from ..reporting.fakes import fake_run
+from .reporting.fakes import fake_run
 
 
 def _seeds(root, method, success, world="Kinematic", task="BlindCraftsman", seeds=5, ret=0.0, **config):

@@ -9,7 +9,7 @@ from craftsuite.cli import main
 from craftsuite.record_format import (FILES, RecordError, check_config, check_episodes, check_evals, check_result,
                                       markdown)
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_the_docs_page_is_the_format_as_it_is():

@@ -104,7 +104,7 @@ def test_the_record_is_the_suites_protocol_for_the_rung():
 def test_the_leaderboard_sets_self_reported_runs_beside_every_regimes_own(tmp_path):
     from craftsuite.cli import main
 
-    from ..reporting.fakes import fake_run
+    from .reporting.fakes import fake_run
 
     archive, mine, out = tmp_path / "archive", tmp_path / "mine", tmp_path / "board"
     for seed in range(3):
@@ -160,7 +160,7 @@ def test_two_recorders_of_one_run_are_refused(tmp_path):
 def test_several_directories_need_an_output_of_their_own(tmp_path, capsys):
     from craftsuite.cli import main
 
-    from ..reporting.fakes import fake_run
+    from .reporting.fakes import fake_run
 
     for root in ("a", "b"):
         fake_run(tmp_path / root, "td3", 0, [(1000, 1.0)], [(995, 1.0)])

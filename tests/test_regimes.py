@@ -10,7 +10,7 @@ from craftsuite.reporting.board import build
 from craftsuite.reporting.pages import comparisons_markdown, leaderboard_markdown
 from craftsuite.suites import SUITES
 
-from ..reporting.fakes import fake_run
+from .reporting.fakes import fake_run
 
 
 @pytest.mark.parametrize("settings, name", [

@@ -72,6 +72,39 @@ def distances(automaton, forward: bool = False) -> list[int | None]:
     return out
 
 
+def route(automaton, state: int) -> list[str] | None:
+    """How the automaton reaches ``state`` from its initial state in the fewest edges (self-
+    loops and the rejecting sink left out), an edge named by the one proposition whose
+    label alone takes it, or by its guard where none does: what a page names a state by
+    (e.g. ``["key", "sword"]``; [] for the initial state, None for one out of reach)."""
+    came: dict[int, tuple[int, str]] = {}
+    frontier, seen = [automaton.initial], {automaton.initial}
+    while frontier and state not in seen:
+        nxt = []
+        for q in frontier:
+            for _, target in [e for e in automaton.edges() if e[0] == q]:
+                if target in seen:
+                    continue
+                seen.add(target)
+                came[target] = (q, _edge_name(automaton, q, target))
+                nxt.append(target)
+        frontier = nxt
+    if state not in seen:
+        return None
+    names = []
+    while state != automaton.initial:
+        state, name = came[state]
+        names.append(name)
+    return names[::-1]
+
+
+def _edge_name(automaton, source: int, target: int) -> str:
+    for i, name in enumerate(automaton.propositions):
+        if automaton.step(source, 1 << i) == target:
+            return name
+    return automaton.guard(source, target, sink_free=True)
+
+
 def _mask(text) -> int | None:
     """A ``seen`` or ``states`` cell: None where the row has none (logged before the column)."""
     return None if text in (None, "") else int(text)

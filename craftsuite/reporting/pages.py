@@ -182,7 +182,8 @@ def obstacles_markdown(rows: list[Entry]) -> list[str]:
     ``THRESHOLD`` for every row), what each method's training episodes reached
     (``craftsuite.reporting.obstacles``): completions per 100k transitions, the visited
     automaton state closest to acceptance, and the share of episodes each proposition held in."""
-    from .obstacles import completed_per_100k, method_progress
+    from ..task_registry import resolve_task
+    from .obstacles import completed_per_100k, method_progress, route
 
     if not rows or any(_finite_mean(e.values["success"]) >= THRESHOLD for e in rows):
         return []
@@ -208,7 +209,11 @@ def obstacles_markdown(rows: list[Entry]) -> list[str]:
             furthest = reached = "not recorded"
         else:
             f = progress.furthest
-            furthest = (f"state {f.state}, {f.distance} edge{'s' if f.distance != 1 else ''} from acceptance "
+            after = route(resolve_task(e.task).automaton, f.state)
+            where = {None: "", (): " (the initial)"}.get(None if after is None else tuple(after),
+                                                          f" (after {', '.join(after or [])})")
+            furthest = (f"state {f.state}{where}"
+                        + f", {f.distance} edge{'s' if f.distance != 1 else ''} from acceptance "
                         f"({f.share:.0%} of episodes)")
             reached = ", ".join(f"{p} {share:.0%}" for p, share in progress.seen_share.items())
         lines.append(f"| {e.label} | {len(e.seeds)} | {per_100k:.1f} | {furthest} | {reached} |")

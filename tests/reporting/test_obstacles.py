@@ -133,3 +133,15 @@ def test_bad_records_are_named(tmp_path):
     (teacher / "config.json").write_text(json.dumps({**record, "max_steps": 1_000}))
     with pytest.raises(RunError, match="no transitions budget"):
         episode_progress(teacher)
+
+
+def test_a_state_is_named_by_the_fewest_edges_that_reach_it():
+    from craftsuite.reporting.obstacles import route
+    from craftsuite.task_registry import resolve_task
+
+    automaton = resolve_task("KeySwordDragon").automaton
+    named = {q: route(automaton, q) for q in range(automaton.n_states)}
+    assert named[automaton.initial] == []
+    assert ["key", "sword", "dragon"] in named.values()  # acceptance: each step a proposition of its own
+    sink = int(automaton.rejecting.nonzero()[0][0])
+    assert named[sink] is None  # the rejecting sink is reached by no edge the route takes

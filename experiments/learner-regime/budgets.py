@@ -54,20 +54,13 @@ def choose(curve: list[tuple[int, float]], budget: int) -> tuple[int, str]:
 
 
 def main(argv=None) -> None:
+    driver = _driver()
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--setting", required=True, help="the adopted setting's name in run.py, e.g. n3")
-    parser.add_argument("--wave", type=int, default=1, help="the wave whose settings name it")
-    parser.add_argument("--n", type=int, nargs=2, metavar=("TD3_N", "DQN_N"))
-    parser.add_argument("--winners", nargs=2, metavar=("TD3", "DQN"))
-    parser.add_argument("--runs", type=Path, nargs="+",
-                        default=[Path("results/learner-regime"), Path(__file__).parent / "results",
-                                 Path("results/n-step-returns"), Path("results")])
+    driver.reader_arguments(parser)
     args = parser.parse_args(argv)
-    driver = _driver()
-    ns = {"Cont": args.n[0], "Grid10": args.n[1]} if args.n else {"Cont": None, "Grid10": None}
-    winners = dict(zip(("Cont", "Grid10"), map(driver.parse_winners, args.winners or ("none", "none")), strict=True))
-    found = {run.name: run for root in args.runs if root.is_dir() for run in root.glob("*/students/*")
-             if (run / "result.json").exists()}
+    ns, winners = driver.read_settings(args)
+    found = driver.finished_runs(args.runs)
     print("| rung | budget now | seeds | mean greedy success at the evaluations | budget by the rule | why |")
     print("|---|---|---|---|---|---|")
     for name, c in driver.configs("standard", args.wave, ns, winners):

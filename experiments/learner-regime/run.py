@@ -104,6 +104,31 @@ def parse_winners(text: str) -> list[str]:
     return [] if text == "none" else [name for name in text.split(",") if name]
 
 
+# where the readers (table.py, budgets.py) find the runs: the archive's and this folder's
+READ_FROM = (Path("results/learner-regime"), Path(__file__).parent / "results", Path("results/n-step-returns"),
+             Path("results"))
+
+
+def reader_arguments(parser: argparse.ArgumentParser, wave_default: int = 1) -> None:
+    """The readers' arguments naming a wave's settings and where its runs lie."""
+    parser.add_argument("--wave", type=int, choices=tuple(WAVES), default=wave_default)
+    parser.add_argument("--n", type=int, nargs=2, metavar=("TD3_N", "DQN_N"), help="wave 1's winners (waves 2, 3)")
+    parser.add_argument("--winners", nargs=2, metavar=("TD3", "DQN"), help="wave 3: wave 2's winners, as run.py's")
+    parser.add_argument("--runs", type=Path, nargs="+", default=list(READ_FROM))
+
+
+def read_settings(args) -> tuple[dict, dict]:
+    """The worlds' n and wave-2 winners that the readers' arguments name."""
+    ns = {"Cont": args.n[0], "Grid10": args.n[1]} if args.n else {"Cont": None, "Grid10": None}
+    return ns, dict(zip(("Cont", "Grid10"), map(parse_winners, args.winners or ("none", "none")), strict=True))
+
+
+def finished_runs(roots) -> dict[str, Path]:
+    """The finished runs under ``roots`` (each a directory of suites' runs), by run name."""
+    return {run.name: run for root in map(Path, roots) if root.is_dir() for run in root.glob("*/students/*")
+            if (run / "result.json").exists()}
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--wave", type=int, choices=tuple(WAVES), required=True)

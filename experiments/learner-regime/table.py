@@ -28,11 +28,7 @@ def _driver():
 def auc_by_setting(driver, wave: int, ns: dict, roots: list[Path], winners: dict | None = None) -> dict:
     """{(world, setting): [AUCs of rung 1's seeds, rung 2's, ...]} for the runs found under
     ``roots`` (each a directory of a suite's runs)."""
-    found = {}
-    for root in roots:
-        for run in root.glob("*/students/*") if root.is_dir() else []:
-            if (run / "result.json").exists():
-                found[run.name] = run
+    found = driver.finished_runs(roots)
     out = {}
     for suite in driver.RUNGS:
         for name, c in driver.configs(suite, wave, ns, winners):
@@ -63,17 +59,11 @@ def decide(order: list[str], aucs: dict[str, list], rungs: int, seeds: int) -> t
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--wave", type=int, choices=(1, 2, 3), default=1)
-    parser.add_argument("--n", type=int, nargs=2, metavar=("TD3_N", "DQN_N"))
-    parser.add_argument("--winners", nargs=2, metavar=("TD3", "DQN"), help="wave 3: as run.py's")
-    parser.add_argument("--runs", type=Path, nargs="+",
-                        default=[Path("results/learner-regime"), Path(__file__).parent / "results",
-                                 Path("results/n-step-returns"), Path("results")])
-    args = parser.parse_args(argv)
     driver = _driver()
-    ns = {"Cont": args.n[0], "Grid10": args.n[1]} if args.n else {"Cont": None, "Grid10": None}
-    winners = dict(zip(("Cont", "Grid10"), map(driver.parse_winners, args.winners or ("none", "none")), strict=True))
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    driver.reader_arguments(parser)
+    args = parser.parse_args(argv)
+    ns, winners = driver.read_settings(args)
     aucs = auc_by_setting(driver, args.wave, ns, args.runs, winners)
     for world, algorithm in driver.SCRATCH.items():
         settings = driver.settings_for(args.wave, world, ns[world], winners[world])

@@ -66,17 +66,19 @@ def test_a_members_model_acts_as_the_member(tmp_path, monkeypatch):
         np.testing.assert_array_equal(agent.predict(obs[k], deterministic=True)[0], greedy[k])
 
 
-def _killed_at_the_second_evaluation(configs, root, monkeypatch) -> None:
-    evaluate, calls = population_train._evaluate, {"n": 0}
+def _killed_at_the_second_evaluation(configs, root, monkeypatch, at: str = "_evaluate") -> None:
+    """The population killed at the second call of ``at``: its evaluation (before it is
+    made), or ``_checkpoint`` (the evaluation made and logged, its checkpoint not)."""
+    real, calls = getattr(population_train, at), {"n": 0}
 
     def dies_at_the_second(*args):
         calls["n"] += 1
         if calls["n"] == 2:
             raise KeyboardInterrupt
-        evaluate(*args)
+        return real(*args)
 
     with monkeypatch.context() as patch:
-        patch.setattr(population_train, "_evaluate", dies_at_the_second)
+        patch.setattr(population_train, at, dies_at_the_second)
         with pytest.raises(KeyboardInterrupt):
             train_population(configs, root, progress=False)
 
@@ -210,18 +212,7 @@ def test_each_member_logs_to_tensorboard_as_an_sb3_run_and_a_resume_drops_what_t
     from ..test_training import _hparams, _scalar_steps
 
     configs = _cell("dqn", "Grid7", "FirstTool", seeds=(0, 1), layout_seed=0)
-    checkpoint, calls = population_train._checkpoint, {"n": 0}
-
-    def dies_at_the_second(*args):  # after the evaluation at 800 is logged, before its checkpoint
-        calls["n"] += 1
-        if calls["n"] == 2:
-            raise KeyboardInterrupt
-        checkpoint(*args)
-
-    with monkeypatch.context() as patch:
-        patch.setattr(population_train, "_checkpoint", dies_at_the_second)
-        with pytest.raises(KeyboardInterrupt):
-            train_population(configs, tmp_path, progress=False)
+    _killed_at_the_second_evaluation(configs, tmp_path, monkeypatch, at="_checkpoint")  # 800 logged, not kept
     killed = _scalar_steps(tmp_path / configs[0].run_name() / "tb" / "run_0")
     assert killed["eval/success_rate"] == [400, 800]  # logged, then lost with the kill
     paths = train_population(configs, tmp_path, progress=False)

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from . import ids
+from .ids import env_id, grid_id, grid_world, world_kind
 from .envs.grid import layout_kwargs
 from .hyperparameters import algorithm_settings
 from .methods import METHODS, check_methods
@@ -42,7 +42,7 @@ class TeacherConfig:
 
     @property
     def env_id(self) -> str:
-        return ids.grid_id(self.task, self.size)
+        return grid_id(self.task, self.size)
 
     @property
     def env_kwargs(self) -> dict:
@@ -54,7 +54,7 @@ class TeacherConfig:
         return _effective("product-dqn", self.hyperparameters, self.env_id, self.env_kwargs, self.task)
 
     def run_name(self) -> str:
-        return f"teacher-{self.task}-{ids.grid_world(self.size)}-s{self.seed}-{config_key(self)}"
+        return f"teacher-{self.task}-{grid_world(self.size)}-s{self.seed}-{config_key(self)}"
 
 
 @dataclass(frozen=True)
@@ -90,8 +90,8 @@ class StudentConfig:
             METHODS[self.method].observes(self.automaton_state)  # a MethodError naming both
             if self.automaton_state == METHODS[self.method].product:  # what the method does anyway: one run key
                 object.__setattr__(self, "automaton_state", None)
-        ids.world_kind(self.world)  # a ValueError naming the worlds there are
-        if layout_kwargs(self.layout_seed) and ids.world_kind(self.world) != "Grid":  # also checks the seed
+        world_kind(self.world)  # a ValueError naming the worlds there are
+        if layout_kwargs(self.layout_seed) and world_kind(self.world) != "Grid":  # also checks the seed
             raise ValueError(f"layout_seed fixes a grid instance; the {self.world} world has none "
                              "(its objects are placed anew every episode)")
         if not isinstance(self.world_kwargs, dict):
@@ -102,7 +102,7 @@ class StudentConfig:
 
     @property
     def env_id(self) -> str:
-        return ids.env_id(self.task, self.world)
+        return env_id(self.task, self.world)
 
     @property
     def product(self) -> bool:

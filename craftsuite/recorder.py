@@ -32,7 +32,7 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 
-from . import ids
+from .ids import env_id
 from .envs.grid import layout_kwargs
 from .runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, RunError, config_key
 
@@ -59,7 +59,7 @@ class RecordedConfig:
 
     @property
     def env_id(self) -> str:
-        return ids.env_id(self.task, self.world)
+        return env_id(self.task, self.world)
 
     @property
     def env_kwargs(self) -> dict:

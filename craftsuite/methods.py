@@ -159,7 +159,6 @@ _ROWS = {m.name: m for m in (
 METHODS = MappingProxyType(_ROWS)
 BUILTIN = tuple(_ROWS)  # the package's own rows, in table order
 ENTRY_POINTS = "craftsuite.methods"  # the entry-point group of installed packages' rows
-_MODULES: list[str] = []  # the user modules ``resolve_method`` imported
 _NAME = re.compile(r"[a-z0-9][a-z0-9.]*(-[a-z0-9.]+)*\Z")  # as the package's rows: lowercase, digits, dashes
 
 
@@ -204,8 +203,6 @@ def resolve_method(text: str) -> str:
         except ImportError as err:
             raise ValueError(f"method {text!r}: module {module!r} cannot be imported ({err}); put it on the "
                              "Python path (PYTHONPATH) or install its package") from None
-        if module not in _MODULES:
-            _MODULES.append(module)
     check_methods([name])
     return name
 

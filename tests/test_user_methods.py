@@ -28,7 +28,6 @@ def user_module(tmp_path, monkeypatch):
     yield "my_methods"
     for name in [n for n in METHODS if n not in methods.BUILTIN]:
         del methods._ROWS[name]
-    methods._MODULES.clear()
     sys.modules.pop("my_methods", None)
 
 

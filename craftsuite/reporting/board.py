@@ -119,8 +119,8 @@ def run_metrics(run: Path) -> dict | None:
     episodes = [(int(e["step"]), float(e["return"]), int(e["success"])) for e in raw_episodes]
     evals = [(int(float(e["step"])), float(e["success"]), float(e.get("length") or "nan")) for e in raw_evals]
     auc = float(np.mean([s for _, s, _ in evals])) if evals else float("nan")
-    every = config.get("eval_every")
-    if regime_of(config) == SELF_REPORTED and isinstance(every, int) and every > 0:
+    every, regime = config.get("eval_every"), regime_of(config)
+    if regime == SELF_REPORTED and isinstance(every, int) and every > 0:
         # its loop chose when to evaluate: a curve short of the suite's schedule has no comparable area
         schedule = {*range(every, budget, every), budget}
         if not schedule <= {step for step, _, _ in evals}:
@@ -133,7 +133,7 @@ def run_metrics(run: Path) -> dict | None:
     world, world_kwargs = world_of(config)
     return {
         "task": config["task"], "world": world, "world_kwargs": world_kwargs, "method": config["method"],
-        "regime": regime_of(config), "seed": config["seed"], "budget": budget, "steps": result["steps"],
+        "regime": regime, "seed": config["seed"], "budget": budget, "steps": result["steps"],
         "updates": result.get("updates"),
         "success": success[-1] if success else float("nan"),
         "return": float(np.mean([r for _, r, _ in tail])) if tail else float("nan"),

@@ -78,11 +78,12 @@ def route(automaton, state: int) -> list[str] | None:
     label alone takes it, or by its guard where none does: what a page names a state by
     (e.g. ``["key", "sword"]``; [] for the initial state, None for one out of reach)."""
     came: dict[int, tuple[int, str]] = {}
+    edges = automaton.edges()  # (the sink's left out)
     frontier, seen = [automaton.initial], {automaton.initial}
     while frontier and state not in seen:
         nxt = []
         for q in frontier:
-            for _, target in [e for e in automaton.edges() if e[0] == q]:
+            for _, target in [e for e in edges if e[0] == q]:
                 if target in seen:
                     continue
                 seen.add(target)

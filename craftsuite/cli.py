@@ -237,7 +237,7 @@ def _teacher(args) -> int:
                            layout_seed=None if args.layout_seed < 0 else args.layout_seed,
                            seed=args.seed, max_steps=args.max_steps, target_success=args.target_success,
                            eval_every=args.eval_every, eval_episodes=args.eval_episodes,
-                           hyperparameters=_hyper(args.hyper, "dqn"), n_envs=args.n_envs)
+                           hyperparameters=_hyper(args.hyper, "dqn"), n_envs=args.n_envs, engine=args.engine)
     path = train_teacher(config, args.out)
     print((path / "result.json").read_text().strip())
     print(f"teacher run: {path}\n  teacher: {path / 'teacher.zip'}\n  dynamic table: {path / 'table.npz'}")
@@ -264,6 +264,11 @@ def _distill(args) -> int:
             if not (source / "config.json").is_file():
                 raise FileNotFoundError(f"{source} is not a teacher run directory (no config.json)")
             config = load_config(TeacherConfig, source)
+            if config.engine == "population":
+                from .population.teacher import distill_run
+
+                table, automaton = distill_run(source)
+                return _write_table(table, automaton, args)
             env_id, env_kwargs = config.env_id, config.env_kwargs
             saved = RunDir(source, config).last_checkpoint()
             if saved is None:
@@ -280,6 +285,10 @@ def _distill(args) -> int:
         teacher.load_replay_buffer(replay)
         table = distill_from_replay(teacher)
         automaton = teacher.get_env().envs[0].unwrapped.automaton
+    return _write_table(table, automaton, args)
+
+
+def _write_table(table, automaton, args) -> int:
     table.save(args.out)
     print(table.describe(automaton))
     print(f"wrote {args.out}")
@@ -515,11 +524,14 @@ DEBUG_HELP = "on an error, show the full traceback instead of one line"
 
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
-    from .configs import ENGINES
+    from .configs import DEFAULT_ENGINE, ENGINES
     from .methods import METHODS
     from .regimes import REGIMES
     from .suites import SUITES
     from .task_registry import SPEC_SUFFIX, ladder
+
+    engine_help = (f"what trains the run: {DEFAULT_ENGINE} (default; the population engine, here a population of "
+                   "one) or sb3 (one SB3 agent: the paper suite's residual CNN)")
 
     parser = argparse.ArgumentParser(prog="craftsuite", description=__doc__, formatter_class=_HelpFormatter)
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
@@ -570,6 +582,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--hyper", help="JSON overrides of the DQN settings, e.g. '{\"learning_rate\": 1e-3}'")
     p.add_argument("--n-envs", type=_positive, default=1,
                    help="envs stepped side by side; each agent step collects one transition from each (default: 1)")
+    p.add_argument("--engine", choices=ENGINES, default=DEFAULT_ENGINE, help=engine_help)
     p.set_defaults(run=_teacher)
 
     p = sub.add_parser("distill", help="distil a teacher (dynamic) or a task's automaton (static) into a table")
@@ -603,8 +616,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--env", help="JSON gymnasium.make keywords beyond the registered world, e.g. the "
                    "fine-control MuJoCo world '{\"frame_skip\": 2, \"max_episode_steps\": 1000}'")
     p.add_argument("--layout-seed", type=_seed, help="grid worlds: one fixed instance (default: a new one per episode)")
-    p.add_argument("--engine", choices=ENGINES, default="sb3", help="sb3 (default: one SB3 agent) or population "
-                   "(the same run by the population engine)")
+    p.add_argument("--engine", choices=ENGINES, default=DEFAULT_ENGINE, help=engine_help)
     p.add_argument("--automaton-state", type=_on_off, metavar="on|off",
                    help="whether a distilled student sees the automaton state (default: as its method; the paper's "
                    "authors' students did not)")

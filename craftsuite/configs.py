@@ -20,6 +20,10 @@ from .task_registry import resolve_task
 
 
 ENGINES = ("sb3", "population")
+# What trains a run unless it says otherwise: the command line's default and the suites'.
+# (A config's ``engine`` field defaults to "sb3" for another reason: a record written before
+# the field existed was an SB3 run, and keeps its run key.)
+DEFAULT_ENGINE = "population"
 
 
 @dataclass(frozen=True)
@@ -35,10 +39,28 @@ class TeacherConfig:
     hyperparameters: dict = field(default_factory=dict)  # overrides of DQN_DEFAULTS
     # envs stepped side by side: each agent step collects n_envs transitions (the authors' 10)
     n_envs: int = field(default=1, metadata={"omit_if_default": True})
+    # what trains it (as StudentConfig's engine): a part of the run key
+    engine: str = field(default="sb3", metadata={"omit_if_default": True})
+
+    # A teacher is a product-DQN run on its grid that stops at a greedy-success target: what
+    # a trainer reads of a student's config, it reads of a teacher's under the same names.
+    method = "product-dqn"
+    product = True
+    table = None
+    automaton_state = None
 
     def __post_init__(self):
         _check_n_envs(self.n_envs)
+        _check_engine(self.engine)
         layout_kwargs(self.layout_seed)  # a ValueError for a bad seed
+
+    @property
+    def steps(self) -> int:
+        return self.max_steps
+
+    @property
+    def world(self) -> str:
+        return grid_world(self.size)
 
     @property
     def env_id(self) -> str:
@@ -84,8 +106,7 @@ class StudentConfig:
 
     def __post_init__(self):
         _check_n_envs(self.n_envs)
-        if self.engine not in ENGINES:
-            raise ValueError(f"engine must be one of {list(ENGINES)}, got {self.engine!r}")
+        _check_engine(self.engine)
         if self.method in METHODS:  # an unknown method is named where it is used (check_methods)
             METHODS[self.method].observes(self.automaton_state)  # a MethodError naming both
             if self.automaton_state == METHODS[self.method].product:  # what the method does anyway: one run key
@@ -132,6 +153,11 @@ class StudentConfig:
         return {k: v for k, v in asdict(self).items() if k != "seed"}
 
 
+def _check_engine(engine) -> None:
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
+
+
 def _check_n_envs(n_envs) -> None:
     if not isinstance(n_envs, int) or isinstance(n_envs, bool) or n_envs < 1:
         raise ValueError(f"n_envs must be a positive integer, got {n_envs!r}")
@@ -152,3 +178,12 @@ def student_result(config: StudentConfig, algorithm: str, steps: int, updates: i
             "task": config.task, "seed": config.seed, "steps": int(steps), "updates": int(updates),
             "product": config.product, "env_kwargs": config.env_kwargs, "model": "model.zip",
             **more, "seconds_this_session": round(seconds, 1)}
+
+
+def teacher_result(config: TeacherConfig, algorithm: str, steps: int, updates: int, success: float,
+                   seconds: float, **more) -> dict:
+    """A finished teacher's ``result.json``, whichever engine trained it: its last greedy
+    ``success`` and whether that reached its target, beside its model and table."""
+    return {"kind": "teacher", "env_id": config.env_id, "algorithm": algorithm, "steps": int(steps),
+            "updates": int(updates), "success": success, "reached_target": success >= config.target_success,
+            **more, "seconds_this_session": round(seconds, 1), "table": "table.npz", "model": "teacher.zip"}

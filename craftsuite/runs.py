@@ -400,6 +400,18 @@ class RunDir:
             os.fsync(f.fileno())
 
 
+def last_success(run) -> float:
+    """The greedy success of the last evaluation of the run at ``run`` (0 before any)."""
+    evals = read_csv(Path(run) / "evals.csv")
+    return float(evals[-1]["success"]) if evals else 0.0
+
+
+def reached_target(run, target: float) -> bool:
+    """Whether the last evaluation of the run at ``run`` reached ``target`` greedy success
+    (a teacher's stopping rule)."""
+    return bool(read_csv(Path(run) / "evals.csv")) and last_success(run) >= target
+
+
 def read_csv(path, fields: tuple[str, ...] = (), required: bool = False) -> list[dict]:
     """A run's CSV log as rows (none if it is missing); ``<name>.gz`` beside a missing
     ``<name>`` is read instead (the results archive keeps ``episodes.csv`` compressed).

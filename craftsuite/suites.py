@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .configs import StudentConfig, TeacherConfig
+from .configs import DEFAULT_ENGINE, StudentConfig, TeacherConfig
 from .ids import CONT, KINEMATIC, world_kind
 from .methods import METHODS, check_methods, methods_for
 from .regimes import check_regime
@@ -66,9 +66,10 @@ class Suite:
     cont_world_kwargs: dict = field(default_factory=dict)
     # the same for the kinematic board (its ``size``)
     kinematic_world_kwargs: dict = field(default_factory=dict)
-    # what trains the students: "population" (the seeds of each cell in one process,
-    # craftsuite.population) or "sb3" (one SB3 agent per run); teachers are SB3 agents
-    engine: str = "population"
+    # what trains the teachers and students: "population" (the seeds of each cell in one
+    # process, craftsuite.population; a teacher is a population of one) or "sb3" (one SB3
+    # agent per run)
+    engine: str = DEFAULT_ENGINE
     # whether ``craftsuite transfer`` keeps its runs' records in the results archive by
     # default (``craftsuite.archive``); the quick suite trains afresh every time, for its video
     archived: bool = True
@@ -110,7 +111,7 @@ class Suite:
             return {}  # e.g. grid-only distillers in a MuJoCo-only suite: no teacher would be used
         return {spec.name: TeacherConfig(task=spec.name, max_steps=self.teacher_max_steps,
                                          layout_seed=self.teacher_layout_seed, n_envs=self.teacher_n_envs,
-                                         hyperparameters=dict(self.teacher_hyperparameters))
+                                         hyperparameters=dict(self.teacher_hyperparameters), engine=self.engine)
                 for spec in self.rungs()}
 
     def student_configs(self, teacher_root) -> list[StudentConfig]:

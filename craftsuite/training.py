@@ -21,10 +21,10 @@ import numpy as np
 import torch
 from stable_baselines3.common.callbacks import BaseCallback
 
-from .configs import StudentConfig, TeacherConfig, student_result
+from .configs import StudentConfig, TeacherConfig, student_result, teacher_result
 from .files import atomic_path
 from .runs import (EPISODE_FIELDS, EVAL_FIELDS, EVAL_METRICS, CheckpointError, RunDir, eval_seed, hparams,
-                   machine_errors, read_csv)
+                   last_success, machine_errors, reached_target)
 
 
 class Evaluation(NamedTuple):
@@ -241,8 +241,7 @@ def _learn_loop(run, agent, total, eval_every, eval_episodes, evaluate_fn, stop_
 
 
 def _stopped(run: RunDir, stop_at) -> bool:
-    evals = read_csv(run.path / "evals.csv")
-    return stop_at is not None and bool(evals) and float(evals[-1]["success"]) >= stop_at
+    return stop_at is not None and reached_target(run.path, stop_at)
 
 
 def _train(config, name: str, root, fresh, *, product: bool, total: int, stop_at: float | None, model: str,
@@ -281,6 +280,11 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
     """A teacher run under ``root``; returns its directory (with teacher.zip and table.npz)."""
     from .agents.factory import distill_from_replay, make_agent
 
+    if config.engine == "population":  # a population of one
+        from .population.teacher import train_teacher as train_population_teacher
+
+        return train_population_teacher(config, root, progress=progress)
+
     def fresh():
         return make_agent("product-dqn", config.env_id, seed=config.seed, n_envs=config.n_envs,
                           env_kwargs=config.env_kwargs, **config.effective()["hyperparameters"])
@@ -289,12 +293,8 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
         distill_from_replay(agent).save(run.path / "table.npz")
 
     def result(run, agent, seconds):
-        evals = read_csv(run.path / "evals.csv")
-        success = float(evals[-1]["success"]) if evals else 0.0
-        return {"kind": "teacher", "env_id": config.env_id, "algorithm": agent.algorithm,
-                "steps": int(agent.num_timesteps), "updates": int(agent.n_updates),
-                "success": success, "reached_target": success >= config.target_success,
-                "seconds_this_session": round(seconds, 1), "table": "table.npz", "model": "teacher.zip"}
+        return teacher_result(config, agent.algorithm, agent.num_timesteps, agent.n_updates,
+                              last_success(run.path), seconds)
 
     # the name checks the hyperparameters before a run directory exists; the last checkpoint
     # stays: `craftsuite distill` reads the replay there

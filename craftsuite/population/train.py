@@ -27,7 +27,7 @@ from ..files import atomic_path, atomic_write
 from ..ids import world_kind
 from ..methods import METHODS
 from ..reached import Reached, check_automaton
-from ..runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, eval_seed
+from ..runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, eval_seed, reached_target
 from .engine import EngineError, Population, check_supported, sparse_width
 from .envs import make_envs, step_records
 from .scalars import Scalars
@@ -102,7 +102,12 @@ def train_population(configs: list[StudentConfig], root, progress: bool = True, 
     return [root / n for n in names]
 
 
-def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=None) -> None:
+def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=None, stop_at=None,
+           finish=None) -> None:
+    """Train the ``todo`` (config, run) pairs together to their budget, or until every
+    member's greedy success reaches ``stop_at`` (a teacher's target); then
+    ``finish(pop, k, config, run, seconds)`` each member (a student's model and result by
+    default)."""
     from ..progress import progress_bar
 
     configs, runs = [c for c, _ in todo], [r for _, r in todo]
@@ -128,17 +133,24 @@ def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=No
         eval_envs = make_envs(config.env_id, K * config.eval_episodes, config.env_kwargs, config.product)
         stack.callback(eval_envs.close)
         with progress_bar(K * total, desc, initial=K * pop.num_timesteps, enabled=progress) as bar:
-            _loop(pop, envs, eval_envs, configs, runs, logs, bar, spec.automaton, on_evaluation)
+            _loop(pop, envs, eval_envs, configs, runs, logs, bar, spec.automaton, on_evaluation, stop_at)
         for k, (c, run) in enumerate(todo):
-            _finish(pop, k, c, run, table, time.perf_counter() - start, str(device))
+            seconds = time.perf_counter() - start
+            if finish is None:
+                _finish(pop, k, c, run, table, seconds, str(device))
+            else:
+                finish(pop, k, c, run, seconds)
     finally:
         stack.close()
         th.set_num_threads(threads)
 
 
-def _loop(pop: Population, envs, eval_envs, configs, runs, logs, bar, automaton, on_evaluation=None) -> None:
+def _loop(pop: Population, envs, eval_envs, configs, runs, logs, bar, automaton, on_evaluation=None,
+          stop_at=None) -> None:
     config = configs[0]
     K, n, total, every = pop.K, pop.n_envs, config.steps, config.eval_every
+    if stop_at is not None and all(reached_target(run.path, stop_at) for run in runs):
+        return  # killed after the evaluation that reached it: its checkpoint is that step's
     seeds = [c.seed + j for c in configs for j in range(n)]  # as SB3's make_vec_env seeds each run's envs
     obs, _ = envs.reset(seed=seeds)
     pop.restart_noise()
@@ -174,6 +186,9 @@ def _loop(pop: Population, envs, eval_envs, configs, runs, logs, bar, automaton,
             results = _evaluate(pop, configs, runs, logs, t, bar, eval_envs)
             if on_evaluation is not None:
                 on_evaluation(pop, t, results)
+            if stop_at is not None and all(r[0] >= stop_at for r in results):
+                _checkpoint(pop, runs)  # a teacher's replay, which `craftsuite distill` reads again
+                return  # before this step's updates, as SB3's callback stops a teacher before its train()
         pop.train()
         if evaluate:  # after them, so that a resumed population has taken every update of its steps
             _checkpoint(pop, runs)

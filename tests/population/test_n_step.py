@@ -309,7 +309,7 @@ def test_n_step_crm_trains_in_the_population_engine_and_the_sb3_engine_refuses_i
     with pytest.raises(ValueError, match="samples windows in the population engine only"):
         agent.replay_buffer.sample(4)
     assert main(["student", "Reach", "--world", "Grid7", "--method", "crm", "--hyper", '{"n_steps": 3}',
-                 "--out", str(tmp_path / "sb3")]) == 2
+                 "--engine", "sb3", "--out", str(tmp_path / "sb3")]) == 2
     assert not (tmp_path / "sb3").exists()
 
 

@@ -105,7 +105,8 @@ def test_shaping_rows_train_in_the_population_engine_and_the_sb3_engine_refuses_
 
     with pytest.raises(ValueError, match="reward shaping is trained by the population engine only"):
         make_agent("rs", "CraftSuite/FirstTool-Grid7-v0")  # an SB3 agent of it would learn unshaped
-    assert main(["student", "FirstTool", "--world", "Grid7", "--method", "rs", "--engine", "sb3", "--out", str(tmp_path / "sb3")]) == 2
+    assert main(["student", "FirstTool", "--world", "Grid7", "--method", "rs", "--engine", "sb3",
+                 "--out", str(tmp_path / "sb3")]) == 2
     assert not (tmp_path / "sb3").exists()
 
 

@@ -531,7 +531,7 @@ def build_parser() -> argparse.ArgumentParser:
     from .task_registry import SPEC_SUFFIX, ladder
 
     engine_help = (f"what trains the run: {DEFAULT_ENGINE} (default; the population engine, here a population of "
-                   "one) or sb3 (one SB3 agent: the paper suite's residual CNN)")
+                   "one) or sb3 (one SB3 agent per run)")
 
     parser = argparse.ArgumentParser(prog="craftsuite", description=__doc__, formatter_class=_HelpFormatter)
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")

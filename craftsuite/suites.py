@@ -187,8 +187,8 @@ PAPER_PROTOCOL = dict(teacher_layout_seed=None, teacher_n_envs=10, teacher_hyper
 # one copy of each step per automaton state, which the 1M-transition TD3 buffer cannot
 # afford on Diamond Mine (13 copies of 154 numbers); the transfer suite runs it.
 PAPER_METHODS = tuple(name for name, m in METHODS.items() if not (m.crm and m.distill) and not m.shaping)
-# the standard and hard suites add the field's shaping baseline (the population engine's
-# alone: the paper suite, on the sb3 engine, keeps the paper's methods)
+# the standard and hard suites add the field's shaping baseline (the paper suite keeps the
+# paper's methods)
 SUITE_METHODS = PAPER_METHODS + tuple(name for name, m in METHODS.items() if m.shaping)
 TRANSFER_METHODS = ("dqn", "dynamic", "crm-edges", "td3", "td3-dynamic", "td3-crm-edges")
 
@@ -220,8 +220,7 @@ SUITES = {s.name: s for s in (
     Suite("paper", "the paper's protocol as the authors' code ran it: the paper's methods and baselines on its tasks "
           "in the grid, MuJoCo and kinematic worlds, 20 seeds, 2M steps of 10 envs (20M transitions) per run",
           tags=("paper",), worlds=("Grid10", "Cont", "Kinematic"), methods=PAPER_METHODS, seeds=20,
-          student_steps=20_000_000, eval_every=500_000, teacher_max_steps=20_000_000, **PAPER_PROTOCOL,
-          engine="sb3"),  # the authors' residual CNN is not in the population engine
+          student_steps=20_000_000, eval_every=500_000, teacher_max_steps=20_000_000, **PAPER_PROTOCOL),
     # the transfer target (a distilled student at 80% greedy success in at most half the
     # transitions its algorithm needs from scratch) on the paper's three tasks: scratch, the
     # paper's method and the transfer method, in the standard suite's collection regimes, with

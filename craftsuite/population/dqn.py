@@ -1,15 +1,22 @@
 """DQN for K members in one set of stacked networks: ``agents.dqn.AutomatonDQN``'s update
 (the dueling head, the double-DQN target, Huber or squared loss weighted by importance
 weights, each member's gradient clipped to its own norm, the hard target update counted in
-transitions or gradient steps, the distilled target), computed for every member at once."""
+transitions or gradient steps, the distilled target), computed for every member at once.
+With ``features_extractor="residual-cnn"`` each member's Q-network reads the grid's planes
+through the paper's residual CNN (``cnn.py``); its batch norms are in training mode only
+for the update's own Q-values, as SB3's DQN has them (the greedy actions, the double-DQN
+argmax and the target network read the running statistics)."""
 
 from __future__ import annotations
+
+import contextlib
 
 import numpy as np
 import torch as th
 import torch.nn.functional as F
 from stable_baselines3.common.utils import polyak_update  # elementwise: stacked members too
 
+from .cnn import StackedQNetwork, StackedResidualCNN
 from .nets import StackedMLP, activation_of, clip_grad_norm_per_member
 from .replay import Batch, SparseRows
 from .targets import MemberTargets, discount
@@ -22,7 +29,8 @@ class PopulationDQN:
     algorithm = "dqn"
 
     def __init__(self, members: int, obs_dim: int, n_actions: int, settings: dict,
-                 targets: MemberTargets | None = None, device: str | th.device = "cpu"):
+                 targets: MemberTargets | None = None, device: str | th.device = "cpu",
+                 planes: tuple[int, int, int] | None = None):
         import torch.nn as nn
 
         self.members, self.device, self.n_actions = members, th.device(device), n_actions
@@ -32,10 +40,20 @@ class PopulationDQN:
         self.dueling = bool(settings.get("dueling", True))
         outputs = n_actions + 1 if self.dueling else n_actions  # column 0 is V, as agents.dqn's head
         layer_norm = bool(settings.get("layer_norm", False))  # in the hidden layers, as agents.dqn's policies
-        self.q_net = StackedMLP(members, [obs_dim, *hidden, outputs], act, device=self.device, layer_norm=layer_norm)
-        self.q_net_target = StackedMLP(members, [obs_dim, *hidden, outputs], act, device=self.device,
-                                       layer_norm=layer_norm)
+        self.cnn = settings.get("features_extractor", "flatten") == "residual-cnn"
+        if self.cnn and planes is None:
+            raise ValueError("a residual CNN reads the grid's planes: give planes (the world's observation_layout)")
+
+        def network():
+            if not self.cnn:
+                return StackedMLP(members, [obs_dim, *hidden, outputs], act, device=self.device, layer_norm=layer_norm)
+            features = StackedResidualCNN(members, obs_dim, planes, device=self.device)
+            return StackedQNetwork(features, StackedMLP(members, [features.features_dim, *hidden, outputs], act,
+                                                        device=self.device, layer_norm=layer_norm))
+
+        self.q_net, self.q_net_target = network(), network()
         self.q_net_target.load_state_dict(self.q_net.state_dict())
+        self.q_net_target.eval()  # a CNN's target reads its running statistics, as SB3's
         optimizer_kwargs = {**(policy_kwargs.get("optimizer_kwargs") or {})}
         self.optimizer = th.optim.Adam(self.q_net.parameters(), lr=float(settings["learning_rate"]),
                                        **optimizer_kwargs)
@@ -66,9 +84,16 @@ class PopulationDQN:
 
     def act(self, observations: np.ndarray) -> np.ndarray:
         """Greedy actions ``(K, n)`` for observations ``(K, n, obs_dim)``."""
-        with th.no_grad():
+        with th.no_grad(), self.evaluating():
             return self.q_values(self.q_net,
                                  th.as_tensor(observations, device=self.device)).argmax(dim=-1).cpu().numpy()
+
+    def evaluating(self):
+        """A context in which the online network's batch norms (a CNN's) read their running
+        statistics and leave them as they are; nothing to switch for an MLP."""
+        if not self.cnn:
+            return contextlib.nullcontext()
+        return _eval_mode(self.q_net)
 
     def td_target(self, batch: Batch, next_obs) -> th.Tensor:
         """The one target rule (``AutomatonDQN._td_target`` for K members), ``(K, B, 1)``."""
@@ -76,7 +101,8 @@ class PopulationDQN:
         with th.no_grad():
             next_q = self.q_values(self.q_net_target, next_obs)
             if self.double:
-                best = self.q_values(self.q_net, next_obs).argmax(dim=-1, keepdim=True)
+                with self.evaluating():  # a CNN's statistics move once per update, as agents.dqn's
+                    best = self.q_values(self.q_net, next_obs).argmax(dim=-1, keepdim=True)
                 next_q = th.gather(next_q, dim=-1, index=best)
             else:
                 next_q = next_q.max(dim=-1, keepdim=True)[0]
@@ -110,22 +136,44 @@ class PopulationDQN:
 
     def update_target(self) -> None:
         polyak_update(self.q_net.parameters(), self.q_net_target.parameters(), self.tau)
+        if self.cnn:  # and the running statistics, copied as SB3's DQN copies them
+            polyak_update(self.q_net.features.running_stats(), self.q_net_target.features.running_stats(), 1.0)
 
     # -- members as SB3 agents ---------------------------------------------------------------------
     def _sequential(self, q_network):
         return q_network.q_net.net if self.dueling else q_network.q_net
 
+    def _pairs(self, agent):
+        """(stacked network, SB3 network) for the online and the target network."""
+        return ((self.q_net, agent.policy.q_net), (self.q_net_target, agent.policy.q_net_target))
+
     def load_member(self, k: int, agent) -> None:
         """Member ``k``'s networks from an ``AutomatonDQN`` (online and target)."""
-        self.q_net.load_member(k, self._sequential(agent.policy.q_net))
-        self.q_net_target.load_member(k, self._sequential(agent.policy.q_net_target))
+        for stacked, q_network in self._pairs(agent):
+            if self.cnn:
+                stacked.features.load_member(k, q_network.features_extractor)
+            (stacked.head if self.cnn else stacked).load_member(k, self._sequential(q_network))
 
     def store_member(self, k: int, agent) -> None:
-        self.q_net.store_member(k, self._sequential(agent.policy.q_net))
-        self.q_net_target.store_member(k, self._sequential(agent.policy.q_net_target))
+        for stacked, q_network in self._pairs(agent):
+            if self.cnn:
+                stacked.features.store_member(k, q_network.features_extractor)
+            (stacked.head if self.cnn else stacked).store_member(k, self._sequential(q_network))
 
     def modules(self) -> dict:
         return {"q_net": self.q_net, "q_net_target": self.q_net_target}
 
     def optimizers(self) -> dict:
         return {"optimizer": self.optimizer}
+
+
+
+@contextlib.contextmanager
+def _eval_mode(module):
+    """``module`` in evaluation mode inside the context, its mode before restored after."""
+    training = module.training
+    module.eval()
+    try:
+        yield
+    finally:
+        module.train(training)

@@ -58,8 +58,6 @@ def check_supported(method: str, settings: dict) -> None:
         why = f"the settings {unknown}"
     elif settings.get("optimize_memory_usage"):
         why = "optimize_memory_usage (its replay keeps next observations; a grid's as their nonzero entries)"
-    elif settings.get("features_extractor", "flatten") != "flatten":
-        why = f"features_extractor {settings['features_extractor']!r}"
     elif sorted(set(settings.get("policy_kwargs") or {}) - _POLICY_KWARGS):
         why = f"policy_kwargs {sorted(set(settings['policy_kwargs']) - _POLICY_KWARGS)}"
     elif not _train_every(settings.get("train_freq", 1)):
@@ -113,11 +111,14 @@ class Population:
 
     ``seeds`` are the members' run seeds: member k's envs reset from seed_k + j (as SB3's
     ``make_vec_env`` seeds them), its noise from seed_k (as ``make_agent``). ``sparse_width``:
-    a DQN replay's observations stored as their nonzero entries (``sparse_width``)."""
+    a DQN replay's observations stored as their nonzero entries (``sparse_width``).
+    ``planes``: the grid's ``(C, H, W)`` (its ``observation_layout``), which a residual CNN
+    (``features_extractor="residual-cnn"``) reads."""
 
     def __init__(self, method: str, settings: dict, seeds: list[int], n_envs: int, obs_dim: int,
                  action_space, automaton, completion_reward: float, total_steps: int,
-                 table: AutomatonQTable | None = None, device: str = "cpu", sparse_width: int | None = None):
+                 table: AutomatonQTable | None = None, device: str = "cpu", sparse_width: int | None = None,
+                 planes: tuple[int, int, int] | None = None):
         check_supported(method, settings)
         row = METHODS[method]
         self.method, self.row, self.settings = method, row, settings
@@ -134,7 +135,9 @@ class Population:
         self.discrete = row.algorithm == "dqn"
         if self.discrete:
             self.n_actions = int(action_space.n)
-            self.learner = PopulationDQN(self.K, obs_dim, self.n_actions, settings, targets, device)
+            self.learner = PopulationDQN(self.K, obs_dim, self.n_actions, settings, targets, device, planes)
+            if self.learner.cnn:
+                sparse_width = None  # a CNN reads whole planes
             action_shape, action_dtype = (), np.int64
             self.noises = []  # epsilon-greedy explores instead
         else:

@@ -32,3 +32,23 @@ def step_records(info: dict, ended: np.ndarray, next_obs: np.ndarray):
             real_next[i] = final_obs[i]
         success[ended] = np.asarray(info["final_info"]["is_success"], dtype=bool)[ended]
     return real_next, info["transition"], success
+
+
+def observation_planes(env_id: str, env_kwargs: dict, product: bool, settings: dict) -> tuple[int, int, int] | None:
+    """The grid planes ``(C, H, W)`` a residual CNN reads in ``env_id``'s observations
+    (``observation_layout``), where ``settings`` ask for one; None otherwise.
+
+    Raises:
+        ValueError: a residual CNN asked for in a world without planes (not a grid).
+    """
+    if settings.get("features_extractor", "flatten") != "residual-cnn":
+        return None
+    env = gym.make(env_id, product=product, **env_kwargs)
+    try:
+        layout = getattr(env.unwrapped, "observation_layout", None)
+    finally:
+        env.close()
+    if not isinstance(layout, dict) or "planes" not in layout:
+        raise ValueError(f"features_extractor 'residual-cnn' reads grid planes; {env_id} has none "
+                         "(it is for the grid worlds)")
+    return tuple(layout["planes"])

@@ -69,7 +69,7 @@ def distill(pop: Population, automaton, chunk: int = 4096) -> list[AutomatonQTab
         raise ValueError("the teacher's replay buffer is empty: train it first")
     taken = np.empty((pop.K, rows))
     learner = pop.learner
-    with th.no_grad():
+    with th.no_grad(), learner.evaluating():  # as the greedy policy reads Q (a CNN's running statistics)
         for start in range(0, rows, chunk):
             at = slice(start, min(start + chunk, rows))
             if replay.sparse_width is None:
@@ -92,7 +92,7 @@ def distill_run(path) -> tuple[AutomatonQTable, object]:
     """
     from ..runs import load_config
     from ..task_registry import resolve_task
-    from .envs import make_envs
+    from .envs import make_envs, observation_planes
 
     config = load_config(TeacherConfig, path)
     saved = RunDir(path, config).last_checkpoint((CHECKPOINT, STEP))
@@ -103,7 +103,7 @@ def distill_run(path) -> tuple[AutomatonQTable, object]:
     with contextlib.closing(make_envs(config.env_id, 1, config.env_kwargs, True)) as envs:
         obs_dim, actions = envs.single_observation_space.shape[0], envs.single_action_space
     pop = Population(config.method, settings, [config.seed], config.n_envs, obs_dim, actions, spec.automaton,
-                     spec.completion_reward, config.steps, None, "cpu",
-                     sparse_width(spec, "Grid", True))
+                     spec.completion_reward, config.steps, None, "cpu", sparse_width(spec, "Grid", True),
+                     observation_planes(config.env_id, config.env_kwargs, True, settings))
     pop.load_states([th.load(saved / CHECKPOINT, weights_only=False, map_location="cpu")])
     return distill(pop, spec.automaton)[0], spec.automaton

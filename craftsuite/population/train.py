@@ -29,7 +29,7 @@ from ..methods import METHODS
 from ..reached import Reached, check_automaton
 from ..runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, eval_seed, reached_target
 from .engine import EngineError, Population, check_supported, sparse_width
-from .envs import make_envs, step_records
+from .envs import make_envs, observation_planes, step_records
 from .scalars import Scalars
 
 CHECKPOINT, STEP = "population.pt", "step.json"  # a member's state, and the step it was saved at
@@ -124,7 +124,8 @@ def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=No
         obs_dim = envs.single_observation_space.shape[0]
         pop = Population(config.method, settings, [c.seed for c in configs], n, obs_dim, envs.single_action_space,
                          spec.automaton, spec.completion_reward, config.steps, table, str(device),
-                         sparse_width(spec, world_kind(config.world), config.product))
+                         sparse_width(spec, world_kind(config.world), config.product),
+                         observation_planes(config.env_id, config.env_kwargs, config.product, settings))
         _resume(pop, runs)
         logs = [Scalars(run, pop.num_timesteps) for run in runs]
         for log in logs:

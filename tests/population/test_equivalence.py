@@ -96,6 +96,49 @@ def test_dqn_update_matches_automaton_dqn(loss, prioritized, sparse, layer_norm)
             _close(a, b)
 
 
+@pytest.mark.parametrize("dueling", [True, False])
+def test_the_residual_cnn_learns_as_automaton_dqns(dueling):
+    """The paper's residual CNN (``features_extractor="residual-cnn"``): one member's
+    updates move its weights and batch-norm statistics as SB3's, its target copies both, and
+    its greedy Q-values read the running statistics as SB3's ``predict`` does.
+
+    A convolution's bias before a batch norm has no gradient but rounding noise (the norm
+    subtracts the mean), which Adam scales to steps of about the learning rate either way:
+    those biases (and the running means that follow them) agree only to a few steps' size,
+    in both engines as between two runs of one; the Q-values they give agree."""
+    cnn = {"features_extractor": "residual-cnn", "policy_kwargs": {"net_arch": [32]}, "dueling": dueling,
+           "target_update_interval": 2, "target_update_unit": "gradient_steps"}
+    agent = _filled("product-dqn", "CraftSuite/FirstTool-Grid7-v0", batch_size=16, **cnn)
+    settings = agent_settings(agent, "dqn", **cnn)
+    planes = agent.get_env().envs[0].unwrapped.observation_layout["planes"]
+    pop = PopulationDQN(1, agent.observation_space.shape[0], 4, settings, planes=planes)
+    pop.load_member(0, agent)
+    for _ in range(3):  # the target (weights and running statistics) is copied after the second
+        samples = agent.replay_buffer.sample(16)
+        _same_sample(agent, samples)
+        agent.train(gradient_steps=1, batch_size=16)
+        pop.update(_batch(samples))
+    mine = make_agent("product-dqn", "CraftSuite/FirstTool-Grid7-v0", seed=9, buffer_size=16, **cnn)
+    pop.store_member(0, mine)
+    noise = 0.01  # a few of Adam's steps (5e-4 each), against weights of about 0.1
+    for name in ("q_net", "q_net_target"):
+        theirs, ours = getattr(agent.policy, name), getattr(mine.policy, name)
+        conv_biases = {id(m.bias) for m in theirs.modules() if isinstance(m, th.nn.Conv2d)}
+        for a, b in zip(theirs.parameters(), ours.parameters()):
+            if id(a) in conv_biases:
+                assert (a - b).abs().max() <= noise
+            else:  # the noise reaches the weights through the next updates' activations, a little
+                assert th.allclose(a, b, atol=1e-5, rtol=1e-4), (a - b).abs().max()
+        for (key, a), b in zip(theirs.named_buffers(), ours.buffers()):
+            if "running" in key:
+                assert a.abs().sum() > 0 and th.allclose(a, b, atol=noise), (key, (a - b).abs().max())
+    obs = th.as_tensor(agent.replay_buffer.observations[:50, 0])
+    agent.policy.set_training_mode(False)
+    with th.no_grad(), pop.evaluating():
+        q_sb3, q_pop = agent.q_net(obs), pop.q_values(pop.q_net, obs[None])[0]
+    assert th.allclose(q_sb3, q_pop, atol=1e-2), (q_sb3 - q_pop).abs().max()
+
+
 def agent_settings(agent, algorithm, **overrides) -> dict:
     from craftsuite.hyperparameters import algorithm_settings
 

@@ -2,6 +2,7 @@
 read, its model loads as an SB3 agent acting as the member did, a killed population resumes
 from its checkpoint, and bad input is refused before anything is written."""
 
+import dataclasses
 import json
 
 import numpy as np
@@ -47,7 +48,9 @@ def test_members_write_ordinary_runs(tmp_path):
     assert [(p / "result.json").read_text() + (p / "config.json").read_text() for p in paths] == records
 
 
-def test_a_members_model_acts_as_the_member(tmp_path, monkeypatch):
+@pytest.mark.parametrize("features", ["flatten", "residual-cnn"])
+def test_a_members_model_acts_as_the_member(features, tmp_path, monkeypatch):
+    """Also with the paper's residual CNN: its weights and batch-norm statistics saved."""
     seen = {}
     finish = population_train._finish
 
@@ -56,10 +59,13 @@ def test_a_members_model_acts_as_the_member(tmp_path, monkeypatch):
         finish(pop, k, *args)
 
     monkeypatch.setattr(population_train, "_finish", spy)
-    paths = train_population(_cell("product-dqn", "Grid7", "FirstTool", seeds=(4, 5), layout_seed=0),
-                             tmp_path, progress=False)
+    cell = _cell("product-dqn", "Grid7", "FirstTool", seeds=(4, 5), layout_seed=0)
+    cell = [dataclasses.replace(c, hyperparameters={**c.hyperparameters, "features_extractor": features})
+            for c in cell]
+    paths = train_population(cell, tmp_path, progress=False)
     pop = seen["pop"]
-    obs = np.random.default_rng(0).random((2, 7, pop.learner.q_net.sizes[0])).astype(np.float32)
+    obs_dim = load_agent(paths[0] / "model.zip").observation_space.shape[0]
+    obs = np.random.default_rng(0).random((2, 7, obs_dim)).astype(np.float32)
     greedy = pop.greedy(obs)
     for k, path in enumerate(paths):
         agent = load_agent(path / "model.zip")
@@ -156,9 +162,9 @@ def test_a_population_is_reproducible(tmp_path):
 
 
 def test_bad_input_leaves_nothing_behind(tmp_path):
-    with pytest.raises(EngineError, match="features_extractor 'residual-cnn'.*--engine sb3"):
+    with pytest.raises(EngineError, match="train_freq \\[4, 'episode'\\].*--engine sb3"):
         train_population([StudentConfig(task="Reach", method="dqn", world="Grid7", steps=100, engine="population",
-                                        hyperparameters={"features_extractor": "residual-cnn"})], tmp_path)
+                                        hyperparameters={"train_freq": [4, "episode"]})], tmp_path)
     with pytest.raises(EngineError, match="differ in \\['steps'\\]"):
         train_population(_cell(seeds=(0,)) + _cell(seeds=(1,), steps=800), tmp_path)
     with pytest.raises(EngineError, match="seeds must differ"):
@@ -183,7 +189,7 @@ def test_a_population_trains_on_the_gpu(tmp_path):
     (["transfer", "--suite", "quick", "--methods", "td3-crm-edges", "--td3-hyper", '{"n_steps": 3}', "--engine",
       "sb3"], "method 'td3-crm-edges' with n_steps 3: n-step CRM is trained by the population engine only"),
     (["student", "Reach", "--world", "Grid10", "--method", "dqn", "--engine", "population", "--hyper",
-      '{"features_extractor": "residual-cnn"}'], "does not support features_extractor 'residual-cnn'"),
+      '{"train_freq": [1, "episode"]}'], "does not support train_freq [1, 'episode']"),
 ])
 def test_the_command_line_refuses_what_the_engine_cannot_run(argv, message, tmp_path, capsys):
     from craftsuite.cli import main

@@ -2,11 +2,15 @@
 adopted regime, read from TD3-from-scratch learning curves by the rule fixed before.
 
     python experiments/learner-regime/budgets.py --setting n3 [--wave 1] [--n 3 3] [--winners ...]
+    python experiments/learner-regime/budgets.py --setting n3 --grid-runs    # trains Grid10's candidates first
 
 A TD3 run's curve at t transitions stands for a run of budget t (no schedule of TD3's
 depends on the budget; its replay holds every transition either way), so the curves of
 the regime's scratch runs give each rung's budget without new runs. DQN anneals its
-exploration over a tenth of its budget: its curves do not, and its budgets need runs.
+exploration over a tenth of its budget: its curves do not, and its budgets need runs
+(``--grid-runs``: the adopted setting's scratch DQN at each of ``GRID_BUDGETS``, 5 seeds, as
+the standard suite would run it at that budget); Grid10's rule is the largest of them whose
+mean final greedy success lies in [0.2, 0.8] (else today's budget).
 """
 
 from __future__ import annotations
@@ -21,6 +25,7 @@ from craftsuite.runs import read_csv
 
 LOW, HIGH = 0.3, 0.6  # the rule's band for scratch's mean greedy success: inside the 20-80% zone, below its middle
 GRID = 50_000  # budgets are multiples of this
+GRID_BUDGETS, GRID_LOW, GRID_HIGH = (30_000, 50_000, 75_000, 100_000), 0.2, 0.8  # Grid10's candidates and zone
 
 
 def _driver():
@@ -53,13 +58,62 @@ def choose(curve: list[tuple[int, float]], budget: int) -> tuple[int, str]:
     return max(GRID, step // GRID * GRID), f"the mean jumps past the band after {step:,}"
 
 
+def grid_candidates(driver, setting: str, wave: int, ns: dict, winners: dict) -> list:
+    """The adopted setting's Grid10 scratch runs at each candidate budget: its standard-suite
+    config with the budget (and the suite's evaluation interval for it) replaced."""
+    import dataclasses
+
+    from craftsuite.suites import SUITES
+
+    suite = SUITES["standard"]
+    return [dataclasses.replace(c, steps=b, eval_every=suite.eval_interval(b, c.world))
+            for name, c in driver.configs("standard", wave, ns, winners) if name == setting and c.world == "Grid10"
+            for b in GRID_BUDGETS]
+
+
+def grid_choice(finals: dict[int, float], budget: int) -> tuple[int, str]:
+    """Grid10's rule: the largest candidate whose mean final success lies in the zone."""
+    inside = [b for b in sorted(finals) if GRID_LOW <= finals[b] <= GRID_HIGH]
+    if inside:
+        return inside[-1], f"mean final {finals[inside[-1]]:.2f} at {inside[-1]:,}"
+    return budget, "no candidate lands in the zone: the budget stays"
+
+
 def main(argv=None) -> None:
     driver = _driver()
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--setting", required=True, help="the adopted setting's name in run.py, e.g. n3")
+    parser.add_argument("--grid-runs", action="store_true", help="train the Grid10 candidates first (into --out)")
+    parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results")
+    parser.add_argument("--workers", type=int, default=2)
     driver.reader_arguments(parser)
     args = parser.parse_args(argv)
     ns, winners = driver.read_settings(args)
+    candidates = grid_candidates(driver, args.setting, args.wave, ns, winners)
+    if args.grid_runs:
+        from craftsuite.suite_runner import run_students
+
+        held = driver.finished_runs(args.runs)
+        todo = [c for c in candidates if c.run_name() not in held]
+        print(f"Grid10 candidates: {len(candidates)} runs, {len(todo)} to train "
+              f"({sum(c.steps for c in todo):,} transitions)")
+        if todo:
+            run_students(todo, args.out / "standard" / "students", workers=args.workers)
+    found = driver.finished_runs(args.runs)
+    print("| rung | budget now | candidate: seeds, mean final greedy success | budget by the rule | why |")
+    print("|---|---|---|---|---|")
+    for c in [c for name, c in driver.configs("standard", args.wave, ns, winners)
+              if name == args.setting and c.world == "Grid10" and c.seed == 0]:
+        finals, shown = {}, []
+        for b in GRID_BUDGETS:
+            runs = [found[r.run_name()] for r in candidates if r.task == c.task and r.steps == b
+                    and r.run_name() in found]
+            if runs:
+                finals[b] = float(np.mean([float(read_csv(r / "evals.csv")[-1]["success"]) for r in runs]))
+                shown.append(f"{b // 1000}k: {len(runs)}, {finals[b]:.2f}")
+        budget, why = grid_choice(finals, c.steps) if finals else (c.steps, "no runs found")
+        print(f"| {c.task} | {c.steps:,} | {'; '.join(shown)} | {budget:,} | {why} |")
+    print()
     found = driver.finished_runs(args.runs)
     print("| rung | budget now | seeds | mean greedy success at the evaluations | budget by the rule | why |")
     print("|---|---|---|---|---|---|")

@@ -238,7 +238,10 @@ def _teacher(args) -> int:
                            seed=args.seed, max_steps=args.max_steps, target_success=args.target_success,
                            eval_every=args.eval_every, eval_episodes=args.eval_episodes,
                            hyperparameters=_hyper(args.hyper, "dqn"), n_envs=args.n_envs, engine=args.engine)
-    path = train_teacher(config, args.out)
+    if config.engine == "sb3" and args.device != "cpu":
+        raise ValueError(f"--device {args.device}: the sb3 engine takes no --device (its agents use a GPU where there "
+                         "is one); leave out --device, or use --engine population")
+    path = train_teacher(config, args.out, device=args.device)
     print((path / "result.json").read_text().strip())
     print(f"teacher run: {path}\n  teacher: {path / 'teacher.zip'}\n  dynamic table: {path / 'table.npz'}")
     return 0
@@ -583,6 +586,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--n-envs", type=_positive, default=1,
                    help="envs stepped side by side; each agent step collects one transition from each (default: 1)")
     p.add_argument("--engine", choices=ENGINES, default=DEFAULT_ENGINE, help=engine_help)
+    p.add_argument("--device", default="cpu", help="the population engine's torch device: cpu (default) or cuda")
     p.set_defaults(run=_teacher)
 
     p = sub.add_parser("distill", help="distil a teacher (dynamic) or a task's automaton (static) into a table")
@@ -653,8 +657,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "again, and every finished run's records are kept there (default: results, for the suites that "
                    "keep their runs: all but quick)")
     p.add_argument("--no-archive", action="store_true", help="neither read nor write a results archive")
-    p.add_argument("--engine", choices=ENGINES, help="what trains the students: population (each cell's seeds in "
-                   "one process) or sb3 (one SB3 agent per run); default: the suite's")
+    p.add_argument("--engine", choices=ENGINES, help="what trains the teachers and students: population (each "
+                   "cell's seeds in one process) or sb3 (one SB3 agent per run); default: the suite's")
     p.add_argument("--regime", choices=list(REGIMES), help="the students' learner regime (craftsuite.regimes: "
                    "n-step returns and the like, for every method alike); default: the suite's")
     p.add_argument("--device", help="the population engine's torch device: cpu (default) or cuda (the sb3 engine "

@@ -66,13 +66,14 @@ def _student_job(config: dict, root: str, task: str | dict | None = None) -> str
         return str(train_student(StudentConfig(**config), root, progress=False))
 
 
-def _teacher_job(config: dict, root: str, task: str | dict | None = None) -> str:
-    """One teacher run (training, then distillation) in a worker process."""
+def _teacher_job(config: dict, root: str, task: str | dict | None = None, device: str = "cpu") -> str:
+    """One teacher run (training, then distillation) in a worker process (``device``: a
+    population teacher's torch device)."""
     _start_worker(task)
     from .training import train_teacher
 
     with _quiet():
-        return str(train_teacher(TeacherConfig(**config), root, progress=False))
+        return str(train_teacher(TeacherConfig(**config), root, progress=False, device=device))
 
 
 @contextlib.contextmanager
@@ -146,7 +147,8 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
             bar.update(done - bar.n)
 
         try:
-            pending = {workers_.submit(_teacher_job, dataclasses.asdict(t), str(teacher_root), _carried(t.task)): task
+            pending = {workers_.submit(_teacher_job, dataclasses.asdict(t), str(teacher_root), _carried(t.task),
+                                       device if t.engine == "population" else "cpu"): task
                        for task, t in teachers.items()}
             futures = {id(job): (job, submit(job)) for job in ready}
             while pending or not all(f.done() for _, f in futures.values()):
@@ -265,7 +267,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     teachers = suite.teachers()
     check_budgets(configs, teachers)
     kept = _check_places(out, archive, suite.name)
-    _check_students(configs, device)  # fail before any training
+    _check_students(configs, device, teachers.values())  # fail before any training
     read(out)  # a damaged provenance record, too
     _counting_acceptance([out / "students" / c.run_name() for c in configs])  # none unfinished
     # the pool, and a Ray cluster with it, before anything is written: one out of reach leaves no output behind
@@ -340,11 +342,11 @@ def _counting_acceptance(runs: list[Path]) -> list[Path]:
     return found
 
 
-def _check_students(configs: list[StudentConfig], device: str | None = None) -> None:
+def _check_students(configs: list[StudentConfig], device: str | None = None, teachers=()) -> None:
     """Build each kind of student once, untrained, from scratch (the teachers' tables do not
     exist yet): a misspelt world setting or algorithm setting (``--env``, ``--td3-hyper``),
-    a run the population engine cannot train, or a device it cannot train on, is named now,
-    not in a worker after the teachers have trained."""
+    a run the population engine cannot train (a student or one of ``teachers``), or a device
+    it cannot train on, is named now, not in a worker after the teachers have trained."""
     import craftsuite  # noqa: F401  (registers the ids)
 
     from .agents.factory import make_agent
@@ -359,7 +361,7 @@ def _check_students(configs: list[StudentConfig], device: str | None = None) -> 
         from .population.train import check_device
 
         check_device(device or "cpu")
-        for c in configs:
+        for c in [*configs, *teachers]:
             if c.engine == "population":
                 check_supported(c.method, c.effective()["hyperparameters"])
     from .training import check_sb3_engine

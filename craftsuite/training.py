@@ -276,14 +276,15 @@ def _train(config, name: str, root, fresh, *, product: bool, total: int, stop_at
         return run.path
 
 
-def train_teacher(config: TeacherConfig, root, progress: bool = True) -> Path:
-    """A teacher run under ``root``; returns its directory (with teacher.zip and table.npz)."""
+def train_teacher(config: TeacherConfig, root, progress: bool = True, device: str = "cpu") -> Path:
+    """A teacher run under ``root``; returns its directory (with teacher.zip and table.npz).
+    ``device``: the population engine's torch device (the sb3 engine takes its settings')."""
     from .agents.factory import distill_from_replay, make_agent
 
     if config.engine == "population":  # a population of one
         from .population.teacher import train_teacher as train_population_teacher
 
-        return train_population_teacher(config, root, progress=progress)
+        return train_population_teacher(config, root, progress=progress, device=device)
 
     def fresh():
         return make_agent("product-dqn", config.env_id, seed=config.seed, n_envs=config.n_envs,

@@ -33,7 +33,7 @@ class PopulationDQN:
                  planes: tuple[int, int, int] | None = None):
         import torch.nn as nn
 
-        self.members, self.device, self.n_actions = members, th.device(device), n_actions
+        self.members, self.device, self.n_actions, self.obs_dim = members, th.device(device), n_actions, obs_dim
         policy_kwargs = settings.get("policy_kwargs") or {}
         hidden = list(policy_kwargs.get("net_arch", [64, 64]))
         act = activation_of(policy_kwargs.get("activation_fn", nn.ReLU))
@@ -76,10 +76,15 @@ class PopulationDQN:
 
     def inputs(self, observations):
         """A minibatch's observations as the networks take them: a tensor, or the
-        ``(index, value)`` tensors of ``SparseRows``."""
+        ``(index, value)`` tensors of ``SparseRows`` (for a CNN, which reads whole planes,
+        the dense tensor they stand for: the replay stays sparse)."""
         if isinstance(observations, SparseRows):
-            return (th.as_tensor(observations.index, device=self.device),
-                    th.as_tensor(observations.value, device=self.device))
+            index = th.as_tensor(observations.index, device=self.device)
+            value = th.as_tensor(observations.value, device=self.device)
+            if not self.cnn:
+                return index, value
+            dense = th.zeros((*index.shape[:-1], self.obs_dim), dtype=value.dtype, device=self.device)
+            return dense.scatter_add_(-1, index, value)  # the padding adds zeros at index 0
         return th.as_tensor(observations, device=self.device)
 
     def act(self, observations: np.ndarray) -> np.ndarray:

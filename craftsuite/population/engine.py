@@ -136,8 +136,6 @@ class Population:
         if self.discrete:
             self.n_actions = int(action_space.n)
             self.learner = PopulationDQN(self.K, obs_dim, self.n_actions, settings, targets, device, planes)
-            if self.learner.cnn:
-                sparse_width = None  # a CNN reads whole planes
             action_shape, action_dtype = (), np.int64
             self.noises = []  # epsilon-greedy explores instead
         else:

@@ -96,11 +96,12 @@ def test_dqn_update_matches_automaton_dqn(loss, prioritized, sparse, layer_norm)
             _close(a, b)
 
 
-@pytest.mark.parametrize("dueling", [True, False])
-def test_the_residual_cnn_learns_as_automaton_dqns(dueling):
+@pytest.mark.parametrize("dueling,sparse", [(True, True), (False, False)])
+def test_the_residual_cnn_learns_as_automaton_dqns(dueling, sparse):
     """The paper's residual CNN (``features_extractor="residual-cnn"``): one member's
     updates move its weights and batch-norm statistics as SB3's, its target copies both, and
-    its greedy Q-values read the running statistics as SB3's ``predict`` does.
+    its greedy Q-values read the running statistics as SB3's ``predict`` does. ``sparse``:
+    the minibatch as the grid replay stores it (nonzero entries), made whole planes again.
 
     A convolution's bias before a batch norm has no gradient but rounding noise (the norm
     subtracts the mean), which Adam scales to steps of about the learning rate either way:
@@ -117,7 +118,12 @@ def test_the_residual_cnn_learns_as_automaton_dqns(dueling):
         samples = agent.replay_buffer.sample(16)
         _same_sample(agent, samples)
         agent.train(gradient_steps=1, batch_size=16)
-        pop.update(_batch(samples))
+        batch = _batch(samples)
+        if sparse:
+            width = int((batch.observations != 0).sum(axis=-1).max())
+            batch = batch._replace(observations=sparse_rows(batch.observations, width),
+                                   next_observations=sparse_rows(batch.next_observations, width))
+        pop.update(batch)
     mine = make_agent("product-dqn", "CraftSuite/FirstTool-Grid7-v0", seed=9, buffer_size=16, **cnn)
     pop.store_member(0, mine)
     noise = 0.01  # a few of Adam's steps (5e-4 each), against weights of about 0.1

@@ -354,7 +354,7 @@ def _transfer(args) -> int:
         raise ValueError(f"--td3-hyper sets the TD3 students (continuous worlds); these worlds have none: {worlds}")
     if args.dqn_hyper is not None:
         dqn = _hyper(args.dqn_hyper, "dqn", "--dqn-hyper")
-        changes["dqn_hyperparameters"] = {**suite.dqn_hyperparameters, **dqn}
+        changes["dqn_overrides"] = {**suite.dqn_overrides, **dqn}
         changes["teacher_hyperparameters"] = {**suite.teacher_hyperparameters, **dqn}
     if args.env is not None:
         changes["cont_world_kwargs"] = _world_kwargs(args.env, CONT)
@@ -363,7 +363,7 @@ def _transfer(args) -> int:
             raise ValueError(f"--board-size sets the kinematic board ({KINEMATIC}); these worlds have none: {worlds}")
         changes["kinematic_world_kwargs"] = {} if args.board_size == 7 else {"size": args.board_size}
     if args.td3_hyper is not None:
-        changes["td3_hyperparameters"] = {**suite.td3_hyperparameters, **_hyper(args.td3_hyper, "td3", "--td3-hyper")}
+        changes["td3_overrides"] = {**suite.td3_overrides, **_hyper(args.td3_hyper, "td3", "--td3-hyper")}
     if args.engine is not None:
         changes["engine"] = args.engine
     if args.regime is not None:  # another regime's runs never pool with the suite's: they may share its archive
@@ -375,8 +375,8 @@ def _transfer(args) -> int:
         raise ValueError("--archive DIR keeps the runs in that archive, --no-archive keeps none: give one or neither")
     # a run whose settings differ from the suite's (a budget, a setting) goes to the archive only
     # when asked for: a smoke test would otherwise sit beside the suite's runs as a variant
-    settings = {"student_steps", "teacher_max_steps", "eval_every", "dqn_hyperparameters", "teacher_hyperparameters",
-                "cont_world_kwargs", "kinematic_world_kwargs", "td3_hyperparameters", "engine"}
+    settings = {"student_steps", "teacher_max_steps", "eval_every", "dqn_overrides", "teacher_hyperparameters",
+                "cont_world_kwargs", "kinematic_world_kwargs", "td3_overrides", "engine"}
     # and a rung, world or method the suite does not run would be filed under a suite it is not part of
     registered = SUITES[args.suite]
     beyond = ({s.name for s in suite.rungs()} - {s.name for s in registered.rungs()}

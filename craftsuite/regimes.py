@@ -38,8 +38,13 @@ REGIMES = {r.name: r for r in (
            td3={"n_steps": 3}, dqn={"n_steps": 3}),
 )}
 
+# Every row fixes the TD targets' length (one step where it says nothing); its other
+# settings tell it apart only where it sets them (a run of the one-step regime may have any
+# network the suite gave it).
+FIXED = ("n_steps",)
+
 # what tells the regimes apart: every setting some row sets
-FACTORS = sorted({name for r in REGIMES.values() for name in (*r.td3, *r.dqn)})
+FACTORS = sorted({*FIXED, *(name for r in REGIMES.values() for name in (*r.td3, *r.dqn))})
 
 
 def _value(algorithm: str, settings: dict, name: str):
@@ -52,12 +57,15 @@ def _value(algorithm: str, settings: dict, name: str):
 
 def regime_of(algorithm: str, settings: dict) -> str:
     """The name of the regime a run of ``algorithm`` with these settings (the overrides
-    its record holds) trained under; a run that matches no row is named by its own
-    values of the regimes' settings, e.g. ``n_steps=5``."""
+    its record holds) trained under: the row that fits them (its TD-target length and every
+    setting it sets), the one setting most where several fit; a run that fits no row is
+    named by its own values of the regimes' settings, e.g. ``n_steps=5``."""
     mine = {name: _value(algorithm, settings, name) for name in FACTORS}
-    for regime in REGIMES.values():
-        if all(mine[name] == _value(algorithm, regime.settings(algorithm), name) for name in FACTORS):
-            return regime.name
+    fits = [regime for regime in REGIMES.values()
+            if all(mine[name] == _value(algorithm, regime.settings(algorithm), name)
+                   for name in {*FIXED, *regime.settings(algorithm)})]
+    if fits:
+        return max(fits, key=lambda regime: len(regime.settings(algorithm))).name
     default = {name: _value(algorithm, {}, name) for name in FACTORS}
     return ", ".join(f"{name}={mine[name]!r}" for name in FACTORS if mine[name] != default[name])
 

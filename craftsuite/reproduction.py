@@ -197,6 +197,9 @@ def _what_ran(runs) -> list[str]:
     run_dir, board, suite = runs.path, runs.board, runs.suite
     lines = ["## What ran", "", *(session_line(s, to_the_minute=False) for s in runs.sessions)]
     if suite:
+        def settings(algorithm):  # the suite's, then the command line's over them
+            return {**suite.get(f"{algorithm}_hyperparameters", {}), **suite.get(f"{algorithm}_overrides", {})}
+
         def layout(key, fixed):  # a suite.json from before a field existed holds the default's meaning
             return "new every episode" if suite.get(key, fixed) is None else "fixed"
 
@@ -206,8 +209,8 @@ def _what_ran(runs) -> list[str]:
                   f"{suite.get('td3_n_envs', 1)}; distilled students see the automaton state: "
                   f"{'yes' if suite.get('students_see_automaton', True) else 'no'}.",
                   f"- DQN settings (teachers): `{json.dumps(suite.get('teacher_hyperparameters', {}))}`",
-                  f"- DQN settings (students): `{json.dumps(suite.get('dqn_hyperparameters', {}))}`",
-                  f"- TD3 settings: `{json.dumps(suite.get('td3_hyperparameters', {}))}`"]
+                  f"- DQN settings (students): `{json.dumps(settings('dqn'))}`",
+                  f"- TD3 settings: `{json.dumps(settings('td3'))}`"]
     budgets = sorted({(e.budget, e.updates) for e in board})
     lines.append("- Budget per run: " + ", ".join(f"{b:,} transitions / " + ("unrecorded" if u is None else f"{u:,}")
                                                   + " gradient updates" for b, u in budgets)

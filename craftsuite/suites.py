@@ -51,10 +51,13 @@ class Suite:
     dqn_hyperparameters: dict = field(default_factory=dict)
     td3_n_envs: int = 1
     dqn_n_envs: int = 1
-    # the learner regime (craftsuite.regimes): learning settings every method's students get
-    # beneath the suite's own hyperparameters above (which, with any command-line overrides,
-    # win), so that a distilled student and scratch learn by the same rule
+    # the learner regime (craftsuite.regimes): the TD targets and networks every method's
+    # students get, over the collection regime above, so that a distilled student and
+    # scratch learn by the same rule
     regime: str = "one-step"
+    # the command line's settings of each algorithm (--td3-hyper, --dqn-hyper): over both
+    td3_overrides: dict = field(default_factory=dict)
+    dqn_overrides: dict = field(default_factory=dict)
     # grid students learn one fixed instance, generated independently of the teacher's (layout 0),
     # as the paper's did; None gives them a new layout every episode
     grid_layout_seed: int | None = 1
@@ -138,8 +141,9 @@ class Suite:
         learner settings (``table``: a teacher's, for a method that needs one)."""
         steps = self.budget(spec, world)
         cont = world_kind(world) == CONT
-        hyperparameters = {**check_regime(self.regime).settings("td3" if cont else "dqn"),
-                           **(self.td3_hyperparameters if cont else self.dqn_hyperparameters)}
+        hyperparameters = {**(self.td3_hyperparameters if cont else self.dqn_hyperparameters),
+                           **check_regime(self.regime).settings("td3" if cont else "dqn"),
+                           **(self.td3_overrides if cont else self.dqn_overrides)}
         return StudentConfig(
             task=spec.name, method=method, world=world, seed=seed, steps=steps, table=table,
             eval_every=self.eval_interval(steps, world), eval_episodes=self.eval_episodes,

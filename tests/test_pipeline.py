@@ -116,8 +116,11 @@ def test_transfer_flags_reach_the_suite(tmp_path, monkeypatch):
     [suite] = seen
     assert suite.cont_world_kwargs == {"frame_skip": 2}
     assert (suite.tags, suite.tasks) == (("medium",), ("Reach",))
-    # merged over the suite's own TD3 settings, not replacing them
-    assert suite.td3_hyperparameters == {**SUITES["quick"].td3_hyperparameters, "learning_rate": 0.0005}
+    # over the suite's own TD3 settings (and its learner regime), not replacing them
+    assert suite.td3_hyperparameters == SUITES["quick"].td3_hyperparameters
+    assert {c.hyperparameters["learning_rate"] for c in suite.student_configs(tmp_path)} == {0.0005}
+    assert all(c.hyperparameters["batch_size"] == SUITES["quick"].td3_hyperparameters["batch_size"]
+               for c in suite.student_configs(tmp_path))
     # without --out, each suite writes to a directory of its own
     monkeypatch.chdir(tmp_path)
     assert main(["transfer", "--suite", "standard", "--tasks", "Reach", "--worlds", "Grid10", "--methods", "dqn"]) == 0

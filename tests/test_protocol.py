@@ -220,6 +220,6 @@ def test_dqn_hyper_reaches_grid_students_and_teachers(tmp_path, monkeypatch):
     assert main(["transfer", "--suite", "paper", "--dqn-hyper", '{"features_extractor": "flatten"}',
                  "--out", str(tmp_path)]) == 0
     [suite] = seen
-    for settings in (suite.dqn_hyperparameters, suite.teacher_hyperparameters):
+    for settings in ({**suite.dqn_hyperparameters, **suite.dqn_overrides}, suite.teacher_hyperparameters):
         assert settings == {**AUTHORS_DQN, "features_extractor": "flatten"}  # merged over the suite's
     assert main(["transfer", "--dqn-hyper", '{"los": "mse"}', "--out", str(tmp_path / "t")]) == 2

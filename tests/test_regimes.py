@@ -23,13 +23,15 @@ def test_a_records_regime_is_read_from_its_settings(settings, name):
     assert regime_of("dqn", settings) == name
 
 
-def test_a_suites_regime_reaches_every_method_and_its_own_settings_win():
+def test_a_suites_regime_reaches_every_method_and_the_command_lines_settings_win():
     suite = dataclasses.replace(SUITES["standard"], regime="n-step", tags=("middle",))
     configs = suite.student_configs("/tmp/teachers")
     assert {c.method for c in configs} >= {"td3", "td3-dynamic", "crm", "dqn", "dynamic", "rs", "td3-rs"}
     assert all(c.hyperparameters["n_steps"] == REGIMES["n-step"].settings("td3")["n_steps"] for c in configs)
-    # what the suite (or the command line, which merges into it) sets wins over the regime
-    mine = dataclasses.replace(suite, td3_hyperparameters={**suite.td3_hyperparameters, "n_steps": 5})
+    # the regime over the suite's collection settings, the command line's over both
+    theirs = dataclasses.replace(suite, td3_hyperparameters={**suite.td3_hyperparameters, "n_steps": 5})
+    assert {c.hyperparameters["n_steps"] for c in theirs.student_configs("/tmp/teachers") if c.world == "Cont"} == {3}
+    mine = dataclasses.replace(theirs, td3_overrides={"n_steps": 5})
     assert {c.hyperparameters["n_steps"] for c in mine.student_configs("/tmp/teachers") if c.world == "Cont"} == {5}
 
 

@@ -20,10 +20,10 @@ from .task_registry import resolve_task
 
 
 ENGINES = ("sb3", "population")
-# What trains a run unless it says otherwise: the command line's default and the suites'.
-# (A config's ``engine`` field defaults to "sb3" for another reason: a record written before
-# the field existed was an SB3 run, and keeps its run key.)
-DEFAULT_ENGINE = "population"
+DEFAULT_ENGINE = "population"  # what trains a run that names no engine: configs, the command line, suites
+# A record without an ``engine`` was an SB3 run (made before the field existed): its key
+# leaves "sb3" out, and reading it back gives "sb3" (``runs.config_from``).
+ENGINE_FIELD = {"omit_if": "sb3"}
 
 
 @dataclass(frozen=True)
@@ -40,7 +40,7 @@ class TeacherConfig:
     # envs stepped side by side: each agent step collects n_envs transitions (the authors' 10)
     n_envs: int = field(default=1, metadata={"omit_if_default": True})
     # what trains it (as StudentConfig's engine): a part of the run key
-    engine: str = field(default="sb3", metadata={"omit_if_default": True})
+    engine: str = field(default=DEFAULT_ENGINE, metadata=ENGINE_FIELD)
 
     # A teacher is a product-DQN run on its grid that stops at a greedy-success target: what
     # a trainer reads of a student's config, it reads of a teacher's under the same names.
@@ -99,10 +99,10 @@ class StudentConfig:
     # whether the policy sees the automaton state (None: as its method's row says); only a
     # distilled student may differ from its row (the paper's authors' students did not see it)
     automaton_state: bool | None = field(default=None, metadata={"omit_if_default": True})
-    # what trains it: "sb3" (one SB3 agent per run) or "population" (the seeds of a cell in
-    # one process: craftsuite.population); a part of the run key, since the two are equal in
+    # what trains it: "population" (the seeds of a cell in one process: craftsuite.population)
+    # or "sb3" (one SB3 agent per run); a part of the run key, since the two are equal in
     # their update but not in their random streams
-    engine: str = field(default="sb3", metadata={"omit_if_default": True})
+    engine: str = field(default=DEFAULT_ENGINE, metadata=ENGINE_FIELD)
 
     def __post_init__(self):
         _check_n_envs(self.n_envs)

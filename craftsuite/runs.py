@@ -102,6 +102,8 @@ def config_dict(config) -> dict:
             default = f.default_factory() if f.default_factory is not dataclasses.MISSING else f.default
             if out[f.name] == default:
                 del out[f.name]
+        elif "omit_if" in f.metadata and out[f.name] == f.metadata["omit_if"]:  # what records without it meant
+            del out[f.name]
     return out
 
 
@@ -186,9 +188,10 @@ def read_result(run) -> dict:
 def config_from(cls, record: dict):
     """The config dataclass (``cls``) of a ``config.json`` record of any layout: its fields
     (the effective settings and the provenance are left out; a field a record predates
-    takes its default)."""
-    names = {f.name for f in dataclasses.fields(cls)}
-    return cls(**{k: v for k, v in record.items() if k in names})
+    takes its default, or the value its ``omit_if`` metadata says such records meant)."""
+    fields = dataclasses.fields(cls)
+    absent = {f.name: f.metadata["omit_if"] for f in fields if "omit_if" in f.metadata and f.name not in record}
+    return cls(**absent, **{k: v for k, v in record.items() if k in {f.name for f in fields}})
 
 
 def load_config(cls, run):

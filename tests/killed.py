@@ -9,7 +9,8 @@ from craftsuite.runs import RunDir
 from craftsuite.training import train_student
 
 TINY = {"learning_starts": 50, "buffer_size": 2_000, "policy_kwargs": {"net_arch": [16]}}
-CONFIG = StudentConfig(method="dqn", world="Grid7", steps=300, eval_every=100, eval_episodes=1, hyperparameters=TINY)
+CONFIG = StudentConfig(method="dqn", world="Grid7", steps=300, eval_every=100, eval_episodes=1, hyperparameters=TINY,
+                       engine="sb3")  # the SB3 trainer's checkpoints
 
 
 def killed_run(root, monkeypatch):

@@ -88,13 +88,13 @@ def test_a_number_out_of_range_is_refused_naming_the_flag(tmp_path, capsys, comm
 
 def test_a_run_that_fails_in_its_directory_removes_the_folders_it_made(tmp_path):
     root = tmp_path / "new" / "runs"
-    with pytest.raises(TypeError):  # the policy's constructor refuses the keyword
-        train_teacher(TeacherConfig(max_steps=100, hyperparameters={"policy_kwargs": {"bogus": 1}}), root,
-                      progress=False)
+    with pytest.raises(TypeError):  # the SB3 policy's constructor refuses the keyword, in the run's directory
+        train_teacher(TeacherConfig(max_steps=100, hyperparameters={"policy_kwargs": {"bogus": 1}}, engine="sb3"),
+                      root, progress=False)
     assert list(tmp_path.iterdir()) == []
     (tmp_path / "kept").mkdir()  # a folder that was there before stays
     with pytest.raises(TypeError):
-        train_teacher(TeacherConfig(max_steps=100, hyperparameters={"policy_kwargs": {"bogus": 1}}),
+        train_teacher(TeacherConfig(max_steps=100, hyperparameters={"policy_kwargs": {"bogus": 1}}, engine="sb3"),
                       tmp_path / "kept", progress=False)
     assert [p.name for p in tmp_path.iterdir()] == ["kept"] and list((tmp_path / "kept").iterdir()) == []
 

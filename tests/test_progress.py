@@ -145,7 +145,7 @@ def test_the_suites_bar_announces_reuse_and_resume_and_starts_past_them(killed, 
 
     root = killed.parent
     done = StudentConfig(method="dqn", world="Grid7", seed=1, steps=300, eval_every=100, eval_episodes=1,
-                         hyperparameters=TINY)
+                         hyperparameters=TINY, engine="sb3")
     (root / done.run_name()).mkdir()
     (root / done.run_name() / "result.json").write_text(json.dumps({"steps": 300}))
     made = []

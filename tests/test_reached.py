@@ -65,7 +65,7 @@ def test_a_student_logs_what_its_episodes_reached(tmp_path, monkeypatch, task, m
     monkeypatch.setattr(ObjectiveTracker, "advance", spy_advance)
     monkeypatch.setattr(factory, "make_agent", make_agent)
     config = StudentConfig(task=task, method=method, world=world, steps=1_200, eval_every=1_200, eval_episodes=1,
-                           hyperparameters=hyper, n_envs=2, **kwargs)
+                           hyperparameters=hyper, n_envs=2, engine="sb3", **kwargs)  # its agent's envs spied on
     path = train_student(config, tmp_path, progress=False)
     assert len(episodes) == 2  # the two training envs
     # every episode but each env's last, still running when training stopped (or never stepped)

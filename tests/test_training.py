@@ -1,4 +1,5 @@
-"""Teacher and student runs: reuse, resume after a kill, evaluation logs."""
+"""The SB3 trainer (``engine="sb3"``): teacher and student runs, reuse, resume after a kill,
+evaluation logs. The population engine's own are ``tests/population``."""
 
 import dataclasses
 import json
@@ -18,7 +19,7 @@ TINY_DQN = {"learning_starts": 100, "buffer_size": 5_000}
 
 
 def test_teacher_run_writes_table_and_is_reused(tmp_path):
-    config = TeacherConfig(max_steps=400, eval_every=200, eval_episodes=2, hyperparameters=TINY_DQN)
+    config = TeacherConfig(max_steps=400, eval_every=200, eval_episodes=2, hyperparameters=TINY_DQN, engine="sb3")
     path = train_teacher(config, tmp_path, progress=False)
     result = json.loads((path / "result.json").read_text())
     assert result["steps"] == 400 and not result["reached_target"]
@@ -31,7 +32,7 @@ def test_teacher_run_writes_table_and_is_reused(tmp_path):
 
 def test_student_run_logs_every_episode(tmp_path):
     config = StudentConfig(method="dqn", world="Grid7", steps=900, eval_every=300, eval_episodes=2,
-                           hyperparameters={**TINY_DQN, "learning_starts": 200})
+                           hyperparameters={**TINY_DQN, "learning_starts": 200}, engine="sb3")
     path = train_student(config, tmp_path, progress=False)
     episodes = read_csv(path / "episodes.csv")
     steps = [int(e["step"]) for e in episodes]
@@ -58,7 +59,7 @@ def test_grid_student_keeps_one_fixed_instance(tmp_path, monkeypatch):
     monkeypatch.setattr(factory, "make_agent", make_agent)
     monkeypatch.setattr(training, "evaluate", evaluate)
     config = StudentConfig(method="dqn", world="Grid7", steps=300, eval_every=300, eval_episodes=1,
-                           hyperparameters={**TINY_DQN, "learning_starts": 200}, layout_seed=3)
+                           hyperparameters={**TINY_DQN, "learning_starts": 200}, layout_seed=3, engine="sb3")
     train_student(config, tmp_path, progress=False)
     assert seen == [("train", {"layout_seed": 3}), ("evaluate", {"layout_seed": 3})]
     with pytest.raises(ValueError, match="the Cont world has none"):
@@ -90,7 +91,7 @@ import sys, craftsuite
 from craftsuite.configs import StudentConfig
 from craftsuite.training import train_student
 config = StudentConfig(method="dqn", world="Grid7", steps=3_000, eval_every=500, eval_episodes=1,
-                       hyperparameters={"learning_starts": 200, "buffer_size": 10_000})
+                       hyperparameters={"learning_starts": 200, "buffer_size": 10_000}, engine="sb3")
 train_student(config, sys.argv[1], progress=False)
 """
 
@@ -147,7 +148,8 @@ def test_a_resumed_run_drops_what_tensorboard_logged_after_its_checkpoint(tmp_pa
 
     config = StudentConfig(method="td3", steps=600, eval_every=200, eval_episodes=1,
                            world_kwargs={"frame_skip": 10, "max_episode_steps": 40},
-                           hyperparameters={"learning_starts": 100, "policy_kwargs": {"net_arch": [16]}})
+                           hyperparameters={"learning_starts": 100, "policy_kwargs": {"net_arch": [16]}},
+                           engine="sb3")
     on_step = training.RunCallback._on_step
 
     def dies_at_350(self):  # after the checkpoint at 200 and a rollout log at 320 (every 4 episodes of 40)
@@ -206,7 +208,8 @@ def test_a_student_trains_and_is_evaluated_in_the_world_its_config_names(tmp_pat
     world = {"frame_skip": 10, "max_episode_steps": 40}
     config = StudentConfig(method="td3", steps=200, eval_every=200, eval_episodes=1, world_kwargs=world,
                            hyperparameters={"learning_starts": 100, "policy_kwargs": {"net_arch": [16]},
-                                            "action_noise": {"type": "persistent", "sigma": 0.6, "resample": 0.1}})
+                                            "action_noise": {"type": "persistent", "sigma": 0.6, "resample": 0.1}},
+                           engine="sb3")
     path = train_student(config, tmp_path, progress=False)
     assert {int(e["length"]) for e in read_csv(path / "episodes.csv")} == {40}  # 200 steps: 5 truncated episodes
     assert seen == [world]

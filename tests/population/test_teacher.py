@@ -91,10 +91,12 @@ def test_a_teacher_killed_after_reaching_its_target_finishes_without_training_mo
 
 
 def test_the_engine_is_part_of_a_teachers_run_key_and_sb3_keeps_the_old_one():
-    sb3 = TeacherConfig(task="Reach")
-    assert TeacherConfig(task="Reach", engine="population").run_name() != sb3.run_name()
-    from craftsuite.runs import config_dict
+    from craftsuite.runs import config_dict, config_from
 
+    sb3 = TeacherConfig(task="Reach", engine="sb3")
+    assert TeacherConfig(task="Reach").engine == "population" != sb3.engine
+    assert TeacherConfig(task="Reach").run_name() != sb3.run_name()
     assert "engine" not in config_dict(sb3)  # the records made before the field keep their keys
+    assert config_from(TeacherConfig, config_dict(sb3)).engine == "sb3"  # and are read back as SB3 runs
     with pytest.raises(ValueError, match="engine must be one of"):
         TeacherConfig(engine="jax")

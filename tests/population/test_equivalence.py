@@ -79,16 +79,7 @@ def test_dqn_update_matches_automaton_dqn(loss, prioritized, sparse, layer_norm)
     pop = PopulationDQN(1, agent.observation_space.shape[0], 4, settings, MemberTargets(agent.distill, 1))
     pop.targets.counts[0] = agent.distill.student_counts.reshape(-1)
     pop.load_member(0, agent)
-    for _ in range(3):  # the target network is copied after the second; clipping bites (0.05)
-        samples = agent.replay_buffer.sample(32)
-        _same_sample(agent, samples)
-        agent.train(gradient_steps=1, batch_size=32)
-        batch = _batch(samples)
-        if sparse:
-            width = int((batch.observations != 0).sum(axis=-1).max())
-            batch = batch._replace(observations=sparse_rows(batch.observations, width),
-                                   next_observations=sparse_rows(batch.next_observations, width))
-        pop.update(batch)
+    _train_both(agent, pop, 32, sparse)  # the target network is copied after the second; clipping bites (0.05)
     mine = make_agent("static", "CraftSuite/FirstTool-Grid7-v0", seed=9, buffer_size=16, layer_norm=layer_norm)
     pop.store_member(0, mine)
     for name in ("q_net", "q_net_target"):
@@ -114,16 +105,7 @@ def test_the_residual_cnn_learns_as_automaton_dqns(dueling, sparse):
     planes = agent.get_env().envs[0].unwrapped.observation_layout["planes"]
     pop = PopulationDQN(1, agent.observation_space.shape[0], 4, settings, planes=planes)
     pop.load_member(0, agent)
-    for _ in range(3):  # the target (weights and running statistics) is copied after the second
-        samples = agent.replay_buffer.sample(16)
-        _same_sample(agent, samples)
-        agent.train(gradient_steps=1, batch_size=16)
-        batch = _batch(samples)
-        if sparse:
-            width = int((batch.observations != 0).sum(axis=-1).max())
-            batch = batch._replace(observations=sparse_rows(batch.observations, width),
-                                   next_observations=sparse_rows(batch.next_observations, width))
-        pop.update(batch)
+    _train_both(agent, pop, 16, sparse)  # the target (weights and running statistics) is copied after the second
     mine = make_agent("product-dqn", "CraftSuite/FirstTool-Grid7-v0", seed=9, buffer_size=16, **cnn)
     pop.store_member(0, mine)
     noise = 0.01  # a few of Adam's steps (5e-4 each), against weights of about 0.1
@@ -143,6 +125,21 @@ def test_the_residual_cnn_learns_as_automaton_dqns(dueling, sparse):
     with th.no_grad(), pop.evaluating():
         q_sb3, q_pop = agent.q_net(obs), pop.q_values(pop.q_net, obs[None])[0]
     assert th.allclose(q_sb3, q_pop, atol=1e-2), (q_sb3 - q_pop).abs().max()
+
+
+def _train_both(agent, pop, batch_size: int, sparse: bool, updates: int = 3) -> None:
+    """``updates`` DQN updates of the SB3 agent and of the population on the same minibatches
+    (``sparse``: the population's as the grid replay stores them, their nonzero entries)."""
+    for _ in range(updates):
+        samples = agent.replay_buffer.sample(batch_size)
+        _same_sample(agent, samples)
+        agent.train(gradient_steps=1, batch_size=batch_size)
+        batch = _batch(samples)
+        if sparse:
+            width = int((batch.observations != 0).sum(axis=-1).max())
+            batch = batch._replace(observations=sparse_rows(batch.observations, width),
+                                   next_observations=sparse_rows(batch.next_observations, width))
+        pop.update(batch)
 
 
 def agent_settings(agent, algorithm, **overrides) -> dict:

@@ -81,6 +81,15 @@ class StackedResidualCNN(nn.Module):
         maps = x.reshape(B, K, -1).transpose(0, 1)  # member k's maps flattened as nn.Flatten does
         return th.cat([maps, observations[..., self.n_plane:]], dim=-1)
 
+    def drop_bias_gradients(self) -> None:
+        """Zero the convolutions' bias gradients. Each convolution feeds a batch norm, which
+        subtracts its channels' mean: a bias there has no gradient but rounding noise, which
+        Adam would scale to steps of about the learning rate in random directions (SB3's
+        network drifts so). Held fixed, it computes the same, and the same on every machine."""
+        for bias in self.conv_biases:
+            if bias.grad is not None:
+                bias.grad.zero_()
+
     def running_stats(self) -> list[th.Tensor]:
         """The batch norms' running means and variances (a target network copies them)."""
         return [b for name, b in self.named_buffers() if name.startswith("running_")]

@@ -132,6 +132,8 @@ class PopulationDQN:
         per_member = elementwise.mean(dim=(1, 2))
         self.optimizer.zero_grad()
         per_member.sum().backward()
+        if self.cnn:
+            self.q_net.features.drop_bias_gradients()
         clip_grad_norm_per_member(self.q_net.parameters(), self.max_grad_norm)
         self.optimizer.step()
         self.n_updates += 1

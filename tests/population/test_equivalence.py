@@ -95,9 +95,9 @@ def test_the_residual_cnn_learns_as_automaton_dqns(dueling, sparse):
     the minibatch as the grid replay stores it (nonzero entries), made whole planes again.
 
     A convolution's bias before a batch norm has no gradient but rounding noise (the norm
-    subtracts the mean), which Adam scales to steps of about the learning rate either way:
-    those biases (and the running means that follow them) agree only to a few steps' size,
-    in both engines as between two runs of one; the Q-values they give agree."""
+    subtracts the mean), which Adam scales to steps of about the learning rate either way in
+    SB3's network; the engine holds those biases fixed: they (and the running means that
+    follow them) agree only to a few steps' size; the Q-values they give agree."""
     cnn = {"features_extractor": "residual-cnn", "policy_kwargs": {"net_arch": [32]}, "dueling": dueling,
            "target_update_interval": 2, "target_update_unit": "gradient_steps"}
     agent = _filled("product-dqn", "CraftSuite/FirstTool-Grid7-v0", batch_size=16, **cnn)

@@ -112,15 +112,17 @@ def test_the_population_engine_reproduces_the_frozen_update(name):
     assert not differences, _report(differences, name, "the population engine")
 
 
-@pytest.mark.parametrize("name", ["dqn", "crm-n3", "crm-edges"])
+@pytest.mark.parametrize("name", ["dqn", "crm-n3", "crm-edges", "dqn-residual-cnn"])
 def test_a_sparse_replay_reproduces_the_dense_fixture(name):
     """The grid students' replay (observations as their nonzero entries, the first layer a
-    sum of weight rows; CRM's one-hot moved in them) learns as the dense one."""
+    sum of weight rows, or planes made whole again for a CNN; CRM's one-hot moved in them)
+    learns as the dense one."""
     differences = _differences(_population(name, sparse=True), _fixture(name))
     assert not differences, _report(differences, name, "the sparse replay")
 
 
-@pytest.mark.parametrize("name", ["dqn", "dqn-transitions", "crm-edges-n3", "td3", "td3-dynamic"])
+@pytest.mark.parametrize("name", ["dqn", "dqn-transitions", "crm-edges-n3", "td3", "td3-dynamic",
+                                  "dqn-residual-cnn"])
 def test_member_zero_of_a_population_of_three_reproduces_the_fixture(name):
     """Members learn apart: member 0, beside two members with other minibatches (their own
     counts, gradient norms, priorities), learns as the one-member population did."""

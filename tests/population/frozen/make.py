@@ -22,7 +22,9 @@ step). A fixture records:
   observations, which CRM relabels);
 * ``targets``, ``td``: every update's TD targets (after the distilled mix) and TD errors;
 * ``losses`` (DQN), ``critic_losses`` and ``actor_losses`` (TD3): the scalars backpropagated;
-* ``param/<module>``: every parameter after the updates (the networks are [16, 16]);
+* ``param/<module>``: every parameter after the updates (the networks are [16, 16]; a
+  residual CNN's as ``param_digest/<module>``), and ``buffers/<module>`` a residual CNN's
+  batch-norm running statistics;
 * ``priorities``, ``max_priority`` (prioritized replay: the sum tree's leaves, p ** alpha,
   after the updates) and ``counts`` (distilled targets: the student's count per (w, sigma)).
 
@@ -78,6 +80,7 @@ class Case:
     settings: dict = field(default_factory=dict)  # over DQN or TD3 above
     sb3: bool = True  # the SB3 stack implements the rule (n-step CRM and shaping it does not)
     interleave: bool = False  # a vector step observed before each update (else the replay stays as filled)
+    planes: tuple | None = None  # the world entries as grid planes (C, H, W), for a residual CNN
 
     @property
     def algorithm(self) -> str:
@@ -95,6 +98,9 @@ CASES = {
     "dqn-uniform": Case("dqn", {"dueling": False, "double": False, "loss": "mse", "prioritized": False}),
     "dqn-layer-norm": Case("product-dqn", {"layer_norm": True}),
     "dqn-n3": Case("product-dqn", {"n_steps": 3}),
+    # the paper's residual CNN over the 8 world entries as 2 planes of 2 x 2 (batch norms in
+    # training mode for the update's own Q-values only, the target copying running statistics)
+    "dqn-residual-cnn": Case("product-dqn", {"features_extractor": "residual-cnn"}, sb3=False, planes=(2, 2, 2)),
     # the hard target update counted in transitions (SB3's, the default): every 3 vector steps
     "dqn-transitions": Case("product-dqn", {"target_update_unit": "transitions", "target_update_interval": 6},
                             interleave=True),
@@ -203,7 +209,7 @@ def set_parameters(learner) -> None:
             for name, p in net.named_parameters():
                 rng = np.random.default_rng(zlib.crc32(f"{module}/{name}".encode()))
                 shape = p.shape[1:]  # one member's
-                if "norm_weights" in name:
+                if "norm_weights" in name or "bn_weights" in name:
                     value = 1.0 + rng.uniform(-0.2, 0.2, size=shape)
                 elif "norm_biases" in name or "biases" in name:
                     value = rng.uniform(-0.2, 0.2, size=shape)
@@ -213,11 +219,36 @@ def set_parameters(learner) -> None:
                 p.copy_(th.as_tensor(value, dtype=p.dtype).expand_as(p))
 
 
+LARGE = 20_000  # a network with more parameters (a CNN's) is kept as digests: the fixtures stay small
+
+
 def parameters(learner) -> dict[str, np.ndarray]:
     """Member 0's parameters, ``param/<module>``: its tensors flattened one after the other
-    in ``named_parameters`` order."""
-    return {f"param/{module}": np.concatenate([p.detach()[0].cpu().numpy().reshape(-1) for p in net.parameters()])
-            for module, net in learner.modules().items()}
+    in ``named_parameters`` order; a network of more than ``LARGE`` as ``param_digest/<module>``,
+    three numbers per tensor (``digest``)."""
+    out = {}
+    for module, net in learner.modules().items():
+        tensors = [p.detach()[0].cpu().numpy().reshape(-1) for p in net.parameters()]
+        if sum(t.size for t in tensors) <= LARGE:
+            out[f"param/{module}"] = np.concatenate(tensors)
+        else:
+            out[f"param_digest/{module}"] = np.concatenate([digest(t) for t in tensors])
+    return out
+
+
+def digest(values: np.ndarray) -> np.ndarray:
+    """A tensor as its sum, its sum of magnitudes and a sum weighted by fixed draws (a change
+    of any entry, or two entries swapped, moves it)."""
+    weights = np.random.default_rng(values.size).uniform(0.5, 1.5, size=values.size)
+    x = values.astype(np.float64)
+    return np.array([x.sum(), np.abs(x).sum(), (weights * x).sum()])
+
+
+def statistics(learner) -> dict[str, np.ndarray]:
+    """Member 0's batch-norm running statistics, ``buffers/<module>``, for the networks that
+    have them (a residual CNN's)."""
+    return {f"buffers/{module}": np.concatenate([b[0].cpu().numpy().reshape(-1) for b in net.buffers()])
+            for module, net in learner.modules().items() if list(net.buffers())}
 
 
 def build(name: str, sparse: bool = False, members: int = 1):
@@ -234,7 +265,7 @@ def build(name: str, sparse: bool = False, members: int = 1):
     K = members
     pop = Population(case.method, case.effective(), list(range(K)), N_ENVS, obs_dim, space, automaton, completion,
                      total_steps=10_000, table=table if METHODS[case.method].needs_table else None,
-                     sparse_width=SPARSE_WIDTH if sparse else None)
+                     sparse_width=SPARSE_WIDTH if sparse else None, planes=case.planes)
     set_parameters(pop.learner)
     counts = initial_counts(automaton.delta.size)
     if pop.learner.targets is not None:
@@ -332,7 +363,7 @@ def run(name: str, sparse: bool = False, members: int = 1) -> dict:
               "input_digest": input_digest(inputs["steps"], inputs["table"], inputs["counts"]),
               "init_digest": np.array([p.detach()[0].double().sum().item() for net in learner.modules().values()
                                        for p in net.parameters()])}
-    obs_dim = learner.q_net.sizes[0] if pop.discrete else learner.actor.sizes[0]
+    obs_dim = FEATURES[CASES[name].algorithm] + automaton.n_states
     if members > 1:
         replay.rng = MemberZero(replay.rng, np.random.default_rng(99))
     recorder = Recorder(replay.rng)
@@ -396,6 +427,7 @@ def run(name: str, sparse: bool = False, members: int = 1) -> dict:
         record["critic_losses"] = np.array([s[0] for s in losses], dtype=np.float32)
         record["actor_losses"] = np.array([s[1] for s in losses if len(s) > 1], dtype=np.float32)
     record.update(parameters(learner))
+    record.update(statistics(learner))
     if replay.trees is not None:
         record["priorities"] = replay.trees.tree[0, replay.trees.leaves:replay.trees.leaves
                                                  + replay.size * replay.per_step].copy()

@@ -15,6 +15,8 @@ from craftsuite.configs import StudentConfig, TeacherConfig
 from craftsuite.runs import RunDir, RunError, load_config, read_csv, settings
 from craftsuite.training import train_student, train_teacher
 
+from .scalars import hparams_sessions, scalar_steps
+
 TINY_DQN = {"learning_starts": 100, "buffer_size": 5_000}
 
 
@@ -134,15 +136,6 @@ def test_a_killed_run_resumes_from_its_checkpoint(tmp_path):
     assert (run / "model.zip").is_file() and not (run / "checkpoint").exists()  # no replay buffer kept
 
 
-def _scalar_steps(log_dir) -> dict[str, list[int]]:
-    """Each TensorBoard scalar's steps, as TensorBoard shows them (purges applied)."""
-    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
-
-    events = EventAccumulator(str(log_dir))
-    events.Reload()
-    return {tag: [e.step for e in events.Scalars(tag)] for tag in events.Tags()["scalars"]}
-
-
 def test_a_resumed_run_drops_what_tensorboard_logged_after_its_checkpoint(tmp_path, monkeypatch):
     import craftsuite.training as training
 
@@ -161,37 +154,20 @@ def test_a_resumed_run_drops_what_tensorboard_logged_after_its_checkpoint(tmp_pa
     with pytest.raises(KeyboardInterrupt):
         train_student(config, tmp_path, progress=False)
     (log_dir,) = tmp_path.glob("*/tb/run_0")
-    assert 320 in _scalar_steps(log_dir)["rollout/ep_rew_mean"]  # logged, then lost with the kill
+    assert 320 in scalar_steps(log_dir)["rollout/ep_rew_mean"]  # logged, then lost with the kill
     monkeypatch.setattr(training.RunCallback, "_on_step", on_step)
     train_student(config, tmp_path, progress=False)  # resumes from step 200
-    steps = _scalar_steps(log_dir)
+    steps = scalar_steps(log_dir)
     # SB3's evaluation tags, each at its evaluation's step, none twice
     for tag in ("eval/mean_reward", "eval/success_rate", "eval/mean_ep_length"):
         assert steps[tag] == [200, 400, 600]
     assert steps["rollout/ep_rew_mean"] == [160, 360, 520]  # the killed run's 320 is gone
     assert all(s == sorted(set(s)) for s in steps.values())
-    [hparams] = _hparams(log_dir)  # logged once, by the session that started the run
+    [hparams] = hparams_sessions(log_dir)  # logged once, by the session that started the run
     assert hparams["method"] == "td3" and hparams["steps"] == 600
     assert hparams["hyperparameters.learning_rate"] == 1e-4  # the default, as it ran
     assert hparams["hyperparameters.policy_kwargs.net_arch"] == "[16]"  # the override
     assert hparams["method.target"] == "null" and hparams["world.id"] == "CraftSuite/BlindCraftsman-Cont-v0"
-
-
-def _hparams(log_dir) -> list[dict]:
-    """The HParams sessions TensorBoard shows for a run: one dict per session start."""
-    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
-    from tensorboard.plugins.hparams import plugin_data_pb2
-
-    events = EventAccumulator(str(log_dir))
-    events.Reload()
-    out = []
-    for content in events.PluginTagToContent("hparams").values():
-        data = plugin_data_pb2.HParamsPluginData.FromString(content)
-        if data.HasField("session_start_info"):
-            out.append({k: v.number_value if v.HasField("number_value") else
-                        v.bool_value if v.HasField("bool_value") else v.string_value
-                        for k, v in data.session_start_info.hparams.items()})
-    return out
 
 
 def test_a_student_trains_and_is_evaluated_in_the_world_its_config_names(tmp_path, monkeypatch):

@@ -215,19 +215,19 @@ def test_suites_train_each_cell_as_one_population():
 
 def test_each_member_logs_to_tensorboard_as_an_sb3_run_and_a_resume_drops_what_the_kill_logged(tmp_path,
                                                                                              monkeypatch):
-    from ..test_training import _hparams, _scalar_steps
+    from ..scalars import hparams_sessions, scalar_steps
 
     configs = _cell("dqn", "Grid7", "FirstTool", seeds=(0, 1), layout_seed=0)
     _killed_at_the_second_evaluation(configs, tmp_path, monkeypatch, at="_checkpoint")  # 800 logged, not kept
-    killed = _scalar_steps(tmp_path / configs[0].run_name() / "tb" / "run_0")
+    killed = scalar_steps(tmp_path / configs[0].run_name() / "tb" / "run_0")
     assert killed["eval/success_rate"] == [400, 800]  # logged, then lost with the kill
     paths = train_population(configs, tmp_path, progress=False)
     for config, path in zip(configs, paths):
-        steps = _scalar_steps(path / "tb" / "run_0")
+        steps = scalar_steps(path / "tb" / "run_0")
         for tag in ("eval/mean_reward", "eval/success_rate", "eval/mean_ep_length"):  # SB3's tags
             assert steps[tag] == [400, 800, 1200]  # each once: the killed session's 800 is dropped
         assert steps["rollout/ep_rew_mean"] and all(s == sorted(set(s)) for s in steps.values())
-        [settings] = _hparams(path / "tb" / "run_0")  # once per run, by the session that started it
+        [settings] = hparams_sessions(path / "tb" / "run_0")  # once per run, by the session that started it
         assert settings["method"] == "dqn" and settings["seed"] == config.seed and settings["engine"] == "population"
 
 

@@ -16,8 +16,8 @@ A run directory holds
   episode length);
 * ``checkpoint/``: the last model and replay buffer, written together at each evaluation,
   and ``checkpoint-old/``, the one before, kept until the next is complete so that a
-  damaged newest checkpoint can be resumed from the one before (``training._resume``,
-  which keeps the damaged one aside as ``checkpoint-unloadable/``); ``RunDir`` rotates
+  damaged newest checkpoint can be resumed from the one before (both trainers' resume
+  keeps the damaged one aside as ``checkpoint-unloadable/``); ``RunDir`` rotates
   them. A student's are removed when it finishes (its final model is ``model.zip``), a
   teacher's older one;
 * ``tb/``: TensorBoard logs (on resume, what the killed run logged after its checkpoint is
@@ -334,6 +334,15 @@ class RunDir:
     # -- files -----------------------------------------------------------------------------------
     # -- checkpoints: the newest being written, the last, the one before -----------------------
     CHECKPOINTS = ("checkpoint-new", "checkpoint", "checkpoint-old")  # newest first
+    UNLOADABLE = "checkpoint-unloadable"  # where a checkpoint that failed to load is kept aside
+
+    def set_aside(self, folder: Path) -> Path:
+        """Keep a checkpoint ``folder`` that failed to load as ``checkpoint-unloadable`` (one
+        kept: a newer failure replaces an older), out of the rotation of checkpoints."""
+        aside = self.path / self.UNLOADABLE
+        shutil.rmtree(aside, ignore_errors=True)
+        folder.rename(aside)
+        return aside
 
     def new_checkpoint(self) -> Path:
         """An empty ``checkpoint-new`` to write the next checkpoint into (what a kill left

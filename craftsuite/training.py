@@ -152,9 +152,6 @@ def save_checkpoint(agent, run: RunDir) -> None:
     run.commit_checkpoint()
 
 
-UNLOADABLE = "checkpoint-unloadable"  # where a checkpoint that failed to load is kept aside
-
-
 def _resume(run: RunDir, fresh):
     """The agent of the run's newest checkpoint that loads whole (model and replay buffer,
     both from one checkpoint), or None when the run has none. A checkpoint that cannot be
@@ -171,9 +168,7 @@ def _resume(run: RunDir, fresh):
             failed.append((saved, str(err)))
             continue
         if failed:
-            aside = run.path / UNLOADABLE
-            shutil.rmtree(aside, ignore_errors=True)
-            failed[0][0].rename(aside)  # the newest failure; an older one is never rotated in again
+            aside = run.set_aside(failed[0][0])  # the newest failure; an older one is never rotated in again
             for other, _ in failed[1:]:
                 shutil.rmtree(other, ignore_errors=True)  # older than ``aside``, and unloadable too
             warnings.warn(f"{run.path}: resuming from {saved.name}, the newest checkpoint that loads; "

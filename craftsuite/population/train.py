@@ -272,11 +272,16 @@ def _saved_steps(run: RunDir) -> dict[int, Path]:
 
 
 def _resume(pop: Population, runs) -> None:
-    """Load the newest step every member has a checkpoint of (a kill between two members'
-    commits leaves the one before), and trim each member's logs to it. With no checkpoint at
-    all, the population starts at step 0. A checkpoint that cannot be loaded is an error that
-    names it (nothing is deleted); so is a population whose members share no step."""
-    from ..runs import CheckpointError, machine_errors
+    """Load the newest step every member has a checkpoint of that loads (a kill between two
+    members' commits leaves the one before), and trim each member's logs to it. With no
+    checkpoint at all, the population starts at step 0. A checkpoint that cannot be loaded
+    (a truncated file, say) is passed over for the step before it, with a warning, and kept
+    aside as ``checkpoint-unloadable``; when no step loads, the error names each file, why,
+    and what to do, and nothing is moved or deleted. So is a population whose members share
+    no step."""
+    import warnings
+
+    from ..runs import CheckpointError
 
     found = [_saved_steps(run) for run in runs]
     if not any(found):
@@ -289,17 +294,21 @@ def _resume(pop: Population, runs) -> None:
             f"the population of {', '.join(str(r.path) for r in runs)} cannot resume: its members' checkpoints "
             f"are at different steps ({', '.join(str(sorted(f)) for f in found)}). Move their checkpoint "
             "directories aside to train them again from step 0, or choose another output directory")
-    step = max(common)
-    states = []
-    for steps in found:
-        path = steps[step]
-        try:
-            states.append(th.load(path, weights_only=False, map_location=pop.learner.device))
-        except machine_errors():
-            raise  # the machine's limits, not the file's fault
-        except Exception as err:  # a damaged file
-            raise CheckpointError(f"{path} cannot be loaded ({type(err).__name__}: {err}): move it aside to "
-                                  "resume from the checkpoint before it, or train the population again") from None
+    failed = []  # (run, checkpoint file, why), newest first
+    for step in sorted(common, reverse=True):
+        states = _load_step(pop, runs, found, step, failed)
+        if states is not None:
+            break
+    else:
+        raise CheckpointError(
+            "the population cannot resume: " + "; ".join(why for _, _, why in failed) + ". Move "
+            + " and ".join(str(path.parent) for _, path, _ in failed) + " aside to train it again from step 0 "
+            "(its logs are trimmed to match), or choose another output directory")
+    for run, path, why in failed:
+        if path.parent.exists():  # a member's newest failure (an older one of the same member went with it)
+            aside = run.set_aside(path.parent)
+            warnings.warn(f"{run.path}: resuming from step {step}, the newest its population loads; {why} "
+                          f"(kept as {aside})", RuntimeWarning, stacklevel=2)
     pop.load_states(states)
     print(f"{', '.join(str(r.path) for r in runs)}: resuming from their checkpoints at step {step} "
           "(episodes logged after it are dropped and played again)")
@@ -307,6 +316,24 @@ def _resume(pop: Population, runs) -> None:
         if steps[step].parent.name == run.CHECKPOINTS[0]:  # a kill came between its writing and its commit
             run.commit_checkpoint()  # as a single run does: the next checkpoint keeps this one
         run.trim_logs(step)
+
+
+def _load_step(pop: Population, runs, found, step: int, failed: list) -> list[dict] | None:
+    """Every member's state at ``step``, or None after adding the first that does not load
+    to ``failed``."""
+    from ..runs import machine_errors
+
+    states = []
+    for run, steps in zip(runs, found):
+        path = steps[step]
+        try:
+            states.append(th.load(path, weights_only=False, map_location=pop.learner.device))
+        except machine_errors():
+            raise  # the machine's limits, not the file's fault
+        except Exception as err:  # a damaged file
+            failed.append((run, path, f"{path} cannot be loaded ({type(err).__name__}: {err})"))
+            return None
+    return states
 
 
 def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, seconds: float, device: str) -> None:

@@ -135,6 +135,44 @@ def test_a_checkpoint_written_but_not_committed_is_committed_when_resumed(tmp_pa
     assert folders[member.name] == ["checkpoint"]
 
 
+def _killed_at_the_third_evaluation(configs, root, monkeypatch) -> None:
+    real, calls = population_train._evaluate, {"n": 0}
+
+    def dies_at_the_third(*args):
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise KeyboardInterrupt
+        return real(*args)
+
+    with monkeypatch.context() as patch:
+        patch.setattr(population_train, "_evaluate", dies_at_the_third)
+        with pytest.raises(KeyboardInterrupt):
+            train_population(configs, root, progress=False)
+
+
+def test_a_damaged_checkpoint_is_passed_over_for_the_populations_step_before(tmp_path, monkeypatch):
+    """Checkpoints at 400 and 800, member 1's newest damaged: every member resumes from 400
+    (a warning names the file), the damaged one kept aside, and the runs finish."""
+    configs = _cell(seeds=(0, 1))
+    _killed_at_the_third_evaluation(configs, tmp_path, monkeypatch)
+    member = tmp_path / configs[1].run_name()
+    (member / "checkpoint" / "population.pt").write_bytes(b"not a checkpoint")
+    loaded = {}
+    load = population_train.Population.load_states
+
+    def spy(self, states):
+        loaded["steps"] = [s["num_timesteps"] for s in states]
+        load(self, states)
+
+    monkeypatch.setattr(population_train.Population, "load_states", spy)
+    with pytest.warns(RuntimeWarning, match="resuming from step 400.*population.pt cannot be loaded"):
+        paths = train_population(configs, tmp_path, progress=False)
+    assert loaded["steps"] == [400, 400]
+    assert (member / "checkpoint-unloadable" / "population.pt").read_bytes() == b"not a checkpoint"
+    for path in paths:
+        assert [int(r["step"]) for r in read_csv(path / "evals.csv")] == [400, 800, 1200]
+
+
 def test_a_population_that_cannot_resume_says_so_and_deletes_nothing(tmp_path, monkeypatch):
     from craftsuite.runs import CheckpointError
 

@@ -419,9 +419,10 @@ def last_success(run) -> float:
 
 
 def reached_target(run, target: float) -> bool:
-    """Whether the last evaluation of the run at ``run`` reached ``target`` greedy success
-    (a teacher's stopping rule)."""
-    return bool(read_csv(Path(run) / "evals.csv")) and last_success(run) >= target
+    """Whether the run at ``run`` has an evaluation and its last reached ``target`` greedy
+    success (a teacher's stopping rule)."""
+    evals = read_csv(Path(run) / "evals.csv")
+    return bool(evals) and float(evals[-1]["success"]) >= target
 
 
 def read_csv(path, fields: tuple[str, ...] = (), required: bool = False) -> list[dict]:

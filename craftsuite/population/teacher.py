@@ -20,9 +20,9 @@ from ..agents.distillation import AutomatonQTable, dynamic_distillation
 from ..configs import TeacherConfig, teacher_result
 from ..reached import check_automaton
 from ..runs import RunDir, last_success
-from .engine import Population, check_supported, sparse_width
+from .engine import Population, check_supported
 from .replay import SparseRows
-from .train import CHECKPOINT, STEP, _train, check_device
+from .train import CHECKPOINT, STEP, _train, build_population, check_device, save_member
 
 
 def train_teacher(config: TeacherConfig, root, progress: bool = True, device: str = "cpu") -> Path:
@@ -42,18 +42,10 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True, device: st
 
 
 def _finish_teacher(pop: Population, k: int, config: TeacherConfig, run: RunDir, seconds: float) -> None:
-    from ..agents.factory import make_agent
-    from ..files import atomic_path
     from ..task_registry import resolve_task
 
     distill(pop, resolve_task(config.task).automaton)[k].save(run.path / "table.npz")
-    agent = make_agent(config.method, config.env_id, seed=config.seed, n_envs=1, env_kwargs=config.env_kwargs,
-                       to_save=True, **config.effective()["hyperparameters"])
-    pop.learner.store_member(k, agent)
-    agent.num_timesteps, agent.n_updates = pop.num_timesteps, pop.learner.n_updates
-    with atomic_path(run.path / "teacher.zip") as tmp:
-        agent.save(tmp)
-    agent.get_env().close()
+    save_member(pop, k, config, run.path / "teacher.zip")
     run.write_result(teacher_result(config, pop.learner.algorithm, pop.num_timesteps, pop.learner.n_updates,
                                     last_success(run.path), seconds, engine="population"))
     run.remove_checkpoints(keep_last=True)  # after the result: a kill before it resumes
@@ -92,18 +84,14 @@ def distill_run(path) -> tuple[AutomatonQTable, object]:
     """
     from ..runs import load_config
     from ..task_registry import resolve_task
-    from .envs import make_envs, observation_planes
+    from .envs import make_envs
 
     config = load_config(TeacherConfig, path)
     saved = RunDir(path, config).last_checkpoint((CHECKPOINT, STEP))
     if saved is None:
         raise FileNotFoundError(f"{path} has no checkpoint ({CHECKPOINT}, with the replay) to distil from")
     spec = resolve_task(config.task)
-    settings = config.effective()["hyperparameters"]
     with contextlib.closing(make_envs(config.env_id, 1, config.env_kwargs, True)) as envs:
-        obs_dim, actions = envs.single_observation_space.shape[0], envs.single_action_space
-    pop = Population(config.method, settings, [config.seed], config.n_envs, obs_dim, actions, spec.automaton,
-                     spec.completion_reward, config.steps, None, "cpu", sparse_width(spec, "Grid", True),
-                     observation_planes(config.env_id, config.env_kwargs, True, settings))
+        pop = build_population(config, [config.seed], config.effective()["hyperparameters"], spec, None, "cpu", envs)
     pop.load_states([th.load(saved / CHECKPOINT, weights_only=False, map_location="cpu")])
     return distill(pop, spec.automaton)[0], spec.automaton

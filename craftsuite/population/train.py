@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import shutil
 import time
 from pathlib import Path
 
@@ -121,11 +122,7 @@ def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=No
     if device.type == "cpu":
         th.set_num_threads(1)  # small nets: one thread is fastest and leaves the other cores to other cells
     try:
-        obs_dim = envs.single_observation_space.shape[0]
-        pop = Population(config.method, settings, [c.seed for c in configs], n, obs_dim, envs.single_action_space,
-                         spec.automaton, spec.completion_reward, config.steps, table, str(device),
-                         sparse_width(spec, world_kind(config.world), config.product),
-                         observation_planes(config.env_id, config.env_kwargs, config.product, settings))
+        pop = build_population(config, [c.seed for c in configs], settings, spec, table, device, envs)
         _resume(pop, runs)
         logs = [Scalars(run, pop.num_timesteps) for run in runs]
         for log in logs:
@@ -144,6 +141,15 @@ def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=No
     finally:
         stack.close()
         th.set_num_threads(threads)
+
+
+def build_population(config, seeds: list[int], settings: dict, spec, table, device, envs) -> Population:
+    """The population of ``config``'s cell (a student's or a teacher's) for ``seeds``, its
+    spaces read from ``envs`` (any vector env of the run's world)."""
+    return Population(config.method, settings, seeds, config.n_envs, envs.single_observation_space.shape[0],
+                      envs.single_action_space, spec.automaton, spec.completion_reward, config.steps, table,
+                      str(device), sparse_width(spec, world_kind(config.world), config.product),
+                      observation_planes(config.env_id, config.env_kwargs, config.product, settings))
 
 
 def _loop(pop: Population, envs, eval_envs, configs, runs, logs, bar, automaton, on_evaluation=None,
@@ -276,9 +282,10 @@ def _resume(pop: Population, runs) -> None:
     members' commits leaves the one before), and trim each member's logs to it. With no
     checkpoint at all, the population starts at step 0. A checkpoint that cannot be loaded
     (a truncated file, say) is passed over for the step before it, with a warning, and kept
-    aside as ``checkpoint-unloadable``; when no step loads, the error names each file, why,
-    and what to do, and nothing is moved or deleted. So is a population whose members share
-    no step."""
+    aside as ``checkpoint-unloadable`` (a member's newest such; its other checkpoints newer
+    than the step resumed from are removed, so that the next commits keep the one resumed
+    from); when no step loads, the error names each file, why, and what to do, and nothing
+    is moved or deleted. So is a population whose members share no step."""
     import warnings
 
     from ..runs import CheckpointError
@@ -304,11 +311,14 @@ def _resume(pop: Population, runs) -> None:
             "the population cannot resume: " + "; ".join(why for _, _, why in failed) + ". Move "
             + " and ".join(str(path.parent) for _, path, _ in failed) + " aside to train it again from step 0 "
             "(its logs are trimmed to match), or choose another output directory")
-    for run, path, why in failed:
-        if path.parent.exists():  # a member's newest failure (an older one of the same member went with it)
-            aside = run.set_aside(path.parent)
-            warnings.warn(f"{run.path}: resuming from step {step}, the newest its population loads; {why} "
-                          f"(kept as {aside})", RuntimeWarning, stacklevel=2)
+    for run, steps in zip(runs, found):  # what is newer than ``step`` leaves the rotation of checkpoints
+        damaged = [(path, why) for r, path, why in failed if r is run]  # newest first
+        if damaged:
+            aside = run.set_aside(damaged[0][0].parent)
+            warnings.warn(f"{run.path}: resuming from step {step}, the newest its population loads; "
+                          f"{damaged[0][1]} (kept as {aside})", RuntimeWarning, stacklevel=2)
+        for newer in [path.parent for at, path in steps.items() if at > step and path.parent.exists()]:
+            shutil.rmtree(newer)  # damaged too, or of the steps the population cannot resume from
     pop.load_states(states)
     print(f"{', '.join(str(r.path) for r in runs)}: resuming from their checkpoints at step {step} "
           "(episodes logged after it are dropped and played again)")
@@ -336,10 +346,10 @@ def _load_step(pop: Population, runs, found, step: int, failed: list) -> list[di
     return states
 
 
-def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, seconds: float, device: str) -> None:
-    """Member ``k``'s model as an SB3 agent (``model.zip``), its result, its checkpoints gone."""
+def save_member(pop: Population, k: int, config, path: Path, table=None) -> None:
+    """Member ``k`` as an SB3 agent of its method (a student's or a teacher's config), saved
+    at ``path``: what ``load_agent`` and SB3's own ``load`` open."""
     from ..agents.factory import make_agent
-    from ..configs import student_result
 
     agent = make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=1,
                        env_kwargs=config.env_kwargs, automaton_state=config.automaton_state, to_save=True,
@@ -348,9 +358,16 @@ def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, 
     agent.num_timesteps, agent.n_updates = pop.num_timesteps, pop.learner.n_updates
     if pop.learner.targets is not None:
         agent.distill = pop.learner.targets.member(k)
-    with atomic_path(run.path / "model.zip") as tmp:
+    with atomic_path(path) as tmp:
         agent.save(tmp)
     agent.get_env().close()
+
+
+def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, seconds: float, device: str) -> None:
+    """Member ``k``'s model as an SB3 agent (``model.zip``), its result, its checkpoints gone."""
+    from ..configs import student_result
+
+    save_member(pop, k, config, run.path / "model.zip", table)
     run.write_result(student_result(config, pop.learner.algorithm, pop.num_timesteps, pop.learner.n_updates, seconds,
                                     engine="population", members=pop.K, device=device))
     run.remove_checkpoints()

@@ -72,19 +72,19 @@ def test_a_members_model_acts_as_the_member(features, tmp_path, monkeypatch):
         np.testing.assert_array_equal(agent.predict(obs[k], deterministic=True)[0], greedy[k])
 
 
-def _killed_at_the_second_evaluation(configs, root, monkeypatch, at: str = "_evaluate") -> None:
-    """The population killed at the second call of ``at``: its evaluation (before it is
-    made), or ``_checkpoint`` (the evaluation made and logged, its checkpoint not)."""
+def _killed_at_the_second_evaluation(configs, root, monkeypatch, at: str = "_evaluate", call: int = 2) -> None:
+    """The population killed at the second (``call``-th) call of ``at``: its evaluation
+    (before it is made), or ``_checkpoint`` (the evaluation made and logged, its checkpoint not)."""
     real, calls = getattr(population_train, at), {"n": 0}
 
-    def dies_at_the_second(*args):
+    def dies(*args):
         calls["n"] += 1
-        if calls["n"] == 2:
+        if calls["n"] == call:
             raise KeyboardInterrupt
         return real(*args)
 
     with monkeypatch.context() as patch:
-        patch.setattr(population_train, at, dies_at_the_second)
+        patch.setattr(population_train, at, dies)
         with pytest.raises(KeyboardInterrupt):
             train_population(configs, root, progress=False)
 
@@ -135,26 +135,12 @@ def test_a_checkpoint_written_but_not_committed_is_committed_when_resumed(tmp_pa
     assert folders[member.name] == ["checkpoint"]
 
 
-def _killed_at_the_third_evaluation(configs, root, monkeypatch) -> None:
-    real, calls = population_train._evaluate, {"n": 0}
-
-    def dies_at_the_third(*args):
-        calls["n"] += 1
-        if calls["n"] == 3:
-            raise KeyboardInterrupt
-        return real(*args)
-
-    with monkeypatch.context() as patch:
-        patch.setattr(population_train, "_evaluate", dies_at_the_third)
-        with pytest.raises(KeyboardInterrupt):
-            train_population(configs, root, progress=False)
-
-
 def test_a_damaged_checkpoint_is_passed_over_for_the_populations_step_before(tmp_path, monkeypatch):
     """Checkpoints at 400 and 800, member 1's newest damaged: every member resumes from 400
-    (a warning names the file), the damaged one kept aside, and the runs finish."""
+    (a warning names the file), the damaged one kept aside, member 0's 800 out of the
+    rotation (so the next commit keeps the 400 resumed from), and the runs finish."""
     configs = _cell(seeds=(0, 1))
-    _killed_at_the_third_evaluation(configs, tmp_path, monkeypatch)
+    _killed_at_the_second_evaluation(configs, tmp_path, monkeypatch, call=3)
     member = tmp_path / configs[1].run_name()
     (member / "checkpoint" / "population.pt").write_bytes(b"not a checkpoint")
     loaded = {}
@@ -162,12 +148,14 @@ def test_a_damaged_checkpoint_is_passed_over_for_the_populations_step_before(tmp
 
     def spy(self, states):
         loaded["steps"] = [s["num_timesteps"] for s in states]
+        loaded["folders"] = [sorted(p.name for p in (tmp_path / c.run_name()).glob("checkpoint*")) for c in configs]
         load(self, states)
 
     monkeypatch.setattr(population_train.Population, "load_states", spy)
     with pytest.warns(RuntimeWarning, match="resuming from step 400.*population.pt cannot be loaded"):
         paths = train_population(configs, tmp_path, progress=False)
     assert loaded["steps"] == [400, 400]
+    assert loaded["folders"] == [["checkpoint-old"], ["checkpoint-old", "checkpoint-unloadable"]]
     assert (member / "checkpoint-unloadable" / "population.pt").read_bytes() == b"not a checkpoint"
     for path in paths:
         assert [int(r["step"]) for r in read_csv(path / "evals.csv")] == [400, 800, 1200]

@@ -200,27 +200,28 @@ TRANSFER_METHODS = ("dqn", "dynamic", "crm-edges", "td3", "td3-dynamic", "td3-cr
 # collapse that follows their first success (greedy success falls for 30-80k transitions
 # before it settles: experiments/collection-regime, "Stability"), so that the last
 # evaluation reads what was learned. The middle rungs (tagged ``middle``) each get the
-# budget at which TD3 from scratch lands between 20% and 80% greedy success in MuJoCo
-# (experiments/rung-calibration): where methods can differ. The paper's tasks get 1M
-# transitions per run, in their own suite: on 2 cores it takes a working day.
+# budget at which TD3 from scratch, in the suite's learner regime, lands between 20% and 80%
+# greedy success in MuJoCo (experiments/learner-regime, plan part 2): where methods can
+# differ. The paper's tasks get 1M transitions per run, in their own suite.
 SUITES = {s.name: s for s in (
     Suite("quick", "the calibration rung and the two-stage rung in MuJoCo: TD3 from scratch and distilled "
           "(about 12 minutes on 2 cores)",
           tasks=("Reach", "FirstTool"), worlds=("Cont",), methods=("td3", "td3-dynamic-edges"), seeds=2,
           budgets={"Cont": {"easy": 200_000, "medium": 800_000}}, archived=False, **TD3_REGIME),
     Suite("standard", "the easy, medium and middle rungs x the paper's methods and baselines, Grid10 and MuJoCo, "
-          "5 seeds (on 2 cores: its grid half took 65 min, its MuJoCo half projects about 4 hours; the paper's "
-          "tasks are the hard suite)",
-          tags=("easy", "medium"), worlds=("Grid10", "Cont"), methods=SUITE_METHODS, seeds=5,
-          budgets={"Cont": {"easy": 250_000, "medium": 800_000, "TwoToolsHome": 1_200_000,
-                            "KeySwordDragon": 400_000},
+          "10 seeds, in the n-step-wide learner regime (on 2 cores many hours: run it in parts, with --worlds, "
+          "--tasks or --methods; the paper's tasks are the hard suite)",
+          tags=("easy", "medium"), worlds=("Grid10", "Cont"), methods=SUITE_METHODS, seeds=10,
+          budgets={"Cont": {"easy": 250_000, "medium": 800_000, "KeySwordDragon": 100_000, "ToolHome": 250_000,
+                            "TwoToolsHome": 300_000},
                    "Grid": {"easy": 30_000, "medium": 150_000}},
-          **TD3_REGIME, **DQN_REGIME),
+          regime="n-step-wide", **TD3_REGIME, **DQN_REGIME),
     Suite("hard", "the paper's tasks x the paper's methods and baselines at 1M transitions per run, Grid10 and "
-          "MuJoCo, 5 seeds (on 2 cores about 5 hours for MuJoCo and 7 for the grids: run it in parts, with "
+          "MuJoCo, 10 seeds, in the n-step-wide learner regime (on 2 cores well over a day: run it in parts, with "
           "--worlds, --tasks or --methods, on any machines; the results archive gathers them)",
-          tags=("hard",), worlds=("Grid10", "Cont"), methods=SUITE_METHODS, seeds=5,
-          budgets={"Cont": {"hard": 1_000_000}, "Grid": {"hard": 1_000_000}}, **TD3_REGIME, **DQN_REGIME),
+          tags=("hard",), worlds=("Grid10", "Cont"), methods=SUITE_METHODS, seeds=10,
+          budgets={"Cont": {"hard": 1_000_000}, "Grid": {"hard": 1_000_000}}, regime="n-step-wide", **TD3_REGIME,
+          **DQN_REGIME),
     Suite("paper", "the paper's protocol as the authors' code ran it: the paper's methods and baselines on its tasks "
           "in the grid, MuJoCo and kinematic worlds, 20 seeds, 2M steps of 10 envs (20M transitions) per run",
           tags=("paper",), worlds=("Grid10", "Cont", "Kinematic"), methods=PAPER_METHODS, seeds=20,

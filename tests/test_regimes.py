@@ -5,6 +5,7 @@ import dataclasses
 
 import pytest
 
+from craftsuite.methods import METHODS
 from craftsuite.regimes import REGIMES, regime_of
 from craftsuite.reporting.board import build
 from craftsuite.reporting.pages import comparisons_markdown, leaderboard_markdown
@@ -37,14 +38,30 @@ def test_a_suites_regime_reaches_every_method_and_the_command_lines_settings_win
 
 def test_the_one_step_regime_records_nothing_new():
     """The suites' regime before regimes were named adds no setting: its runs keep their keys."""
-    suite = SUITES["standard"]
-    assert suite.regime == "one-step"
+    suite = dataclasses.replace(SUITES["standard"], regime="one-step")
     assert all("n_steps" not in c.hyperparameters for c in suite.student_configs("/tmp/teachers"))
+
+
+@pytest.mark.parametrize("algorithm", ["td3", "dqn"])
+def test_the_row_that_sets_most_names_a_run_that_fits_two(algorithm):
+    """A run of the wide regime also fits ``n-step`` (3-step targets); the row that sets its
+    networks too names it, and a 3-step run with the default networks stays ``n-step``."""
+    wide = REGIMES["n-step-wide"].settings(algorithm)
+    assert regime_of(algorithm, wide) == "n-step-wide"
+    assert regime_of(algorithm, {"n_steps": 3, "policy_kwargs": {"net_arch": [64, 64]}}) == "n-step"
+
+
+@pytest.mark.parametrize("suite", ["standard", "hard"])
+def test_the_standard_and_hard_suites_train_in_the_wide_regime(suite):
+    configs = SUITES[suite].student_configs("/tmp/teachers")
+    names = {regime_of(METHODS[c.method].algorithm, c.hyperparameters) for c in configs}
+    assert names == {"n-step-wide"}
+    assert {c.hyperparameters["policy_kwargs"]["net_arch"][0] for c in configs} == {256}
 
 
 def test_an_unknown_regime_is_refused_by_name():
     suite = dataclasses.replace(SUITES["standard"], regime="fast")
-    with pytest.raises(ValueError, match=r"unknown learner regime 'fast'; regimes: \['one-step', 'n-step'\]"):
+    with pytest.raises(ValueError, match=r"unknown learner regime 'fast'; regimes: \['one-step', 'n-step', 'n-step-wide'\]"):
         suite.student_configs("/tmp/teachers")
 
 

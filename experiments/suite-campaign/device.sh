@@ -2,7 +2,8 @@
 # One part of the campaign on a machine with a GPU and 16 cores, within a fixed wall time:
 # the standard suite's MuJoCo cells as populations of 10 on the GPU, the middle rungs first,
 # then the easy rungs if the time left can finish them. Cells that finish are archived into
-# results/standard there and packed, with the log and the machine's description, into $OUT.
+# results/standard there and packed, one archive per rung, with the log (the machine, the GPU's
+# load, each run's time) and the archive's provenance, into $OUT.
 # Usage, from the project root: bash experiments/suite-campaign/device.sh COMMIT SECONDS
 set -u
 commit=$1
@@ -15,7 +16,11 @@ py=${PYTHON:-python3}
 device=${DEVICE:-cuda}
 end=$(( $(date +%s) + seconds ))
 { nproc; free -g | head -2; nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv 2>&1; } \
-  > "$out/machine.txt"
+  >> "$out/campaign.log"
+# the GPU's load while the cells train, every 30 s
+( while sleep 30; do echo "gpu $(date -u +%H:%M:%S) $(nvidia-smi --query-gpu=utilization.gpu,memory.used \
+  --format=csv,noheader 2>&1)"; done >> "$out/campaign.log" ) &
+sampler=$!
 ls results/standard/students > /tmp/before.txt
 
 run_part() {  # run_part NAME WORKERS ARGS...: one transfer, stopped at the deadline
@@ -24,24 +29,29 @@ run_part() {  # run_part NAME WORKERS ARGS...: one transfer, stopped at the dead
   echo "== $name: $left s left, $(date -u +%H:%M:%S)" | tee -a "$out/campaign.log"
   local start=$(date +%s)
   timeout "$left" "$py" -m craftsuite transfer --suite standard --worlds Cont "$@" --workers "$workers" \
-    --device "$device" --no-video --out "/tmp/runs/$name" ${EXTRA:-} >> "$out/campaign.log" 2>&1
+    --device "$device" --no-video --archive results --out "/tmp/runs/$name" ${EXTRA:-} >> "$out/campaign.log" 2>&1
   echo "== $name: rc $?, $(( $(date +%s) - start )) s" | tee -a "$out/campaign.log"
 }
 
 run_part middle 21 --tags middle
 # the easy rungs' cells take 2.5M transitions each: only where the time left can hold them
-if [ $(( end - $(date +%s) )) -gt 240 ]; then run_part easy 14 --tags easy; fi
+if [ $(( end - $(date +%s) )) -gt 300 ]; then run_part easy 14 --tags easy; fi
 
 # what finished goes into the archive there (unfinished runs are named and skipped)
 for d in /tmp/runs/*/; do "$py" -m craftsuite archive "$d" --suite standard >> "$out/campaign.log" 2>&1; done
 ls results/standard/students | sort > /tmp/after.txt
 comm -13 <(sort /tmp/before.txt) /tmp/after.txt | sed 's|^|results/standard/students/|' > /tmp/new.txt
 echo "$(wc -l < /tmp/new.txt) new runs archived" | tee -a "$out/campaign.log"
-tar -czf "$out/standard.tgz" results/standard/provenance.json -T /tmp/new.txt
-# each run's rate, for the campaign's measured times
-"$py" - > "$out/rates.txt" <<'PY'
+kill $sampler
+# one archive per rung (a file that comes back holds at most 16 MiB)
+cp results/standard/provenance.json "$out/provenance.json"
+for task in $(sed 's|.*/student-\([A-Za-z]*\)-.*|\1|' /tmp/new.txt | sort -u); do
+  grep "/student-$task-" /tmp/new.txt | tar -czf "$out/standard-$task.tgz" -T -
+done
+# each run's transitions and seconds, for the part's measured time
+"$py" - >> "$out/campaign.log" <<'PY'
 import json, pathlib
 for line in open("/tmp/new.txt"):
     r = json.loads((pathlib.Path(line.strip()) / "result.json").read_text())
-    print(line.strip().split("/")[-1], r.get("steps"), r.get("seconds") or r.get("wall_seconds"))
+    print(line.strip().split("/")[-1], r.get("steps"), r.get("seconds_this_session"))
 PY

@@ -15,7 +15,7 @@ export PYTHONPATH=${PYTHONPATH:-}:$PWD MUJOCO_GL=disable PYTHONUNBUFFERED=1 CRAF
 py=${PYTHON:-python3}
 device=${DEVICE:-cuda}
 end=$(( $(date +%s) + seconds ))
-{ nproc; free -g | head -2; nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv 2>&1; } \
+{ echo "cores: $(nproc --all)"; free -g | head -2; nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv 2>&1; } \
   >> "$out/campaign.log"
 # the GPU's load while the cells train, every 30 s
 ( while sleep 30; do echo "gpu $(date -u +%H:%M:%S) $(nvidia-smi --query-gpu=utilization.gpu,memory.used \

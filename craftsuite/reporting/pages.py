@@ -16,6 +16,7 @@ from ..files import atomic_write
 from ..ids import CONT, world_kind
 from ..regimes import describe
 from ..runs import RunError, read_config, read_result
+from ..suites import SUITES
 from ..archive import size as archive_size
 from .board import (
     METRICS,
@@ -32,6 +33,7 @@ from .board import (
     rung_order,
     verdict,
 )
+from .coverage import coverage_markdown
 from .plots import draw_curves, draw_profiles, file_part, save_figures
 from .sources import read_runs, session_line
 
@@ -383,6 +385,7 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
                   f"Runs in `{runs.path.as_posix()}`." + _suite_scope(suite), ""]
         lines += [session_line(s, to_the_minute=True) for s in runs.sessions]
         lines += wall_time_lines(runs.sessions)
+        lines += ["", *coverage_markdown(runs.path, name)] if name in SUITES else []
         if not runs.sessions:
             lines.append(f"- runs in `{runs.path}` (no provenance.json: not made by `craftsuite transfer`)")
         # named after the directory, not the suite: two directories of one suite keep their own plots

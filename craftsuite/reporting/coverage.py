@@ -1,0 +1,44 @@
+"""How much of a suite, as it is defined now, an archive directory holds: per world and
+rung, the runs archived under the suite's current run keys against the runs it asks for,
+and the transitions still to train. A suite runs in parts across machines and sessions; the
+results page says which parts are in and which are not, so that a table that is missing a
+cell reads as not run, not as cut."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..suites import SUITES
+from .board import rung_order
+
+
+def coverage_markdown(root: Path, suite_name: str) -> list[str]:
+    """Lines of Markdown for the archive directory ``root`` of the suite ``suite_name``; none
+    for a name that is not a suite of this version (an archive of a removed or renamed one)."""
+    suite = SUITES.get(suite_name)
+    if suite is None:
+        return []
+    cells: dict[tuple[str, str], list] = {}  # (world, task) -> [archived, asked, transitions left, methods left]
+    for config in suite.student_configs(Path(root) / "teachers"):
+        cell = cells.setdefault((config.world, config.task), [0, 0, 0, set()])
+        cell[1] += 1
+        if (Path(root) / "students" / config.run_name() / "result.json").is_file():
+            cell[0] += 1
+        else:
+            cell[2] += config.steps
+            cell[3].add(config.method)
+    archived = sum(c[0] for c in cells.values())
+    asked = sum(c[1] for c in cells.values())
+    left = sum(c[2] for c in cells.values())
+    lines = [f"The suite as defined now ({suite.regime} learner regime, {suite.seeds} seeds a cell) asks for "
+             f"{asked:,} student runs; {archived:,} of them are archived here"
+             + (f", and {left / 1e6:,.1f}M transitions are still to train." if left else ", all of them."), ""]
+    if not left:
+        return lines
+    lines += ["| world | rung | runs archived / asked | transitions to train | methods not yet archived |",
+              "|---|---|---|---|---|"]
+    for (world, task), (done, total, todo, methods) in sorted(cells.items(),
+                                                              key=lambda kv: (kv[0][0], rung_order(kv[0][1]))):
+        missing = ", ".join(f"`{m}`" for m in suite.methods if m in methods) or "none"
+        lines.append(f"| {world} | {task} | {done} / {total} | {todo / 1e6:,.1f}M | {missing} |")
+    return [*lines, ""]

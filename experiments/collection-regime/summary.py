@@ -1,4 +1,4 @@
-"""Tables from run.py's JSON lines: learning per wall-clock second, per task and regime.
+"""Tables from the JSON lines run.py wrote: learning per wall-clock second, per task and regime.
 
 Usage: python experiments/collection-regime/summary.py results.jsonl [more.jsonl ...]
 """
@@ -10,7 +10,35 @@ import sys
 from collections import defaultdict
 
 import numpy as np
-from run import REGIMES, describe  # experiments/collection-regime/ is on sys.path as a script
+
+# the regimes run.py trained (SB3 agents' settings; run.py was removed with the SB3 trainer)
+REGIMES = {
+    "A": dict(n_envs=1, batch_size=64, learning_rate=1e-4, net=[64, 64]),     # the package's TD3, small net
+    "B": dict(n_envs=1, batch_size=256, learning_rate=1e-3, net=[64, 64]),    # SB3 zoo's batch and lr
+    "C": dict(n_envs=10, batch_size=64, learning_rate=1e-4, net=[64, 64]),    # the authors' collection
+    "D": dict(n_envs=10, batch_size=256, learning_rate=1e-3, net=[64, 64]),
+    "E": dict(n_envs=4, batch_size=256, learning_rate=1e-3, net=[64, 64]),
+    "F": dict(n_envs=10, batch_size=256, learning_rate=1e-3, net=[64, 64], gradient_steps=4),
+    "G": dict(n_envs=10, batch_size=256, learning_rate=1e-3, net=[256, 256]),
+    "H": dict(n_envs=4, batch_size=256, learning_rate=1e-3, net=[64, 64], prioritized=True),
+    "I": dict(n_envs=4, batch_size=256, learning_rate=3e-4, net=[64, 64]),
+    "J": dict(n_envs=4, batch_size=256, learning_rate=1e-3, net=[256, 256]),
+    "K": dict(n_envs=10, batch_size=256, learning_rate=3e-4, net=[64, 64]),  # D, a third of the step size
+    # DQN on the grids (the package's DQN otherwise: dueling, double, PER, lr 5e-4, batch 64);
+    # the target network is updated every 100 gradient updates in each
+    "a": dict(n_envs=1, target_update_interval=100, net=[64, 64]),  # the package's
+    "b": dict(n_envs=4, target_update_interval=400, net=[64, 64]),
+    "c": dict(n_envs=10, target_update_interval=1_000, net=[64, 64]),  # the authors' collection
+    "d": dict(n_envs=4, target_update_interval=200, gradient_steps=2, net=[64, 64]),
+}
+
+
+def describe(regime: dict) -> str:
+    updates = regime.get("gradient_steps", 1) / regime["n_envs"]
+    if "batch_size" not in regime:  # DQN
+        return f"DQN, {regime['n_envs']} env(s), {updates:g} updates/transition, {regime['net']}"
+    return (f"{regime['n_envs']} env(s), {updates:g} updates/transition, batch {regime['batch_size']}, "
+            f"lr {regime['learning_rate']:g}, {regime['net']}" + (", PER" if regime.get("prioritized") else ""))
 
 
 def main(paths):

@@ -43,7 +43,6 @@ bench: $(STAMP)
 	$(PY) benchmarks/grid_steps.py --steps 100000
 	$(PY) benchmarks/cont_steps.py --steps 20000
 	$(PY) benchmarks/vector_envs.py
-	$(PY) benchmarks/training_steps.py --repeats 2
 	$(PY) benchmarks/student_throughput.py
 	$(PY) benchmarks/crm_memory.py
 	$(PY) benchmarks/engine_equivalence.py

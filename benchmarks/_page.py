@@ -24,8 +24,8 @@ ROOT = Path(__file__).resolve().parents[1]
 PAGE = ROOT / "docs" / "performance.md"
 
 # The page's order: the package's own speed first (automata, worlds, training), then its statistics.
-SECTIONS = ("automata", "grid_steps", "cont_steps", "vector_envs", "training_steps", "student_throughput",
-            "crm_memory", "engine_equivalence", "teachers", "interval_coverage")
+SECTIONS = ("automata", "grid_steps", "cont_steps", "vector_envs", "student_throughput", "crm_memory",
+            "engine_equivalence", "teachers", "interval_coverage")
 
 HEADER = """\
 # Performance

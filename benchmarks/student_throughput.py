@@ -1,20 +1,16 @@
-"""Student throughput: transitions and gradient updates per second per core, SB3 agents
-beside the population engine, per collection regime.
+"""Student throughput of the population engine: transitions and gradient updates per second per core.
 
 Usage: python benchmarks/student_throughput.py [--seconds 10] [--members 5 10] [--page PATH | --no-page]
 
 One process, one torch thread, Blind Craftsman: TD3 in the MuJoCo world and on the
-kinematic board, DQN on the 10x10 grid. SB3 rows: the package's defaults (one env, one
-update per transition; TD3 [400, 300]) and the suites' regimes (``craftsuite.suites.TD3_REGIME``
-/ ``DQN_REGIME``: several envs per update, small networks) with the fused Adam that
-``make_agent`` uses, each after 2,000 warm-up transitions. Population rows
-(``craftsuite.population``): the suites' regimes for ``--members`` seeds in one process (5:
-a suite's cell; 10: as many as the engines were compared with), collecting from one vector
-env, counted over all members, after the warm-up of random actions (``learning_starts``).
-Each row trains for about ``--seconds``. The reference column is the target of each
-population row, or what was measured before. Under the table, the standard suite's student
-time projected from these rates. With ``--device cuda --members 20`` it measures a GPU
-population.
+kinematic board, DQN on the 10x10 grid. Each row (``craftsuite.population``): the suites'
+regimes (``craftsuite.suites.TD3_REGIME`` / ``DQN_REGIME``: several envs per update, small
+networks) for ``--members`` seeds in one process (5: a suite's cell; 10: as many as the
+engines were compared with), collecting from one vector env, counted over all members,
+after the warm-up of random actions (``learning_starts``). Each row trains for about
+``--seconds``. The reference column is each row's target. Under the table, the standard
+suite's student time projected from these rates. With ``--device cuda --members 20`` it
+measures a GPU population.
 """
 
 from __future__ import annotations
@@ -23,7 +19,6 @@ import argparse
 import time
 
 import craftsuite  # noqa: F401
-from craftsuite.agents.factory import make_agent
 from craftsuite.hyperparameters import algorithm_settings
 from craftsuite.suites import DQN_REGIME, TD3_REGIME
 from _page import Report, add_page_argument  # benchmarks/ is on sys.path as a script
@@ -32,32 +27,12 @@ CONT, GRID = "CraftSuite/BlindCraftsman-Cont-v0", "CraftSuite/BlindCraftsman-Gri
 KINEMATIC = "CraftSuite/BlindCraftsman-Kinematic-v0"
 TD3_N, DQN_N = TD3_REGIME["td3_n_envs"], DQN_REGIME["dqn_n_envs"]
 TD3_SET, DQN_SET = TD3_REGIME["td3_hyperparameters"], DQN_REGIME["dqn_hyperparameters"]
-SB3_ROWS = [  # (label, method, env id, n_envs, algorithm settings, reference transitions/s)
-    ("TD3, MuJoCo, package defaults (1 env, [400, 300], batch 64)", "td3", CONT, 1, {}, "~85 (SB3 TD3, 1 env)"),
-    ("TD3, MuJoCo, suites' regime (10 envs, [64, 64], batch 256)", "td3", CONT, TD3_N, TD3_SET, "2,052 (before)"),
-    ("TD3, kinematic, suites' regime", "td3", KINEMATIC, TD3_N, TD3_SET, ""),
-    ("DQN, Grid10, package defaults (1 env, [64, 64])", "dqn", GRID, 1, {"env_kwargs": {"layout_seed": 1}}, ""),
-    ("DQN, Grid10, suites' regime (4 envs, 2 updates per step)", "dqn", GRID, DQN_N,
-     {**DQN_SET, "env_kwargs": {"layout_seed": 1}}, "710 (before)"),
-]
 POPULATION_ROWS = [  # (label, method, env id, n_envs, settings, env keywords, target transitions/s)
     ("TD3, MuJoCo, suites' regime", "td3", CONT, TD3_N, TD3_SET, {}, ">= 5,000"),
     ("TD3, kinematic, suites' regime", "td3", KINEMATIC, TD3_N, TD3_SET, {}, ">= 8,000"),
     ("DQN, Grid10, suites' regime", "dqn", GRID, DQN_N, DQN_SET, {"layout_seed": 1}, ">= 5,000"),
     ("CRM (DQN), Grid10, suites' regime", "crm", GRID, DQN_N, DQN_SET, {"layout_seed": 1}, ""),
 ]
-
-
-def measure_sb3(method, env_id, n_envs, settings, seconds: float) -> tuple[float, float]:
-    agent = make_agent(method, env_id, n_envs=n_envs, buffer_size=200_000, **settings)
-    agent.learn(2_000)
-    steps, total = 1_000 * n_envs, 0.0
-    transitions, updates = agent.num_timesteps, agent.n_updates
-    while total < seconds:
-        start = time.perf_counter()
-        agent.learn(steps, reset_num_timesteps=False)
-        total += time.perf_counter() - start
-    return (agent.num_timesteps - transitions) / total, (agent.n_updates - updates) / total
 
 
 def measure_population(method, env_id, n_envs, settings, env_kwargs, members: int, seconds: float,
@@ -105,7 +80,7 @@ def _kind(method: str, env_id: str) -> tuple[str, bool]:
     return parse_id(env_id)[1].rstrip("0123456789"), METHODS[method].crm
 
 
-def suite_projection(name: str, rates: dict, sb3_rates: dict, cores: int = 2) -> str:
+def suite_projection(name: str, rates: dict, cores: int = 2) -> str:
     """The suite's student transitions over the rates just measured, on ``cores`` cores: a
     projection (teachers, evaluations and the tail of the last runs left out)."""
     from craftsuite.ids import parse_id
@@ -113,19 +88,17 @@ def suite_projection(name: str, rates: dict, sb3_rates: dict, cores: int = 2) ->
     from craftsuite.suites import SUITES
 
     configs = SUITES[name].student_configs("teachers")
-    seconds = {"population": 0.0, "sb3": 0.0}
+    seconds = 0.0
     for c in configs:
         kind = (parse_id(c.env_id)[1].rstrip("0123456789"), METHODS[c.method].crm)
-        seconds["population"] += c.steps / rates.get(kind, rates.get((kind[0], False), float("nan")))
-        seconds["sb3"] += c.steps / sb3_rates.get((kind[0], False), float("nan"))
+        seconds += c.steps / rates.get(kind, rates.get((kind[0], False), float("nan")))
     total = sum(c.steps for c in configs)
 
     def hours(s):
         return f"{s / cores / 3600:.1f} h"
 
     return (f"The `{name}` suite's students ({len(configs)} runs, {total:,} transitions) at these rates on "
-            f"{cores} cores: {hours(seconds['population'])} with the population engine (5 seeds a population), "
-            f"{hours(seconds['sb3'])} with one SB3 agent per run, its CRM counted at its DQN rate (a projection "
+            f"{cores} cores: {hours(seconds)} with the population engine (5 seeds a population; a projection "
             "from one process alone, teachers and evaluations not counted; on these 2 cores two grid populations "
             "kept about these rates, two MuJoCo populations about half each).")
 
@@ -144,12 +117,7 @@ def main():
     report = Report()
     report("| student | engine | transitions/s | updates/s (all members) | reference transitions/s |")
     report("|---|---|---|---|---|")
-    rates, sb3_rates = {}, {}  # transitions/s per (world kind, algorithm, crm), for the projection
-    for label, method, env_id, n_envs, settings, reference in SB3_ROWS:
-        tps, ups = measure_sb3(method, env_id, n_envs, settings, args.seconds)
-        if n_envs > 1:
-            sb3_rates.setdefault(_kind(method, env_id), tps)
-        report(f"| {label} | SB3 | {tps:,.0f} | {ups:,.0f} | {reference} |")
+    rates = {}  # transitions/s per (world kind, crm), for the projection
     for label, method, env_id, n_envs, settings, env_kwargs, target in POPULATION_ROWS:
         for members in args.members:
             tps, ups = measure_population(method, env_id, n_envs, settings, env_kwargs, members, args.seconds,
@@ -159,7 +127,7 @@ def main():
                 rates[_kind(method, env_id)] = tps
     report("")
     for suite in ("standard", "hard"):
-        report(suite_projection(suite, rates, sb3_rates))
+        report(suite_projection(suite, rates))
         report("")
     report.save(__file__, __doc__, args)
 

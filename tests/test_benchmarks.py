@@ -84,7 +84,6 @@ TINY = {"automata": ["--tasks", "Reach", "--flloat-timeout", "5"], "cont_steps":
         "crm_memory": ["--steps", "300"], "engine_equivalence": [], "grid_steps": ["--steps", "200"],
         "interval_coverage": ["--trials", "20"], "student_throughput": ["--seconds", "0.2", "--members", "2"],
         "teachers": ["--tasks", "Reach", "--max-steps", "300"],
-        "training_steps": ["--dqn-steps", "200", "--td3-steps", "200", "--repeats", "1"],
         "vector_envs": ["--envs", "2", "--steps", "20"]}
 
 

@@ -151,7 +151,7 @@ def test_suites_are_well_formed(tmp_path):
     grid_distiller = dataclasses.replace(SUITES["quick"], methods=("td3", "dynamic"))
     assert grid_distiller.teachers() == {}  # `dynamic` needs one, but runs on the grids, not in this suite's world
     # standard and hard: every rung x the paper's methods and baselines and the shaping baseline (each in its
-    # world) x 5 seeds, budgets by level or by the rung's own name; the paper suite without shaping
+    # world) x 10 seeds, budgets by level or by the rung's own name; the paper suite without shaping
     from craftsuite.suites import PAPER_METHODS, SUITE_METHODS
 
     standard = SUITES["standard"].student_configs(tmp_path)
@@ -166,13 +166,13 @@ def test_suites_are_well_formed(tmp_path):
     # every TD3 method of the transfer suite gets the same replay, small enough for CRM's copies
     assert {c.hyperparameters["buffer_size"] for c in transfer if c.world == "Cont"} == {200_000}
     assert {c.table is not None for c in transfer if c.method.endswith("crm-edges")} == {True}
-    assert {c.seed for c in standard} == set(range(5))
+    assert {c.seed for c in standard} == set(range(10))
     budgets, specs = SUITES["standard"].budgets, {s.name: s for s in ladder()}
     for c in standard:
         table = budgets["Cont" if c.world == "Cont" else "Grid"]
         assert c.steps == table.get(c.task, table[specs[c.task].level])
-    assert {c.steps for c in standard if c.task == "TwoToolsHome" and c.world == "Cont"} == {1_200_000}
-    assert {c.steps for c in standard if c.task == "ToolHome" and c.world == "Cont"} == {budgets["Cont"]["medium"]}
+    assert {c.steps for c in standard if c.task == "TwoToolsHome" and c.world == "Cont"} == {300_000}
+    assert {c.steps for c in standard if c.task == "ToolHome" and c.world == "Cont"} == {250_000}  # its own budget
     assert {c.steps for c in standard if c.world == "Cont"} != {c.steps for c in standard if c.world == "Grid10"}
     paper = SUITES["paper"].student_configs(tmp_path)
     assert {c.task for c in paper} == {s.name for s in ladder("paper")}

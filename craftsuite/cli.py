@@ -238,9 +238,6 @@ def _teacher(args) -> int:
                            seed=args.seed, max_steps=args.max_steps, target_success=args.target_success,
                            eval_every=args.eval_every, eval_episodes=args.eval_episodes,
                            hyperparameters=_hyper(args.hyper, "dqn"), n_envs=args.n_envs, engine=args.engine)
-    if config.engine == "sb3" and args.device != "cpu":
-        raise ValueError(f"--device {args.device}: the sb3 engine takes no --device (its agents use a GPU where there "
-                         "is one); leave out --device, or use --engine population")
     path = train_teacher(config, args.out, device=args.device)
     print((path / "result.json").read_text().strip())
     print(f"teacher run: {path}\n  teacher: {path / 'teacher.zip'}\n  dynamic table: {path / 'table.npz'}")
@@ -534,7 +531,7 @@ def build_parser() -> argparse.ArgumentParser:
     from .task_registry import SPEC_SUFFIX, ladder
 
     engine_help = (f"what trains the run: {DEFAULT_ENGINE} (default; the population engine, here a population of "
-                   "one) or sb3 (one SB3 agent per run)")
+                   "one); sb3 (one SB3 agent per run, as CraftSuite trained before) only reuses a finished run")
 
     parser = argparse.ArgumentParser(prog="craftsuite", description=__doc__, formatter_class=_HelpFormatter)
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
@@ -658,11 +655,11 @@ def build_parser() -> argparse.ArgumentParser:
                    "keep their runs: all but quick)")
     p.add_argument("--no-archive", action="store_true", help="neither read nor write a results archive")
     p.add_argument("--engine", choices=ENGINES, help="what trains the teachers and students: population (each "
-                   "cell's seeds in one process) or sb3 (one SB3 agent per run); default: the suite's")
+                   "cell's seeds in one process); sb3 (one SB3 agent per run, as CraftSuite trained before) only "
+                   "reuses finished runs, from --out or the archive; default: the suite's")
     p.add_argument("--regime", choices=list(REGIMES), help="the students' learner regime (craftsuite.regimes: "
                    "n-step returns and the like, for every method alike); default: the suite's")
-    p.add_argument("--device", help="the population engine's torch device: cpu (default) or cuda (the sb3 engine "
-                   "takes none: its agents use a GPU where there is one)")
+    p.add_argument("--device", help="the population engine's torch device: cpu (default) or cuda")
     p.set_defaults(run=_transfer)
 
     p = sub.add_parser("archive", help="keep finished runs' records in the results archive (results/<suite>)")

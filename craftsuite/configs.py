@@ -99,9 +99,10 @@ class StudentConfig:
     # whether the policy sees the automaton state (None: as its method's row says); only a
     # distilled student may differ from its row (the paper's authors' students did not see it)
     automaton_state: bool | None = field(default=None, metadata={"omit_if_default": True})
-    # what trains it: "population" (the seeds of a cell in one process: craftsuite.population)
-    # or "sb3" (one SB3 agent per run); a part of the run key, since the two are equal in
-    # their update but not in their random streams
+    # what trains it: "population" (the seeds of a cell in one process: craftsuite.population);
+    # "sb3" (one SB3 agent per run) names the runs SB3 trained before, which are reused, not
+    # trained; a part of the run key, since the two were equal in their update but not in
+    # their random streams
     engine: str = field(default=DEFAULT_ENGINE, metadata=ENGINE_FIELD)
 
     def __post_init__(self):

@@ -14,10 +14,11 @@ A run directory holds
   visited, as bitmasks: ``craftsuite.reached``);
 * ``evals.csv``: one row per evaluation (step, success rate, mean return, episodes, mean
   episode length);
-* ``checkpoint/``: the last model and replay buffer, written together at each evaluation,
-  and ``checkpoint-old/``, the one before, kept until the next is complete so that a
-  damaged newest checkpoint can be resumed from the one before (both trainers' resume
-  keeps the damaged one aside as ``checkpoint-unloadable/``); ``RunDir`` rotates
+* ``checkpoint/``: the last state (networks, optimizer moments, replay: the population
+  engine's ``population.pt``; ``model.zip`` and ``replay.pkl`` in an SB3-trained run's),
+  written at each evaluation, and ``checkpoint-old/``, the one before, kept until the next
+  is complete so that a damaged newest checkpoint can be resumed from the one before (the
+  resume keeps the damaged one aside as ``checkpoint-unloadable/``); ``RunDir`` rotates
   them. A student's are removed when it finishes (its final model is ``model.zip``), a
   teacher's older one;
 * ``tb/``: TensorBoard logs (on resume, what the killed run logged after its checkpoint is

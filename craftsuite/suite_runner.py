@@ -48,22 +48,12 @@ def _population_job(configs: list[dict], root: str, task: str | dict | None = No
 
 def cells(configs: list[StudentConfig]) -> list[list[StudentConfig]]:
     """The population engine's jobs: configs equal but for the seed, together, in order;
-    each SB3 config alone."""
+    each SB3 config alone (a finished run, reused)."""
     groups: dict[str, list[StudentConfig]] = {}
     for c in {c.run_name(): c for c in configs}.values():  # a run asked for twice is one run
         key = json.dumps(c.cell(), sort_keys=True) if c.engine == "population" else c.run_name()
         groups.setdefault(key, []).append(c)
     return list(groups.values())
-
-
-def _student_job(config: dict, root: str, task: str | dict | None = None) -> str:
-    """One student run in a worker process (one thread: the workers share the cores);
-    ``task``: its task as ``task_registry.carried`` gives it (a user task's data)."""
-    _start_worker(task)
-    from .training import train_student  # torch: only where runs train, not to list the suites
-
-    with _quiet():
-        return str(train_student(StudentConfig(**config), root, progress=False))
 
 
 def _teacher_job(config: dict, root: str, task: str | dict | None = None, device: str = "cpu") -> str:
@@ -105,7 +95,8 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                  progress: bool = True, teachers: dict[str, TeacherConfig] | None = None, teacher_root=None,
                  log=print, device: str = "cpu", pool: WorkerPool | None = None) -> list[Path]:
     """Run students in parallel (processes or Ray) with one progress bar over all their
-    transitions: one job per SB3 run, one per population (the seeds of a cell, ``cells``).
+    transitions: one job per population (the seeds of a cell, ``cells``); a finished run of
+    the sb3 engine is reused, an unfinished one refused (``training.finished_sb3_run``).
     With ``teachers`` (by task, trained under ``teacher_root``), each teacher runs first in
     the same pool and its task's distilled students start when it is done; the other
     students start at once. ``device`` is the populations' torch device. ``pool``: the
@@ -133,7 +124,14 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
             if job[0].engine == "population":
                 return workers_.submit(_population_job, [dataclasses.asdict(c) for c in job], str(root),
                                        _carried(job[0].task), device)
-            return workers_.submit(_student_job, dataclasses.asdict(job[0]), str(root), _carried(job[0].task))
+            from .training import finished_sb3_run
+
+            reused = Future()  # an sb3 run is reused, never trained: no worker
+            try:
+                reused.set_result(str(finished_sb3_run(job[0], root)))
+            except Exception as err:
+                reused.set_exception(err)
+            return reused
 
         def poll():
             done = 0
@@ -194,19 +192,16 @@ def _announce(log, kind: str, runs: list[tuple[Path, int]], root) -> dict[Path, 
 
 
 def checkpoint_step(run: Path) -> int | None:
-    """The step a killed run resumes from: its newest complete checkpoint's (None: it has none)."""
-    import zipfile
-
+    """The step a killed population member resumes from: its newest complete checkpoint's
+    (None: it has none)."""
+    from .population.train import CHECKPOINT, STEP
     from .runs import RunDir
 
     for folder in (run / name for name in RunDir.CHECKPOINTS):  # newest first
         try:
-            if (folder / "step.json").is_file() and (folder / "population.pt").is_file():  # a population member's
-                return int(json.loads((folder / "step.json").read_text())["num_timesteps"])
-            if (folder / "model.zip").is_file() and (folder / "replay.pkl").is_file():  # an SB3 agent's, as saved
-                with zipfile.ZipFile(folder / "model.zip") as saved:
-                    return int(json.loads(saved.read("data"))["num_timesteps"])
-        except (OSError, ValueError, KeyError, TypeError, zipfile.BadZipFile):
+            if (folder / STEP).is_file() and (folder / CHECKPOINT).is_file():
+                return int(json.loads((folder / STEP).read_text())["num_timesteps"])
+        except (OSError, ValueError, KeyError, TypeError):
             continue  # unreadable: the worker falls back to the one before, as this does
     return None
 
@@ -242,7 +237,8 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     """The suite end to end: teachers and distillation, students, leaderboard, plots, video.
 
     ``device``: the torch device of the population engine's students (``cpu``, the
-    default, or ``cuda``); the sb3 engine takes none. ``command``: how this run was asked
+    default, or ``cuda``). A suite of the ``sb3`` engine reuses its finished runs (from
+    ``out`` or the archive) and refuses to train the others. ``command``: how this run was asked
     for, as ``provenance.json`` records it (the CLI passes its command line); by default,
     this Python call. ``archive``: a results archive (``craftsuite.archive``; e.g.
     ``results``): the runs it holds under ``<archive>/<suite>`` are not trained again, and
@@ -288,6 +284,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         for run in _counting_acceptance([out / "students" / name for name in sorted(names["students"])]):
             reread_in_place(run)  # (restored ones too)
             log(f"re-read {run.name}: its success counted the automaton's acceptance; now completion")
+        _refuse_unfinished_sb3(out, configs, teachers.values())  # after the archive's: restored ones are reused
     except BaseException:
         pool.close(abort=True)
         raise
@@ -342,6 +339,16 @@ def _counting_acceptance(runs: list[Path]) -> list[Path]:
     return found
 
 
+def _refuse_unfinished_sb3(out: Path, configs: list[StudentConfig], teachers) -> None:
+    """Refuse, before any training, a run of the sb3 engine that is not finished in ``out``
+    (nor restored there from the archive): that engine's runs are reused, never trained."""
+    from .training import finished_sb3_run
+
+    for root, config in [*((out / "teachers", t) for t in teachers), *((out / "students", c) for c in configs)]:
+        if config.engine == "sb3" and not (root / config.run_name() / "result.json").is_file():
+            finished_sb3_run(config, root)  # raises, naming the run and the fix
+
+
 def _check_students(configs: list[StudentConfig], device: str | None = None, teachers=()) -> None:
     """Build each kind of student once, untrained, from scratch (the teachers' tables do not
     exist yet): a misspelt world setting or algorithm setting (``--env``, ``--td3-hyper``),
@@ -351,12 +358,7 @@ def _check_students(configs: list[StudentConfig], device: str | None = None, tea
 
     from .agents.factory import make_agent
 
-    if device is not None and not any(c.engine == "population" for c in configs):
-        # the sb3 engine's agents take their device from their settings: --device would be ignored
-        raise ValueError(f"--device {device}: these students train on the sb3 engine, which takes no --device (its "
-                         "agents use a GPU where there is one; --td3-hyper/--dqn-hyper '{\"device\": \"cpu\"}' sets "
-                         "theirs); leave out --device, or use --engine population")
-    if any(c.engine == "population" for c in configs):
+    if any(c.engine == "population" for c in [*configs, *teachers]):
         from .population import check_supported
         from .population.train import check_device
 
@@ -364,11 +366,6 @@ def _check_students(configs: list[StudentConfig], device: str | None = None, tea
         for c in [*configs, *teachers]:
             if c.engine == "population":
                 check_supported(c.method, c.effective()["hyperparameters"])
-    from .training import check_sb3_engine
-
-    for c in configs:
-        if c.engine != "population":
-            check_sb3_engine(c)
 
     kinds = {(c.env_id, c.world, c.n_envs, json.dumps(c.env_kwargs, sort_keys=True),
               json.dumps(c.hyperparameters, sort_keys=True)) for c in configs}
@@ -413,7 +410,7 @@ def smallest_budget(settings: dict, n_envs: int) -> int:
     """The fewest transitions in which a run of these (effective) settings takes a gradient
     update: it collects ``n_envs`` a step and updates on the steps that are multiples of
     ``train_freq`` once more than ``learning_starts`` are collected (the population engine
-    ends its budget on the step that reaches it; SB3 on the ``train_freq`` boundary after)."""
+    ends its budget on the step that reaches it)."""
     freq = settings.get("train_freq", 1)
     if isinstance(freq, (list, tuple)):  # [4, "step"]; in episodes, unknown ahead: as if every step
         freq = freq[0] if len(freq) == 2 and freq[1] == "step" else 1

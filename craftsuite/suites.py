@@ -70,8 +70,8 @@ class Suite:
     # the same for the kinematic board (its ``size``)
     kinematic_world_kwargs: dict = field(default_factory=dict)
     # what trains the teachers and students: "population" (the seeds of each cell in one
-    # process, craftsuite.population; a teacher is a population of one) or "sb3" (one SB3
-    # agent per run)
+    # process, craftsuite.population; a teacher is a population of one); "sb3" (one SB3 agent
+    # per run) reuses the finished runs SB3 trained before and trains none
     engine: str = DEFAULT_ENGINE
     # whether ``craftsuite transfer`` keeps its runs' records in the results archive by
     # default (``craftsuite.archive``); the quick suite trains afresh every time, for its video

@@ -1,20 +1,18 @@
-"""Bad input of training named before a run directory exists; damaged checkpoints on resume;
-bad input to ``craftsuite transfer`` refused before it writes anything."""
+"""Bad input of training named before a run directory exists; bad input to ``craftsuite
+transfer`` refused before it writes anything (damaged checkpoints on resume:
+``tests/population/test_runs.py``)."""
 
 from __future__ import annotations
 
 import dataclasses
 import json
-import warnings
 
 import pytest
 
 from craftsuite.cli import main
 from craftsuite.configs import StudentConfig, TeacherConfig
 from craftsuite.hyperparameters import HyperparameterError
-from craftsuite.runs import CheckpointError, RunDir, read_csv
 from craftsuite.training import train_student, train_teacher
-from .killed import CONFIG, TINY, killed_run
 
 
 
@@ -86,93 +84,6 @@ def test_a_number_out_of_range_is_refused_naming_the_flag(tmp_path, capsys, comm
     assert list(tmp_path.iterdir()) == []
 
 
-def test_a_run_that_fails_in_its_directory_removes_the_folders_it_made(tmp_path):
-    root = tmp_path / "new" / "runs"
-    with pytest.raises(TypeError):  # the SB3 policy's constructor refuses the keyword, in the run's directory
-        train_teacher(TeacherConfig(max_steps=100, hyperparameters={"policy_kwargs": {"bogus": 1}}, engine="sb3"),
-                      root, progress=False)
-    assert list(tmp_path.iterdir()) == []
-    (tmp_path / "kept").mkdir()  # a folder that was there before stays
-    with pytest.raises(TypeError):
-        train_teacher(TeacherConfig(max_steps=100, hyperparameters={"policy_kwargs": {"bogus": 1}}, engine="sb3"),
-                      tmp_path / "kept", progress=False)
-    assert [p.name for p in tmp_path.iterdir()] == ["kept"] and list((tmp_path / "kept").iterdir()) == []
-
-
-# -- damaged checkpoints ----------------------------------------------------------------------------
-@pytest.fixture
-def interrupted(tmp_path, monkeypatch):
-    """A run killed after its last checkpoint (at 300), with the one before it (at 200)."""
-    return killed_run(tmp_path, monkeypatch)
-
-
-def _truncate(path):
-    path.write_bytes(path.read_bytes()[: path.stat().st_size // 3])
-
-
-@pytest.mark.parametrize("name", ["replay.pkl", "model.zip"])
-def test_a_damaged_checkpoint_falls_back_to_the_one_before(interrupted, name, capsys):
-    run = interrupted
-    _truncate(run / "checkpoint" / name)
-    capsys.readouterr()
-    with pytest.warns(RuntimeWarning, match=f"resuming from checkpoint-old.*checkpoint/{name} cannot be loaded"):
-        assert train_student(CONFIG, run.parent, progress=False) == run
-    assert f"{run}: resuming from its checkpoint at step 200 of 300" in capsys.readouterr().out
-    result = json.loads((run / "result.json").read_text())
-    assert result["steps"] == 300 and result["algorithm"] == "dqn"
-    # resumed at 200: the evaluation at 300 was made again, once
-    assert [int(r["step"]) for r in read_csv(run / "evals.csv")] == [100, 200, 300]
-    assert not (run / "checkpoint").exists() and not (run / "checkpoint-old").exists()
-    assert (run / "checkpoint-unloadable" / name).stat().st_size > 0  # kept aside, not deleted
-
-
-def test_after_a_fallback_the_damaged_checkpoint_never_rotates_back_in(interrupted, monkeypatch):
-    run = interrupted
-    _truncate(run / "checkpoint" / "replay.pkl")
-    # resumed from the checkpoint at 200, killed again after its checkpoint at 300
-    monkeypatch.setattr(RunDir, "write_result", lambda self, result: (_ for _ in ()).throw(KeyboardInterrupt))
-    with pytest.warns(RuntimeWarning), pytest.raises(KeyboardInterrupt):
-        train_student(CONFIG, run.parent, progress=False)
-    monkeypatch.undo()
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", RuntimeWarning)
-        _truncate(run / "checkpoint" / "model.zip")  # the one before it must be the good one resumed from
-        with pytest.raises(RuntimeWarning, match="resuming from checkpoint-old"):
-            train_student(CONFIG, run.parent, progress=False)
-
-
-def test_a_kill_between_the_swaps_resumes_from_the_complete_new_checkpoint(interrupted, monkeypatch):
-    import craftsuite.training
-
-    run = interrupted
-    (run / "checkpoint").rename(run / "checkpoint-new")  # killed after checkpoint -> -old, before new -> checkpoint
-    saves = []
-    real = craftsuite.training.save_checkpoint
-    monkeypatch.setattr(craftsuite.training, "save_checkpoint", lambda agent, r: saves.append(r) or real(agent, r))
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", RuntimeWarning)
-        assert train_student(CONFIG, run.parent, progress=False) == run
-    assert saves == []  # resumed at 300, its budget: nothing trained again
-    assert not (run / "checkpoint-new").exists()
-
-
-def test_when_no_checkpoint_loads_the_error_says_what_to_move_aside(interrupted):
-    run = interrupted
-    _truncate(run / "checkpoint" / "replay.pkl")
-    _truncate(run / "checkpoint-old" / "model.zip")
-    with pytest.raises(CheckpointError) as err:
-        train_student(CONFIG, run.parent, progress=False)
-    text = str(err.value)
-    assert f"{run / 'checkpoint' / 'replay.pkl'} cannot be loaded" in text
-    assert f"{run / 'checkpoint-old' / 'model.zip'} cannot be loaded" in text
-    assert f"Move {run / 'checkpoint'} and {run / 'checkpoint-old'} aside to train this run again from step 0" in text
-    assert (run / "evals.csv").is_file()  # nothing of the run was removed
-    for d in ("checkpoint", "checkpoint-old"):  # done as told, the run trains again from step 0
-        (run / d).rename(run / f"{d}-aside")
-    assert train_student(CONFIG, run.parent, progress=False) == run
-    assert [int(r["step"]) for r in read_csv(run / "evals.csv")] == [100, 200, 300]
-
-
 # -- craftsuite transfer: bad input refused before anything is written ----------------------------
 QUICK_REACH = ["transfer", "--suite", "quick", "--tasks", "Reach", "--seeds", "1", "--no-video"]
 
@@ -203,16 +114,15 @@ def test_transfer_refuses_a_budget_too_small_to_train(tmp_path, capsys, flags, m
     assert _refused(tmp_path, capsys, *flags) == message
 
 
-@pytest.mark.parametrize("engine", ["population", "sb3"])
-def test_the_smallest_budget_named_is_the_first_that_trains(tmp_path, engine):
+def test_the_smallest_budget_named_is_the_first_that_trains(tmp_path):
     from craftsuite.suite_runner import smallest_budget
 
-    hyper = {**TINY, "buffer_size": 500, "batch_size": 8}
+    hyper = {"learning_starts": 50, "buffer_size": 500, "batch_size": 8, "policy_kwargs": {"net_arch": [16]}}
     need = smallest_budget({"learning_starts": 50, "train_freq": 1}, 4)
     assert need == 49  # 13 steps of 4 envs: 52 transitions, past 50
     for steps, trains in ((need - 1, False), (need, True)):
         config = StudentConfig(method="dqn", world="Grid7", steps=steps, eval_every=steps, eval_episodes=1,
-                               n_envs=4, hyperparameters=hyper, engine=engine)
+                               n_envs=4, hyperparameters=hyper)
         result = json.loads((train_student(config, tmp_path / str(steps), progress=False) / "result.json").read_text())
         assert (result["updates"] > 0) == trains, (steps, result["updates"])
 
@@ -250,14 +160,20 @@ def test_a_budget_given_announces_the_evaluation_interval_it_sets(tmp_path, monk
     assert [p.closed for p in pools] == [[True]]  # an interrupted transfer stops its pool
 
 
-def test_transfer_refuses_device_the_engine_ignores_or_the_machine_lacks(tmp_path, capsys, monkeypatch):
+def test_transfer_on_the_sb3_engine_trains_nothing_and_names_the_run_it_would(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main([*QUICK_REACH, "--steps", "2000", "--engine", "sb3", "--no-archive", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("craftsuite transfer: error: teacher-Reach-Grid7-")
+    assert err.endswith(": the sb3 engine no longer trains (finished sb3 runs are reused, and this one is not "
+                        "finished); train it with --engine population\n")
+    assert not (out / "teachers").exists() and not (out / "students").exists()
+
+
+def test_transfer_refuses_a_device_the_machine_lacks(tmp_path, capsys, monkeypatch):
     import torch
 
     base = ["--steps", "2000"]
-    assert _refused(tmp_path, capsys, *base, "--engine", "sb3", "--device", "cuda") == (
-        "--device cuda: these students train on the sb3 engine, which takes no --device (its agents use a GPU where "
-        "there is one; --td3-hyper/--dqn-hyper '{\"device\": \"cpu\"}' sets theirs); leave out --device, or use "
-        "--engine population")
     assert _refused(tmp_path, capsys, *base, "--device", "nonsense") == (
         "--device 'nonsense' is not a torch device: use cpu or cuda")
     assert _refused(tmp_path, capsys, *base, "--device", "mps") == (

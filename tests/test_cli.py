@@ -55,7 +55,6 @@ def test_video_loads_craftsuite_agents(tmp_path, capsys):
     from craftsuite.agents.factory import make_agent
 
     agent = make_agent("product-dqn", "CraftSuite/DungeonQuest-Grid7-v0", learning_starts=10, buffer_size=500)
-    agent.learn(50)
     agent.save(tmp_path / "teacher.zip")
     out = tmp_path / "v.mp4"
     assert main(["video", "CraftSuite/DungeonQuest-Grid7-v0", "--product", "--policy",

@@ -16,7 +16,8 @@ from craftsuite.progress import LineProgress, progress_bar
 from craftsuite.runs import RunDir
 from craftsuite.training import train_student
 
-from .killed import CONFIG, TINY, killed_run
+TINY = {"learning_starts": 50, "buffer_size": 2_000, "policy_kwargs": {"net_arch": [16]}}
+CONFIG = StudentConfig(method="dqn", world="Grid7", steps=300, eval_every=100, eval_episodes=1, hyperparameters=TINY)
 
 
 class _Terminal(io.StringIO):
@@ -78,10 +79,18 @@ def test_a_message_gets_a_line_of_its_own(capsys):
 
 @pytest.fixture
 def killed(tmp_path, monkeypatch):
-    """An SB3 run killed after its checkpoint at 300, the one before at 200, the newer set
-    aside: it resumes from 200."""
-    run = killed_run(tmp_path, monkeypatch)
+    """``CONFIG``'s population run killed after its checkpoint at 300, the one before at 200,
+    the newer set aside: it resumes from 200."""
+    from craftsuite.suite_runner import checkpoint_step
+
+    monkeypatch.setattr(RunDir, "write_result", lambda self, result: (_ for _ in ()).throw(KeyboardInterrupt))
+    with pytest.raises(KeyboardInterrupt):
+        train_student(CONFIG, tmp_path, progress=False)
+    monkeypatch.undo()
+    run = tmp_path / CONFIG.run_name()
+    assert checkpoint_step(run) == 300
     (run / "checkpoint").rename(run / "checkpoint-aside")
+    assert checkpoint_step(run) == 200
     return run
 
 
@@ -97,43 +106,25 @@ def _bars(monkeypatch) -> list[dict]:
     return made
 
 
-def test_a_resumed_run_counts_its_earlier_steps_as_done_before(killed, monkeypatch):
-    from craftsuite.suite_runner import checkpoint_step
-
-    assert checkpoint_step(killed) == 200  # read from SB3's own checkpoint
+def test_a_resumed_population_counts_its_earlier_steps_as_done_before(killed, monkeypatch):
     made = _bars(monkeypatch)
     train_student(CONFIG, killed.parent, progress=False)
-    assert made == [{"total": 300, "desc": f"dqn {CONFIG.task} s0", "initial": 200}]
-
-
-def test_a_resumed_population_counts_its_earlier_steps_as_done_before(tmp_path, monkeypatch):
-    from craftsuite.suite_runner import checkpoint_step
-
-    config = StudentConfig(method="dqn", world="Grid7", steps=300, eval_every=100, eval_episodes=1,
-                           hyperparameters=TINY, engine="population")
-    monkeypatch.setattr(RunDir, "write_result", lambda self, result: (_ for _ in ()).throw(KeyboardInterrupt))
-    with pytest.raises(KeyboardInterrupt):
-        train_student(config, tmp_path, progress=False)
-    monkeypatch.undo()
-    assert checkpoint_step(tmp_path / config.run_name()) == 300
-    (tmp_path / config.run_name() / "checkpoint").rename(tmp_path / config.run_name() / "checkpoint-aside")
-    assert checkpoint_step(tmp_path / config.run_name()) == 200
-    made = _bars(monkeypatch)
-    train_student(config, tmp_path, progress=False)
     assert [bar["initial"] for bar in made] == [200]
 
 
 class _Pool:
-    """Runs nothing: each student job "finishes" at once, as a worker that found the run done."""
+    """Runs nothing: each population job "finishes" at once, as a worker that found its runs done."""
 
     def __init__(self, root):
-        self.root, self.closed = root, False
+        self.root, self.closed, self.submitted = root, False, []
 
-    def submit(self, job, config, root, *_):
-        name = StudentConfig(**config).run_name()
-        (self.root / name / "result.json").write_text("{}")
+    def submit(self, job, configs, root, *_):
+        names = [StudentConfig(**c).run_name() for c in configs]
+        self.submitted += names
+        for name in names:
+            (self.root / name / "result.json").write_text("{}")
         future = Future()
-        future.set_result(str(self.root / name))
+        future.set_result([str(self.root / name) for name in names])
         return future
 
     def close(self, abort=False):
@@ -159,6 +150,7 @@ def test_the_suites_bar_announces_reuse_and_resume_and_starts_past_them(killed, 
     assert said == [f"reused 1 finished student run from {root}",
                     f"resuming {CONFIG.run_name()} from step 200 (its checkpoint)"]
     assert made == [(600, 500)] and pool.closed  # 300 reused and 200 resumed: done before this session
+    assert pool.submitted == [CONFIG.run_name()]  # the finished sb3 run is reused without a worker
 
 
 def test_a_workers_prints_never_reach_the_drivers_bar(capsys):

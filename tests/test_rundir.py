@@ -1,5 +1,6 @@
 """Run directories: locking, config mismatch, atomic writes, log trimming."""
 
+import dataclasses
 import json
 import os
 import subprocess
@@ -9,7 +10,7 @@ import pytest
 
 from craftsuite.configs import StudentConfig
 from craftsuite.files import atomic_write
-from craftsuite.runs import EPISODE_FIELDS, RunDir, RunError, read_csv
+from craftsuite.runs import EPISODE_FIELDS, RunDir, RunError, load_config, read_csv, settings
 
 
 def test_two_live_runs_never_share_a_directory(tmp_path):
@@ -151,3 +152,19 @@ def test_checkpoints_rotate_keeping_the_one_before_the_last(tmp_path):
         assert steps(run) == [("checkpoint", "4")]
         run.remove_checkpoints()
         assert not any((run.path / name).exists() for name in RunDir.CHECKPOINTS)
+
+
+def test_a_field_at_its_default_is_left_out_of_the_key_and_old_records_load_but_are_not_resumed(tmp_path):
+    plain, skipped = StudentConfig(), StudentConfig(world_kwargs={"frame_skip": 10})
+    assert plain.run_name() != skipped.run_name() != StudentConfig(n_envs=4).run_name()
+    assert not {"world_kwargs", "n_envs"} & set(settings(plain))  # fields added later, at their default
+    # a record of format 1: the config's fields alone, without the effective settings
+    saved = {k: v for k, v in dataclasses.asdict(plain).items() if k not in ("world_kwargs", "n_envs")}
+    old = tmp_path / plain.run_name()
+    old.mkdir()
+    (old / "config.json").write_text(json.dumps(saved))
+    assert load_config(StudentConfig, old) == plain  # it loads
+    with pytest.raises(RunError, match=r"recorded without its effective settings \(record format 1\)"):
+        with RunDir(old, plain):  # but is not taken for a run of these settings
+            pass
+    assert json.loads((old / "config.json").read_text()) == saved  # and is left as it was

@@ -11,7 +11,8 @@ automaton's fingerprint so that it cannot be applied to another task by mistake.
 
 ``DistilledTarget`` is the students' one change (Eq. 5-6): Q' = beta Q_teacher +
 (1 - beta) Q_target with beta = rho ** eta_student(w, sigma), beta = 0 where the teacher
-has no value.
+has no value. It holds the rule's settings and a student's counts (a saved student keeps
+it); the population engine applies it (``craftsuite.population.targets.MemberTargets``).
 """
 
 from __future__ import annotations
@@ -22,7 +23,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import torch as th
 
 from ..automata import Automaton
 from ..files import atomic_path
@@ -208,33 +208,3 @@ class DistilledTarget:
         if not self_loops:  # only transitions that change the automaton state carry the teacher's value
             self.seen = self.seen & (automaton.delta != np.arange(len(automaton.delta))[:, None])
         self.student_counts = np.zeros(table.q.shape, dtype=np.int64)
-        self.last_weight = 0.0  # mean beta of the last minibatch: the teacher's share, logged by the agents
-        self._n_labels = table.q.shape[1]
-        self._make_views()
-
-    def _make_views(self) -> None:
-        # flat views: one fancy index per array per minibatch (this runs every gradient step)
-        self._teacher_flat = self.q_teacher.reshape(-1)
-        self._seen_flat = self.seen.reshape(-1).astype(np.float32)
-        self._counts_flat = self.student_counts.reshape(-1)
-
-    def __getstate__(self) -> dict:  # views do not survive pickling (checkpoints): rebuild them
-        return {k: v for k, v in self.__dict__.items() if not k.endswith("_flat")}
-
-    def __setstate__(self, state: dict) -> None:
-        self.__dict__.update(state)
-        self._make_views()
-
-    def beta(self, w: np.ndarray, sigma: np.ndarray) -> np.ndarray:
-        flat = np.asarray(w) * self._n_labels + np.asarray(sigma)
-        return self._seen_flat[flat] * self.rho ** self._counts_flat[flat]
-
-    def __call__(self, w: np.ndarray, sigma: np.ndarray, q_target: th.Tensor) -> th.Tensor:
-        flat = w * self._n_labels + sigma
-        mix = np.empty((2, len(flat)), dtype=np.float32)
-        mix[0] = self._seen_flat[flat] * self.rho ** self._counts_flat[flat]  # beta
-        mix[1] = self._teacher_flat[flat]
-        np.add.at(self._counts_flat, flat, 1)
-        self.last_weight = float(mix[0].mean())
-        beta, teacher = th.from_numpy(mix).to(q_target.device).reshape(2, *q_target.shape)
-        return q_target + beta * (teacher - q_target)

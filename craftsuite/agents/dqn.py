@@ -1,14 +1,11 @@
-"""DQN teachers and students: SB3's DQN with a dueling head, the double-DQN target,
-prioritized replay and, for students, the distilled target.
+"""DQN teachers and students as saved: SB3's DQN class that holds a trained member of the
+population engine (``craftsuite.population``), so that ``DQN.load`` and ``load_agent`` open
+it and it acts. It does not learn: its settings say what the population engine trained
+(double DQN, prioritized replay, the loss, the target update's unit, the distilled
+target), and ``learn`` names the trainer.
 
-Where this differs from SB3's DQN, and nowhere else:
-* ``DuelingQNetwork``: Q = V + A - mean(A) on SB3's MLP trunk (a policy class).
-* ``AutomatonDQN._td_target``: the one seam for the target (double DQN, then the distilled
-  mix when a ``DistilledTarget`` is given).
-* ``AutomatonDQN.train``: SB3's loop, with the loss weighted by importance weights and
-  the priorities updated from the TD errors; the loss Huber (SB3's) or squared error
-  (the paper's authors'); the target network's hard update counted in transitions (SB3's
-  ``target_update_interval``) or in gradient steps (the authors').
+Its networks, which a saved model rebuilds (policy classes and keywords):
+* ``DuelingQNetwork``: Q = V + A - mean(A) on SB3's MLP trunk.
 * ``features_extractor``: SB3's flattening, or a residual CNN over the grid's planes
   (``agents/networks.py``).
 * ``layer_norm``: LayerNorm after each hidden Linear layer of the Q-network and its target
@@ -19,9 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 import torch as th
-import torch.nn.functional as F
 from stable_baselines3 import DQN
-from stable_baselines3.common.utils import polyak_update
 from stable_baselines3.dqn.policies import DQNPolicy, QNetwork
 from torch import nn
 
@@ -29,7 +24,7 @@ from ..hyperparameters import DQN_CHOICES
 from .distillation import DistilledTarget
 from .networks import features_policy_kwargs, value_mlp
 from .base import AutomatonAlgorithm
-from .replay import AutomatonReplayBuffer, AutomatonSamples, automaton_buffer_kwargs
+from .replay import AutomatonReplayBuffer, automaton_buffer_kwargs
 
 
 LOSSES, TARGET_UPDATE_UNITS = DQN_CHOICES["loss"], DQN_CHOICES["target_update_unit"]
@@ -93,15 +88,16 @@ class DuelingDQNPolicy(LayerNormDQNPolicy):
 
 
 class AutomatonDQN(AutomatonAlgorithm, DQN):
-    """DQN for CraftSuite worlds: dueling, double, prioritized, optionally distilled.
+    """DQN for CraftSuite worlds, as a trained member is saved: dueling, double, prioritized,
+    optionally distilled (its training is ``craftsuite.population``'s).
 
     Args (beyond SB3's DQN):
         double: use the double-DQN target (online argmax, target-network value).
         dueling: with ``policy="MlpPolicy"``, use ``DuelingDQNPolicy``.
         prioritized: prioritized replay (``AutomatonReplayBuffer``), else uniform.
         distill: a ``DistilledTarget`` for students; None for teachers and baselines.
-        n_steps: n-step returns from the replay buffer (1: the one-step target); SB3's own
-            setting, so ``model.n_steps`` is what the buffer uses.
+        n_steps: the length of the TD targets it was trained with (1: one-step); SB3's own
+            setting, so ``model.n_steps`` says it.
         loss: ``"huber"`` (SB3's smooth L1) or ``"mse"`` (squared TD error).
         target_update_unit: what ``target_update_interval`` counts: ``"transitions"`` (SB3's
             meaning: env steps over all envs) or ``"gradient_steps"``.
@@ -136,68 +132,6 @@ class AutomatonDQN(AutomatonAlgorithm, DQN):
         self.double = double
         self.distill = distill
         super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, n_steps=n_steps, **kwargs)
-
-    def _td_target(self, data: AutomatonSamples) -> th.Tensor:
-        """r + gamma * Q_target(s', a*), a* from the online net when double; then distilled."""
-        with th.no_grad():
-            next_q = self.q_net_target(data.next_observations)
-            if self.double:
-                # a CNN's batch-norm statistics move once per gradient step, not twice (an MLP has none:
-                # no mode switch on the hot path)
-                training = self.q_net.training
-                if self.batch_norm_stats:
-                    self.q_net.set_training_mode(False)
-                best = self.q_net(data.next_observations).argmax(dim=1, keepdim=True)
-                if self.batch_norm_stats:
-                    self.q_net.set_training_mode(training)
-                next_q = th.gather(next_q, dim=1, index=best)
-            else:
-                next_q = next_q.max(dim=1, keepdim=True)[0]
-            discount = self.gamma if data.discounts is None else data.discounts  # gamma ** k after k rewards
-            target = data.rewards + (1 - data.dones) * discount * next_q
-            if self.distill is not None:
-                target = self.distill(data.w, data.sigma, target)
-        return target
-
-    def _on_step(self) -> None:
-        if self.target_update_unit == "transitions":
-            return super()._on_step()  # SB3's: the target's update by transitions, then epsilon
-        self._n_calls += 1
-        self.exploration_rate = self.exploration_schedule(self._current_progress_remaining)
-        self.logger.record("rollout/exploration_rate", self.exploration_rate)
-
-    def _update_target(self) -> None:
-        polyak_update(self.q_net.parameters(), self.q_net_target.parameters(), self.tau)
-        polyak_update(self.batch_norm_stats, self.batch_norm_stats_target, 1.0)  # a CNN's running stats, as SB3
-
-    def train(self, gradient_steps: int, batch_size: int = 100) -> None:
-        self.policy.set_training_mode(True)
-        self._update_learning_rate(self.policy.optimizer)
-        losses = []
-        for step in range(gradient_steps):
-            data = self.replay_buffer.sample(batch_size, env=self._vec_normalize_env)
-            target = self._td_target(data)
-            current = th.gather(self.q_net(data.observations), dim=1, index=data.actions.long())
-            loss_fn = F.smooth_l1_loss if self.loss == "huber" else F.mse_loss
-            if self.replay_buffer.prioritized:
-                loss = (data.weights * loss_fn(current, target, reduction="none")).mean()
-            else:  # uniform replay: SB3's loss exactly
-                loss = loss_fn(current, target)
-            losses.append(loss.item())
-            self.policy.optimizer.zero_grad()
-            loss.backward()
-            th.nn.utils.clip_grad_norm_(self.policy.parameters(), self.max_grad_norm)
-            self.policy.optimizer.step()
-            if self.replay_buffer.prioritized:
-                self.replay_buffer.update_priorities(data.indices, (current - target).detach().cpu().numpy())
-            counted = self._n_updates + step + 1
-            if self.target_update_unit == "gradient_steps" and counted % self.target_update_interval == 0:
-                self._update_target()
-        self._n_updates += gradient_steps
-        self.logger.record("train/n_updates", self._n_updates, exclude="tensorboard")
-        self.logger.record("train/loss", np.mean(losses))
-        if self.distill is not None:
-            self.logger.record("train/teacher_weight", self.distill.last_weight)
 
     def q_values(self, observations: np.ndarray) -> np.ndarray:
         """Q(s, .) of the online network for a batch of observations, in evaluation mode (a

@@ -1,9 +1,11 @@
-"""Agents built and loaded: every method of ``craftsuite.methods.METHODS`` built into an
-agent by ``make_agent(method, env, ...)``, a saved agent loaded by ``load_agent``.
+"""Agents built and loaded: every method of ``craftsuite.methods.METHODS`` built into the
+SB3 agent that holds a trained member (``make_agent(method, env, ...)``: what the population
+engine saves), a saved agent loaded by ``load_agent``.
 
 Grid methods are DQN (``AutomatonDQN``), MuJoCo methods TD3 (``AutomatonTD3``); the table
 says which sees the automaton state and how it uses the automaton. A teacher is
-``product-dqn`` on a 7x7 grid; ``distill_from_replay`` turns it into a table.
+``product-dqn`` on a 7x7 grid; ``distill_from_replay`` turns an SB3-trained teacher's
+checkpoint into a table.
 """
 
 from __future__ import annotations
@@ -34,10 +36,10 @@ assert set(CLASSES) == set(ALGORITHMS), "every algorithm of the methods table ne
 
 def make_agent(method: str, env, *, table: AutomatonQTable | None = None, seed: int = 0,
                n_envs: int = 1, rho: float | None = None, self_loops: bool | None = None, verbose: int = 0,
-               env_kwargs: dict | None = None, automaton_state: bool | None = None, to_save: bool = False,
-               **overrides):
-    """An untrained agent of ``method``: each step of the agent collects one transition per
-    env, then takes ``gradient_steps`` updates.
+               env_kwargs: dict | None = None, automaton_state: bool | None = None, **overrides):
+    """An untrained SB3 agent of ``method``, built as the population engine saves a member
+    (``population.train.save_member``): it acts and saves, and its settings are checked;
+    it does not learn (``learn`` names ``craftsuite.population.train_population``).
 
     ``env`` is a CraftSuite id (the agent gets ``n_envs`` copies of it, made with
     ``env_kwargs``, e.g. ``{"layout_seed": 0}`` for a fixed grid instance) or an env made
@@ -48,14 +50,9 @@ def make_agent(method: str, env, *, table: AutomatonQTable | None = None, seed: 
     target (``DistilledTarget``; None: the method's); ``overrides`` to the algorithm,
     checked by name and type (``craftsuite.hyperparameters.check_hyperparameters``; TD3's
     ``action_noise`` may be a spec such as ``{"type": "persistent", "sigma": 0.6,
-    "resample": 0.1}``: ``agents/noise.py``). ``to_save``: the agent is built to hold a
-    population member's trained weights, not to learn: the only way to build one of a
-    method whose learning rule only the population engine has (reward shaping)."""
+    "resample": 0.1}``: ``agents/noise.py``)."""
     check_methods([method])
     m = METHODS[method]
-    if m.shaping and not to_save:  # its rule is the population engine's: an SB3 agent of it would learn unshaped
-        raise ValueError(f"method {method!r}: reward shaping is trained by the population engine only; use "
-                         "--engine population (make_agent builds its model only to save a member: to_save=True)")
     product = m.observes(automaton_state)  # a MethodError naming both, for a method that cannot go without
     kwargs = algorithm_settings(m.algorithm, overrides)  # bad settings are named before an env is made
     if isinstance(env, str):
@@ -111,7 +108,8 @@ def _check_suited(name: str, method: Method, env, product: bool) -> None:
 
 
 def distill_from_replay(teacher: AutomatonDQN, chunk: int = 4096) -> AutomatonQTable:
-    """Dynamic distillation of a DQN teacher: mean Q of the taken action per (w, sigma)."""
+    """Dynamic distillation of a DQN teacher with its SB3 replay (an SB3-trained teacher
+    run's checkpoint): mean Q of the taken action per (w, sigma)."""
     buf = teacher.replay_buffer
     rows = buf.buffer_size if buf.full else buf.pos
     if rows == 0:

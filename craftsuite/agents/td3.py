@@ -1,35 +1,26 @@
-"""TD3 students for the MuJoCo worlds: SB3's TD3 with prioritized replay, an actor delay
-schedule and, for distilled students, the distilled target.
+"""TD3 students as saved: SB3's TD3 class that holds a trained member of the population
+engine (``craftsuite.population``), so that ``TD3.load`` and ``load_agent`` open it and it
+acts. It does not learn: its settings say what the population engine trained (the prioritized
+replay, the actor's delay schedule, the distilled target), and ``learn`` names the trainer.
 
-Where this differs from SB3's TD3, and nowhere else:
-* ``AutomatonTD3._td_target``: the one seam for the target (clipped double-Q with target
-  policy smoothing, as SB3, after n rewards when ``n_steps`` > 1; then the distilled mix
-  when a ``DistilledTarget`` is given).
-* ``AutomatonTD3.train``: SB3's loop, with the critic loss weighted by importance weights,
-  priorities updated from the first critic's TD errors, and the actor delayed by
-  ``policy_delay_at(num_timesteps)`` (by default ``hyperparameters.TD3_DELAY_SCHEDULE``), which it
-  sets as SB3's ``policy_delay`` for each call, so that attribute says the delay in force.
 * ``layer_norm``: LayerNorm after each hidden Linear layer of the critics and their
-  targets (``LayerNormTD3Policy``); the actor is SB3's.
+  targets (``LayerNormTD3Policy``, a policy keyword, so a saved model rebuilds them); the
+  actor is SB3's.
 """
 
 from __future__ import annotations
 
-import numpy as np
-import torch as th
-import torch.nn.functional as F
 from stable_baselines3 import TD3
 from stable_baselines3.common.policies import ContinuousCritic
 from stable_baselines3.common.preprocessing import get_action_dim
-from stable_baselines3.common.utils import polyak_update
 from stable_baselines3.td3.policies import TD3Policy
 from torch import nn
 
-from ..hyperparameters import TD3_DELAY_SCHEDULE
+from ..population.td3 import delay_at, delay_schedule as check_delay_schedule
 from .distillation import DistilledTarget
 from .base import AutomatonAlgorithm
 from .networks import value_mlp
-from .replay import AutomatonReplayBuffer, AutomatonSamples, automaton_buffer_kwargs
+from .replay import AutomatonReplayBuffer, automaton_buffer_kwargs
 
 
 class LayerNormCritic(ContinuousCritic):
@@ -66,7 +57,8 @@ class LayerNormTD3Policy(TD3Policy):
 
 
 class AutomatonTD3(AutomatonAlgorithm, TD3):
-    """TD3 for CraftSuite worlds: prioritized, delay-scheduled, optionally distilled.
+    """TD3 for CraftSuite worlds, as a trained member is saved: prioritized, delay-scheduled,
+    optionally distilled (its training is ``craftsuite.population``'s).
 
     Args (beyond SB3's TD3):
         prioritized: prioritized replay (``AutomatonReplayBuffer``), else uniform.
@@ -74,10 +66,9 @@ class AutomatonTD3(AutomatonAlgorithm, TD3):
         delay_schedule: ``((until_step, delay), ..., (None, delay))``: the actor's delay
             by step (default: ``hyperparameters.TD3_DELAY_SCHEDULE``).
         policy_delay: a constant delay, as in SB3's TD3: the schedule ``((None, policy_delay),)``
-            (give this or ``delay_schedule``). ``model.policy_delay`` is always the delay in
-            force: the schedule's at the last training call.
-        n_steps: n-step returns from the replay buffer (1: SB3's one-step target); SB3's own
-            setting, so ``model.n_steps`` is what the buffer uses.
+            (give this or ``delay_schedule``); ``policy_delay_at(step)`` reads the schedule.
+        n_steps: the length of the TD targets it was trained with (1: one-step); SB3's own
+            setting, so ``model.n_steps`` says it.
         layer_norm: LayerNorm after each hidden Linear layer of the critics and their
             targets, before the activation (with ``policy="MlpPolicy"``; a policy keyword).
 
@@ -96,89 +87,10 @@ class AutomatonTD3(AutomatonAlgorithm, TD3):
                                                        replay_buffer_kwargs)
         self.algorithm = "td3"
         self.distill = distill
-        self.delay_schedule = _delay_schedule(delay_schedule, policy_delay)
+        self.delay_schedule = check_delay_schedule(delay_schedule, policy_delay)
         super().__init__(policy, env, replay_buffer_kwargs=replay_buffer_kwargs, n_steps=n_steps,
                          policy_delay=self.policy_delay_at(0), **kwargs)
 
     def policy_delay_at(self, step: int) -> int:
+        """The actor's delay the schedule sets at ``step``."""
         return delay_at(self.delay_schedule, step)
-
-    def _td_target(self, data: AutomatonSamples) -> th.Tensor:
-        with th.no_grad():
-            noise = data.actions.clone().data.normal_(0, self.target_policy_noise)
-            noise = noise.clamp(-self.target_noise_clip, self.target_noise_clip)
-            next_actions = (self.actor_target(data.next_observations) + noise).clamp(-1, 1)
-            next_q = th.cat(self.critic_target(data.next_observations, next_actions), dim=1)
-            next_q = th.min(next_q, dim=1, keepdim=True)[0]
-            discount = self.gamma if data.discounts is None else data.discounts  # gamma ** k after k rewards
-            target = data.rewards + (1 - data.dones) * discount * next_q
-            if self.distill is not None:
-                target = self.distill(data.w, data.sigma, target)
-        return target
-
-    def train(self, gradient_steps: int, batch_size: int = 100) -> None:
-        self.policy.set_training_mode(True)
-        self._update_learning_rate([self.actor.optimizer, self.critic.optimizer])
-        self.policy_delay = delay = self.policy_delay_at(self.num_timesteps)  # SB3's attribute tells the truth
-        actor_losses, critic_losses = [], []
-        for _ in range(gradient_steps):
-            self._n_updates += 1
-            data = self.replay_buffer.sample(batch_size, env=self._vec_normalize_env)
-            target = self._td_target(data)
-            current = self.critic(data.observations, data.actions)
-            if self.replay_buffer.prioritized:
-                critic_loss = sum((data.weights * (q - target) ** 2).mean() for q in current)
-            else:  # uniform replay: SB3's loss exactly
-                critic_loss = sum(F.mse_loss(q, target) for q in current)
-            critic_losses.append(critic_loss.item())
-            self.critic.optimizer.zero_grad()
-            critic_loss.backward()
-            self.critic.optimizer.step()
-            if self.replay_buffer.prioritized:
-                self.replay_buffer.update_priorities(data.indices, (current[0] - target).detach().cpu().numpy())
-
-            if self._n_updates % delay == 0:
-                actor_loss = -self.critic.q1_forward(data.observations, self.actor(data.observations)).mean()
-                actor_losses.append(actor_loss.item())
-                self.actor.optimizer.zero_grad()
-                actor_loss.backward()
-                self.actor.optimizer.step()
-                polyak_update(self.critic.parameters(), self.critic_target.parameters(), self.tau)
-                polyak_update(self.actor.parameters(), self.actor_target.parameters(), self.tau)
-                polyak_update(self.critic_batch_norm_stats, self.critic_batch_norm_stats_target, 1.0)
-                polyak_update(self.actor_batch_norm_stats, self.actor_batch_norm_stats_target, 1.0)
-
-        self.logger.record("train/n_updates", self._n_updates, exclude="tensorboard")
-        self.logger.record("train/policy_delay", delay)
-        if actor_losses:
-            self.logger.record("train/actor_loss", np.mean(actor_losses))
-        self.logger.record("train/critic_loss", np.mean(critic_losses))
-        if self.distill is not None:
-            self.logger.record("train/teacher_weight", self.distill.last_weight)
-
-
-def delay_at(schedule: tuple, step: int) -> int:
-    """The actor's delay in force at ``step`` under a ``_delay_schedule``."""
-    for until, delay in schedule:
-        if until is None or step < until:
-            return delay
-    return schedule[-1][1]
-
-
-def _delay_schedule(schedule, policy_delay) -> tuple:
-    """The actor's delay schedule from ``delay_schedule`` or a constant ``policy_delay``."""
-    if schedule is not None and policy_delay is not None:
-        raise ValueError("give delay_schedule or policy_delay (a constant delay), not both")
-    if policy_delay is not None:
-        schedule = ((None, policy_delay),)
-    elif schedule is None:
-        schedule = TD3_DELAY_SCHEDULE
-    schedule = tuple(tuple(row) for row in schedule)
-    for i, row in enumerate(schedule):
-        last = i == len(schedule) - 1
-        ok = (len(row) == 2 and isinstance(row[1], int) and not isinstance(row[1], bool) and row[1] >= 1
-              and ((row[0] is None) if last else (isinstance(row[0], int) and not isinstance(row[0], bool))))
-        if not ok:
-            raise ValueError(f"delay_schedule must be ((until_step, delay), ..., (None, delay)) with delays of at "
-                             f"least 1, got {schedule!r}")
-    return schedule

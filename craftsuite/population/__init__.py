@@ -2,9 +2,10 @@
 
 K members' networks are stacked on a leading axis and updated together (``nets``,
 ``td3``, ``dqn``), their replay preallocated with a sum tree per member (``replay``), their
-envs one vector env (``envs``); ``engine.Population`` collects and learns as the SB3
-agents do, ``train.train_population`` makes each member an ordinary run directory. The SB3
-agents (``craftsuite.agents``) stay the reference and the per-agent API.
+envs one vector env (``envs``); ``engine.Population`` collects and learns,
+``train.train_population`` makes each member an ordinary run directory. Every learning rule
+CraftSuite trains with lives here once; a member is saved as an SB3 agent
+(``craftsuite.agents``), which loads and acts but does not learn.
 """
 
 from .engine import EngineError, Population, check_supported  # noqa: F401

@@ -1,4 +1,4 @@
-"""DQN for K members in one set of stacked networks: ``agents.dqn.AutomatonDQN``'s update
+"""DQN for K members in one set of stacked networks: CraftSuite's one DQN update
 (the dueling head, the double-DQN target, Huber or squared loss weighted by importance
 weights, each member's gradient clipped to its own norm, the hard target update counted in
 transitions or gradient steps, the distilled target), computed for every member at once.
@@ -101,7 +101,8 @@ class PopulationDQN:
         return _eval_mode(self.q_net)
 
     def td_target(self, batch: Batch, next_obs) -> th.Tensor:
-        """The one target rule (``AutomatonDQN._td_target`` for K members), ``(K, B, 1)``."""
+        """The one DQN target rule, ``(K, B, 1)``: r + gamma * Q_target(s', a*), a* the online
+        network's argmax when double (else the target's max), then the distilled mix where there is one."""
         K, B = batch.rewards.shape
         with th.no_grad():
             next_q = self.q_values(self.q_net_target, next_obs)

@@ -3,13 +3,14 @@
 ``Population`` owns the members' learner (``PopulationTD3`` or ``PopulationDQN``), their
 replay and exploration, and steps the K x n envs of one vector env: member k acts in its
 own n envs, stores in its own replay slice and takes its own gradient steps, in lockstep
-with the others. What a member does per transition is what an SB3 agent of its run does
-(``agents.factory.make_agent``): the same warm-up of random actions, exploration noise or
-epsilon schedule, collection regime (``train_freq``, ``gradient_steps``), target-update
-interval, TD3 delay schedule, n-step returns (``n_steps``) and ``_td_target`` rule. Two
-differences, both deliberate:
-DQN explores with a coin per env (SB3's ``predict`` tosses one for all envs of a step), and
-members share one random stream for sampling (their minibatches are still their own).
+with the others. Every learning rule of CraftSuite lives here once: the warm-up of random
+actions, exploration noise or epsilon schedule, collection regime (``train_freq``,
+``gradient_steps``), target-update interval, TD3 delay schedule, n-step returns
+(``n_steps``), CRM and reward shaping (``replay``), and the TD target rules (``dqn``,
+``td3``, ``targets``), for SB3's settings of the same names. Where SB3's DQN and TD3 do
+otherwise, deliberately: DQN explores with a coin per env (SB3's ``predict`` tosses one for
+all envs of a step), and members share one random stream for sampling (their minibatches
+are still their own).
 """
 
 from __future__ import annotations
@@ -19,14 +20,13 @@ import torch as th
 
 from ..agents.distillation import AutomatonQTable, DistilledTarget, static_distillation
 from ..agents.noise import make_action_noise
-from ..agents.td3 import _delay_schedule, delay_at
 from ..methods import METHODS
 from ..shaping import Shaping, potential
 from .dqn import PopulationDQN
 from .envs import step_records
 from .replay import CounterfactualView, PopulationReplay
 from .targets import MemberTargets
-from .td3 import PopulationTD3
+from .td3 import PopulationTD3, delay_at, delay_schedule
 
 
 class EngineError(ValueError):
@@ -34,7 +34,7 @@ class EngineError(ValueError):
 
 
 # Settings the engine reads; any other override of a run's algorithm is refused by name
-# (the SB3 engine runs every setting).
+# (it would be silently ignored otherwise).
 _READ = {
     "td3": {"learning_rate", "buffer_size", "batch_size", "learning_starts", "gamma", "tau", "target_policy_noise",
             "target_noise_clip", "action_noise", "policy_kwargs", "train_freq", "gradient_steps", "n_steps",
@@ -50,7 +50,7 @@ _POLICY_KWARGS = {"net_arch", "activation_fn", "optimizer_kwargs", "n_critics"}
 
 
 def check_supported(method: str, settings: dict) -> None:
-    """Raise ``EngineError`` naming what the engine cannot run, and pointing to ``--engine sb3``."""
+    """Raise ``EngineError`` naming what the engine, which trains every CraftSuite run, cannot run."""
     algorithm = METHODS[method].algorithm
     why = None
     unknown = sorted(set(settings) - _READ[algorithm])
@@ -69,8 +69,8 @@ def check_supported(method: str, settings: dict) -> None:
     elif algorithm == "td3" and not isinstance(settings.get("action_noise"), (dict, type(None))):
         why = "an action_noise object (it takes a spec such as {'type': 'normal', 'sigma': 0.3})"
     if why is not None:
-        raise EngineError(f"method {method!r}: the population engine does not support {why}; "
-                          "run it with --engine sb3")
+        raise EngineError(f"method {method!r}: the population engine, which trains CraftSuite's runs, does not "
+                          f"support {why}; leave it out of the run's settings")
     _check_n_steps(method, settings.get("n_steps", 1))
 
 
@@ -142,7 +142,7 @@ class Population:
             self.act_dim = int(action_space.shape[-1])
             self.learner = PopulationTD3(self.K, obs_dim, self.act_dim, settings, targets, device)
             action_shape, action_dtype = (self.act_dim,), np.float32
-            self.delay_schedule = _delay_schedule(settings.get("delay_schedule"), settings.get("policy_delay"))
+            self.delay_schedule = delay_schedule(settings.get("delay_schedule"), settings.get("policy_delay"))
             spec = settings.get("action_noise")
             self.noises = [make_action_noise(spec, self.act_dim, seed, n_envs) if spec else None for seed in seeds]
         buffer = settings.get("replay_buffer_kwargs") or {}

@@ -140,7 +140,7 @@ def activation_of(activation_fn) -> callable:
         return ACTIVATIONS[activation_fn]
     except KeyError:
         raise ValueError(f"the population engine supports the activations {[a.__name__ for a in ACTIVATIONS]}, "
-                         f"not {activation_fn!r}: use --engine sb3") from None
+                         f"not {activation_fn!r}: use one of them") from None
 
 
 def clip_grad_norm_per_member(params, max_norm: float) -> None:

@@ -3,23 +3,23 @@ per member in one array, and CRM's counterfactuals made when a batch is sampled.
 
 Each member's transitions sit at the same positions of its own slice, written in step
 (members collect in lockstep), in the order SB3's buffer uses: a step of ``n_envs`` envs
-fills ``n_envs`` consecutive positions. Sampling follows ``agents.replay``: uniformly, or
+fills ``n_envs`` consecutive positions. Sampling is uniform, or
 stratified by priority p ** alpha with importance weights (N P(i)) ** -beta over their
 maximum, new transitions at the maximum priority seen.
 
-With ``n_steps`` > 1 a sample is an n-step return, as ``agents.replay._n_step``: the
+With ``n_steps`` > 1 a sample is an n-step return, as SB3's ``NStepReplayBuffer`` makes one: the
 discounted rewards of up to n steps of the same env (the next step of env j sits
 ``n_envs`` positions on), stopping at the episode's end (terminated or truncated) and at
 the newest step written (what lies after it is unwritten, or the oldest steps once the
 replay has wrapped), the next observation and terminal of the window's last step, and
 ``gamma ** k`` after its k rewards in ``discounts``. The automaton pair (w, sigma), the
-priority and the importance weight stay the first step's, as the SB3 buffer's do.
+priority and the importance weight stay the first step's.
 
 CRM (``crm=CounterfactualView(...)``) stores each real step once, with its automaton
 transition ``(w, sigma, w')``. A leaf of the sum tree is a (step, live automaton state u)
 pair; sampling leaf (i, u) rewrites step i as read from u: the observation's one-hot, u' =
 delta(u, sigma), the reward with u's completion bonus for the real one, an end where u'
-accepts or is rejecting (``agents.crm.counterfactuals``, to which this is equal). Memory
+accepts or is rejecting (Toro Icarte et al., JAIR 2022). Memory
 grows with the steps, not with the steps times the automaton's states. With ``n_steps`` > 1
 (n-step CRM), u is carried through the window's stored labels: each step pays the world's
 reward and u's completion bonus, and the window stops where the automaton from u accepts or
@@ -371,8 +371,7 @@ class PopulationReplay:
 
     def _n_step(self, index: np.ndarray):
         """For positions ``(K, B)``: the position that ends each one's n-step window, the
-        discounted rewards up to it and ``gamma ** k`` after its k rewards
-        (``agents.replay.AutomatonReplayBuffer._n_step``, on this replay's layout).
+        discounted rewards up to it and ``gamma ** k`` after its k rewards.
 
         A position is (vector step, env): env j's next transition is ``n_envs`` positions on,
         modulo the capacity. A window stops at its episode's end (terminated or truncated),

@@ -2,13 +2,12 @@
 one count table per member (each member's own minibatches decide how far it trusts the
 teacher), the teacher's table shared; and the bootstrap's discount of a minibatch.
 
-With n-step returns the rule mixes the teacher in as the SB3 agents do
-(``AutomatonDQN._td_target``, ``AutomatonTD3._td_target``): after the n-step target
+With n-step returns the rule mixes the teacher in after the n-step target
 r_0 + ... + gamma^(k-1) r_(k-1) + gamma^k Q(s_k) is made, with the (w, sigma) of the
-sample's first step, the one its action took (``AutomatonReplayBuffer._samples`` returns
-``w[batch]``, ``sigma[batch]`` at the window's start, not at its k-th step): the teacher's
-Q(w, sigma) is its value of that first transition, which the target estimates; the
-student's count of that pair is the one that goes up.
+sample's first step, the one its action took (the replay's ``Batch`` holds ``w``, ``sigma``
+at the window's start, not at its k-th step): the teacher's Q(w, sigma) is its value of
+that first transition, which the target estimates; the student's count of that pair is
+the one that goes up.
 """
 
 from __future__ import annotations

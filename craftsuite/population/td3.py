@@ -1,8 +1,9 @@
-"""TD3 for K members in one set of stacked networks: ``agents.td3.AutomatonTD3``'s update
-(clipped double-Q with target policy smoothing, importance-weighted critic loss with
-prioritized replay, the delayed actor, Polyak averaging, the distilled target), computed
-for every member in the same tensor operations. One optimizer steps all members: Adam is
-elementwise, so each member's parameters move exactly as its own Adam would move them."""
+"""TD3 for K members in one set of stacked networks: CraftSuite's one TD3 update (clipped
+double-Q with target policy smoothing, importance-weighted critic loss with prioritized
+replay, the actor delayed by a schedule (``delay_schedule``), Polyak averaging, the
+distilled target), computed for every member in the same tensor operations. One optimizer
+steps all members: Adam is elementwise, so each member's parameters move exactly as its
+own Adam would move them. A member is saved as an ``agents.td3.AutomatonTD3``."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import numpy as np
 import torch as th
 from stable_baselines3.common.utils import polyak_update  # elementwise: stacked members too
 
+from ..hyperparameters import TD3_DELAY_SCHEDULE
 from .nets import StackedMLP, activation_of
 from .replay import Batch
 from .targets import MemberTargets, discount
@@ -78,7 +80,8 @@ class PopulationTD3:
         return t if shape is None else t.reshape(shape)
 
     def td_target(self, batch: Batch, next_obs: th.Tensor, actions: th.Tensor) -> th.Tensor:
-        """The one target rule (``AutomatonTD3._td_target`` for K members), ``(K, B, 1)``."""
+        """The one TD3 target rule, ``(K, B, 1)``: clipped double-Q with target policy
+        smoothing after the sample's rewards, then the distilled mix where there is one."""
         K, B = batch.rewards.shape
         with th.no_grad():
             noise = actions.clone().data.normal_(0, self.policy_noise).clamp(-self.noise_clip, self.noise_clip)
@@ -147,3 +150,31 @@ class PopulationTD3:
         return {"actor_optimizer": self.actor_optimizer, "critic_optimizer": self.critic_optimizer}
 
 
+
+
+def delay_at(schedule: tuple, step: int) -> int:
+    """The actor's delay in force at ``step`` under a ``delay_schedule``."""
+    for until, delay in schedule:
+        if until is None or step < until:
+            return delay
+    return schedule[-1][1]
+
+
+def delay_schedule(schedule, policy_delay) -> tuple:
+    """The actor's delay schedule ``((until_step, delay), ..., (None, delay))`` from a run's
+    ``delay_schedule`` or a constant ``policy_delay`` (default: ``TD3_DELAY_SCHEDULE``)."""
+    if schedule is not None and policy_delay is not None:
+        raise ValueError("give delay_schedule or policy_delay (a constant delay), not both")
+    if policy_delay is not None:
+        schedule = ((None, policy_delay),)
+    elif schedule is None:
+        schedule = TD3_DELAY_SCHEDULE
+    schedule = tuple(tuple(row) for row in schedule)
+    for i, row in enumerate(schedule):
+        last = i == len(schedule) - 1
+        ok = (len(row) == 2 and isinstance(row[1], int) and not isinstance(row[1], bool) and row[1] >= 1
+              and ((row[0] is None) if last else (isinstance(row[0], int) and not isinstance(row[0], bool))))
+        if not ok:
+            raise ValueError(f"delay_schedule must be ((until_step, delay), ..., (None, delay)) with delays of at "
+                             f"least 1, got {schedule!r}")
+    return schedule

@@ -1,7 +1,7 @@
 """Teachers on the population engine: a product-DQN population of one on its grid, stopped at
 its greedy-success target, then distilled from its own replay.
 
-``train_teacher(config, root)`` writes the run directory ``training.train_teacher`` writes:
+``train_teacher(config, root)`` (``training.train_teacher`` for the population engine) writes:
 ``teacher.zip`` (an SB3 agent), ``table.npz`` (``distill``: per automaton transition (w,
 sigma), the mean Q of the actions its replay took there) and ``result.json``; its last
 checkpoint stays, so that ``distill_run`` (``craftsuite distill RUN``) reads the same replay

@@ -352,7 +352,7 @@ def save_member(pop: Population, k: int, config, path: Path, table=None) -> None
     from ..agents.factory import make_agent
 
     agent = make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=1,
-                       env_kwargs=config.env_kwargs, automaton_state=config.automaton_state, to_save=True,
+                       env_kwargs=config.env_kwargs, automaton_state=config.automaton_state,
                        **config.effective()["hyperparameters"])
     pop.learner.store_member(k, agent)
     agent.num_timesteps, agent.n_updates = pop.num_timesteps, pop.learner.n_updates

@@ -52,4 +52,3 @@ def test_make_agent_takes_a_spec_and_keeps_the_white_default():
     agent = make_agent("td3", CONT, seed=3, action_noise={"type": "persistent", "sigma": 0.6, "resample": 0.1},
                        **small)
     assert isinstance(agent.action_noise, PersistentActionNoise) and agent.action_noise.resample == 0.1
-    agent.learn(20)  # the noise drives SB3's collection

@@ -344,12 +344,3 @@ def test_the_scripted_policy_completes_blind_craftsman():
     policy = KinematicScriptedPolicy(env)
     wins = sum(rollout(env, policy, 1, s)[0].success for s in range(10))
     assert wins == 10
-
-
-def test_a_td3_agent_learns_a_few_steps():
-    from craftsuite.agents.factory import make_agent
-
-    agent = make_agent("td3", "CraftSuite/Reach-Kinematic-v0", learning_starts=50, buffer_size=1_000, seed=0)
-    agent.learn(120)
-    action, _ = agent.predict(np.zeros(agent.observation_space.shape, dtype=np.float32), deterministic=True)
-    assert action.shape == (2,) and np.all(np.abs(action) <= 1)

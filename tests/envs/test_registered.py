@@ -245,3 +245,19 @@ def test_every_keyword_a_world_lists_is_taken():
         env.reset(seed=0)
         assert env.spec.max_episode_steps == 5
         env.close()
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_plain_sb3_algorithms_train_on_every_id(env_id):
+    """SB3 stays where users meet it: its own DQN (grid worlds) and TD3 (continuous ones)
+    train on each id, with and without the automaton state, as on any gymnasium env."""
+    import stable_baselines3 as sb3
+
+    for product in (False, True):
+        env = gym.make(env_id, product=product)
+        algorithm = sb3.DQN if isinstance(env.action_space, gym.spaces.Discrete) else sb3.TD3
+        model = algorithm("MlpPolicy", env, learning_starts=16, batch_size=8, buffer_size=64, seed=0, device="cpu",
+                          policy_kwargs={"net_arch": [8]})
+        model.learn(24)
+        assert model.num_timesteps == 24 and model._n_updates > 0
+        env.close()

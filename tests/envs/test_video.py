@@ -106,7 +106,6 @@ def test_videos_for_people_carry_the_status_panel(tmp_path, capsys):
     run = tmp_path / "students" / "run"
     run.mkdir(parents=True)
     agent = make_agent("product-dqn", env_id, learning_starts=10, buffer_size=100)
-    agent.learn(20)
     agent.save(run / "model.zip")
     (run / "config.json").write_text(json.dumps({"task": "DungeonQuest", "world": "Grid7", "method": "product-dqn",
                                                  "seed": 0, "steps": 20}))

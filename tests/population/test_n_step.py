@@ -1,7 +1,7 @@
-"""n-step returns in the population engine: its replay samples them as the SB3 buffer does
-(by hand on tiny replays, and sample for sample against ``AutomatonReplayBuffer``), its
-distilled target mixes the teacher in at the first step's automaton pair as the SB3 agents
-do, a population trains with them, and with CRM (n-step CRM) too."""
+"""n-step returns in the population engine: its replay samples them (by hand on tiny
+replays; the learning rule on them: the frozen ``*-n3`` cases), its distilled target mixes
+the teacher in at the first step's automaton pair, a population trains with them, and with
+CRM (n-step CRM) too."""
 
 import json
 
@@ -14,7 +14,6 @@ import craftsuite  # noqa: F401
 from craftsuite.agents import AutomatonQTable, DistilledTarget
 from craftsuite.agents.distillation import static_distillation
 from craftsuite.agents.factory import load_agent
-from craftsuite.agents.replay import AutomatonReplayBuffer
 from craftsuite.configs import StudentConfig
 from craftsuite.hyperparameters import algorithm_settings
 from craftsuite.population import Population, train_population
@@ -98,42 +97,8 @@ def test_n_step_windows_never_run_from_the_newest_step_into_the_oldest():
     assert got[(4, 1)] == (160 + 0.5 * 320, 0.25, 0.0, 15.5)
 
 
-def test_population_n_step_samples_equal_the_sb3_buffers():
-    """One random stream of 3 envs (terminations, time limits, a wrap) into both buffers:
-    every position samples the same return, discount, terminal and next observation."""
-    rng = np.random.default_rng(7)
-    n_envs, slots, n, gamma = 3, 16, 4, 0.9
-    space = gym.spaces.Box(-1e6, 1e6, (2,), np.float32)
-    sb3 = AutomatonReplayBuffer(slots * n_envs, space,  # SB3 counts transitions over all envs
-                                gym.spaces.Discrete(4), n_envs=n_envs, prioritized=False,
-                                n_steps=n, gamma=gamma)
-    pop = PopulationReplay(1, slots * n_envs, n_envs, 2, (), np.int64, prioritized=False, n_steps=n, gamma=gamma)
-    for _ in range(41):
-        obs, next_obs = rng.normal(size=(2, n_envs, 2)).astype(np.float32)
-        rewards = rng.normal(size=n_envs).astype(np.float32)
-        terminated, truncated = rng.random(n_envs) < 0.15, rng.random(n_envs) < 0.1
-        truncated &= ~terminated
-        actions, w, sigma = rng.integers(4, size=n_envs), rng.integers(3, size=n_envs), rng.integers(4, size=n_envs)
-        sb3.add(obs, next_obs, actions[:, None], rewards, terminated | truncated,
-                [{"automaton_transition": (int(w[e]), int(sigma[e]), 0), "TimeLimit.truncated": bool(truncated[e])}
-                 for e in range(n_envs)])
-        pop.add(obs[None], next_obs[None], actions[None], rewards[None], terminated[None].astype(np.float32),
-                w[None], sigma[None], (terminated | truncated)[None])
-    batch = pop.sample(2_000)
-    positions = batch.leaves[0]
-    assert len(np.unique(positions)) == slots * n_envs and (batch.discounts < gamma ** 3 + 1e-6).any()
-    theirs = sb3._samples(positions, np.ones(len(positions), dtype=np.float32))
-    np.testing.assert_array_equal(batch.rewards[0], theirs.rewards.numpy()[:, 0])
-    np.testing.assert_array_equal(batch.discounts[0], theirs.discounts.numpy()[:, 0])
-    np.testing.assert_array_equal(batch.terminals[0], theirs.dones.numpy()[:, 0])
-    np.testing.assert_array_equal(batch.next_observations[0], theirs.next_observations.numpy())
-    np.testing.assert_array_equal(batch.observations[0], theirs.observations.numpy())
-    np.testing.assert_array_equal(batch.w[0], theirs.w)
-    np.testing.assert_array_equal(batch.sigma[0], theirs.sigma)
-
-
 def test_the_distilled_target_mixes_in_the_first_steps_automaton_pair():
-    """As ``AutomatonDQN._td_target``: the n-step target, then the teacher's value of the
+    """The n-step target, then the teacher's value of the
     window's first (w, sigma), whose count goes up, not the k-th step's."""
     spec = resolve_task("Reach")
     automaton = spec.automaton
@@ -294,9 +259,7 @@ def test_n_step_crm_carries_each_counterfactual_state_through_the_window(n_steps
     assert {int(u) for u in batch.w[0]} == set(view.live.tolist())  # every live state read
 
 
-def test_n_step_crm_trains_in_the_population_engine_and_the_sb3_engine_refuses_it(tmp_path):
-    from craftsuite.cli import main
-
+def test_n_step_crm_trains_in_the_population_engine_and_saves_its_return_length(tmp_path):
     settings = algorithm_settings("dqn", {"n_steps": 3})
     spec = resolve_task("Reach")
     Population("crm", settings, [0], 1, spec.automaton.n_states + 300, gym.spaces.Discrete(4), spec.automaton,
@@ -304,13 +267,8 @@ def test_n_step_crm_trains_in_the_population_engine_and_the_sb3_engine_refuses_i
     [run] = train_population([StudentConfig(task="FirstTool", method="crm", world="Grid7", steps=400, eval_every=200,
                                             eval_episodes=1, engine="population", hyperparameters={
                                                 **DQN, "learning_starts": 100})], tmp_path, progress=False)
-    agent = load_agent(run / "model.zip")  # saved as an SB3 agent, whose replay will not sample n-step CRM
-    assert agent.n_steps == 3
-    with pytest.raises(ValueError, match="samples windows in the population engine only"):
-        agent.replay_buffer.sample(4)
-    assert main(["student", "Reach", "--world", "Grid7", "--method", "crm", "--hyper", '{"n_steps": 3}',
-                 "--engine", "sb3", "--out", str(tmp_path / "sb3")]) == 2
-    assert not (tmp_path / "sb3").exists()
+    agent = load_agent(run / "model.zip")  # saved as an SB3 agent, which says what it was trained with
+    assert agent.n_steps == agent.replay_buffer.n_steps == 3
 
 
 DQN = {"batch_size": 32, "learning_starts": 200, "policy_kwargs": {"net_arch": [16, 16]}, "gradient_steps": 2,

@@ -1,31 +1,31 @@
-"""The population's replay: its sum trees sample as the SB3 agents' tree does, and CRM's
-counterfactuals made at sampling equal those the CRM buffer stores."""
+"""The population's replay: its sum trees sum and find as brute force does, and CRM's
+counterfactuals made at sampling are the hand-made ones."""
 
 import numpy as np
 import pytest
 
 import craftsuite  # noqa: F401
-from craftsuite.agents.crm import counterfactuals
-from craftsuite.agents.replay import SumTree
 from craftsuite.population.replay import CounterfactualView, PopulationReplay, SumTrees, sparse_rows
 from craftsuite.task_registry import resolve_task
 
 
-def test_sum_trees_match_one_tree_per_member():
+def test_sum_trees_sum_and_find_as_brute_force():
     rng = np.random.default_rng(0)
-    trees, singles = SumTrees(3, 100), [SumTree(100) for _ in range(3)]
+    trees, leaves = SumTrees(3, 100), np.zeros((3, 100))
     for _ in range(5):
-        leaves = rng.integers(0, 100, size=(3, 17))
+        at = rng.integers(0, 100, size=(3, 17))
         values = rng.random((3, 17))
-        trees.update(leaves, values)
-        for k, tree in enumerate(singles):
-            for leaf, value in zip(leaves[k], values[k]):  # one at a time: repeats keep the last
-                tree.update(np.array([leaf]), np.array([value]))
+        trees.update(at, values)
+        for k in range(3):
+            for leaf, value in zip(at[k], values[k]):  # one at a time: repeats keep the last
+                leaves[k, leaf] = value
+    np.testing.assert_allclose(trees.total(), leaves.sum(axis=1))
     targets = rng.random((3, 50)) * trees.total()[:, None]
     found = trees.find(targets)
-    for k, tree in enumerate(singles):
-        assert trees.total()[k] == pytest.approx(tree.total())
-        np.testing.assert_array_equal(found[k], tree.find(targets[k]))
+    for k in range(3):  # the leaf whose interval of the cumulative sum holds each target
+        expected = np.searchsorted(np.cumsum(leaves[k]), targets[k], side="right")
+        np.testing.assert_array_equal(found[k], expected)
+        assert (leaves[k, found[k]] > 0).all()
 
 
 def test_prioritized_sampling_follows_the_priorities():
@@ -63,8 +63,7 @@ def test_counterfactuals_at_sampling_equal_the_stored_ones(task, sparse):
                         or automaton.rejecting[automaton.delta[w, sigma]])
         replay.add(obs[None, None], next_obs[None, None], action[None, None], np.array([[reward]]),
                    np.array([[terminal]]), np.array([[w]]), np.array([[sigma]]))
-        stored.append(counterfactuals(automaton, spec.completion_reward, obs, next_obs, action, reward, False,
-                                      w, sigma))
+        stored.append(_by_hand(automaton, spec.completion_reward, obs, next_obs, reward, w, sigma))
     batch = replay.sample(300)
     if sparse:  # back to dense rows, to compare
         batch = batch._replace(observations=dense(batch.observations, 6 + S),
@@ -72,12 +71,30 @@ def test_counterfactuals_at_sampling_equal_the_stored_ones(task, sparse):
     index, j = np.divmod(batch.leaves[0], view.n_live)
     assert len(np.unique(j)) == view.n_live  # every live state is read
     for b in range(300):
-        live, _, obs_u, next_u, _, rewards, dones, _ = stored[index[b]]
+        live, obs_u, next_u, rewards, dones = stored[index[b]]
         np.testing.assert_array_equal(batch.observations[0, b], obs_u[j[b]])
         np.testing.assert_array_equal(batch.next_observations[0, b], next_u[j[b]])
         assert batch.rewards[0, b] == pytest.approx(rewards[j[b]])
         assert batch.terminals[0, b] == dones[j[b]]
         assert batch.w[0, b] == live[j[b]]
+
+
+def _by_hand(automaton, completion: float, obs, next_obs, reward: float, w: int, sigma: int):
+    """One real step read from every live automaton state u, in order: (u, observation and
+    next observation with u's and u''s one-hot, reward, terminal)."""
+    S = automaton.n_states
+    live = np.flatnonzero(~(automaton.accepting | automaton.rejecting))
+    rows = []
+    for u in live:
+        after = automaton.delta[u, sigma]
+        o, n = obs.copy(), next_obs.copy()
+        o[-S:], n[-S:] = np.eye(S)[u], np.eye(S)[after]
+        # the world's own reward without the real completion bonus, then u's
+        world = reward - completion * automaton.accepting[automaton.delta[w, sigma]]
+        own = world + completion * automaton.accepting[after]
+        rows.append((o, n, own, bool(automaton.accepting[after] or automaton.rejecting[after])))
+    obs_u, next_u, rewards, dones = (np.array(column) for column in zip(*rows))
+    return live, obs_u, next_u, rewards, dones
 
 
 def dense(rows, width):

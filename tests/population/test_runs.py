@@ -188,7 +188,7 @@ def test_a_population_is_reproducible(tmp_path):
 
 
 def test_bad_input_leaves_nothing_behind(tmp_path):
-    with pytest.raises(EngineError, match="train_freq \\[4, 'episode'\\].*--engine sb3"):
+    with pytest.raises(EngineError, match="train_freq \\[4, 'episode'\\].*; leave it out of the run's settings$"):
         train_population([StudentConfig(task="Reach", method="dqn", world="Grid7", steps=100, engine="population",
                                         hyperparameters={"train_freq": [4, "episode"]})], tmp_path)
     with pytest.raises(EngineError, match="differ in \\['steps'\\]"):
@@ -212,8 +212,9 @@ def test_a_population_trains_on_the_gpu(tmp_path):
 
 @pytest.mark.parametrize("argv,message", [
     (["transfer", "--suite", "quick", "--device", "gpu0"], "--device 'gpu0' is not a torch device"),
-    (["transfer", "--suite", "quick", "--methods", "td3-crm-edges", "--td3-hyper", '{"n_steps": 3}', "--engine",
-      "sb3"], "method 'td3-crm-edges' with n_steps 3: n-step CRM is trained by the population engine only"),
+    (["student", "Reach", "--world", "Grid10", "--method", "dqn", "--engine", "sb3"],
+     ": the sb3 engine no longer trains (finished sb3 runs are reused, and this one is not finished); train it with "
+     "--engine population"),
     (["student", "Reach", "--world", "Grid10", "--method", "dqn", "--engine", "population", "--hyper",
       '{"train_freq": [1, "episode"]}'], "does not support train_freq [1, 'episode']"),
 ])
@@ -236,7 +237,7 @@ def test_suites_train_each_cell_as_one_population():
     assert sorted(c.seed for c in jobs[0]) == list(range(SUITES["standard"].seeds))
     assert {c.engine for s in SUITES.values() for c in s.student_configs("teachers")} == {"population"}
     sb3 = [dataclasses.replace(c, engine="sb3") for c in SUITES["paper"].student_configs("teachers")]
-    assert len(cells(sb3)) == len(sb3)  # one job per SB3 run
+    assert len(cells(sb3)) == len(sb3)  # one job per SB3 run: each reused alone
 
 
 def test_each_member_logs_to_tensorboard_as_an_sb3_run_and_a_resume_drops_what_the_kill_logged(tmp_path,

@@ -1,6 +1,6 @@
 """Potential-based reward shaping (``rs``, ``dynamic-rs`` and their TD3 rows): the shaped
 optimum is the unshaped one, the replay shapes what it samples (one step and n steps), the
-population engine trains it, and the sb3 engine refuses it by name."""
+population engine trains it, and its members save as their method."""
 
 from __future__ import annotations
 
@@ -91,8 +91,8 @@ def test_the_replay_shapes_each_sample_from_its_first_state_to_the_state_after_i
         assert got.rewards[0, b] == pytest.approx(expected)
 
 
-def test_shaping_rows_train_in_the_population_engine_and_the_sb3_engine_refuses_them(tmp_path):
-    from craftsuite.cli import main
+def test_shaping_rows_train_in_the_population_engine_and_save_as_their_method(tmp_path):
+    from craftsuite.agents.factory import load_agent
 
     table = static_distillation(resolve_task("FirstTool").automaton, completion_reward=100.0).save(tmp_path / "t.npz")
     tiny = {"learning_starts": 100, "batch_size": 16, "policy_kwargs": {"net_arch": [16]}, "n_steps": 3}
@@ -101,13 +101,7 @@ def test_shaping_rows_train_in_the_population_engine_and_the_sb3_engine_refuses_
                        engine="population", hyperparameters=tiny,
                        table=str(table) if METHODS[method].needs_table else None)], tmp_path / "runs", progress=False)]
     assert all((r / "result.json").exists() for r in runs)
-    from craftsuite.agents.factory import make_agent
-
-    with pytest.raises(ValueError, match="reward shaping is trained by the population engine only"):
-        make_agent("rs", "CraftSuite/FirstTool-Grid7-v0")  # an SB3 agent of it would learn unshaped
-    assert main(["student", "FirstTool", "--world", "Grid7", "--method", "rs", "--engine", "sb3",
-                 "--out", str(tmp_path / "sb3")]) == 2
-    assert not (tmp_path / "sb3").exists()
+    assert [load_agent(r / "model.zip").n_steps for r in runs] == [3, 3]
 
 
 def test_a_shaping_row_is_a_method_of_its_own():

@@ -78,7 +78,6 @@ TD3 = {**COMMON, "policy_delay": 2, "tau": 0.05}
 class Case:
     method: str  # a METHODS row: the rule's wiring (distilled target, CRM, shaping)
     settings: dict = field(default_factory=dict)  # over DQN or TD3 above
-    sb3: bool = True  # the SB3 stack implements the rule (n-step CRM and shaping it does not)
     interleave: bool = False  # a vector step observed before each update (else the replay stays as filled)
     planes: tuple | None = None  # the world entries as grid planes (C, H, W), for a residual CNN
 
@@ -100,7 +99,7 @@ CASES = {
     "dqn-n3": Case("product-dqn", {"n_steps": 3}),
     # the paper's residual CNN over the 8 world entries as 2 planes of 2 x 2 (batch norms in
     # training mode for the update's own Q-values only, the target copying running statistics)
-    "dqn-residual-cnn": Case("product-dqn", {"features_extractor": "residual-cnn"}, sb3=False, planes=(2, 2, 2)),
+    "dqn-residual-cnn": Case("product-dqn", {"features_extractor": "residual-cnn"}, planes=(2, 2, 2)),
     # the hard target update counted in transitions (SB3's, the default): every 3 vector steps
     "dqn-transitions": Case("product-dqn", {"target_update_unit": "transitions", "target_update_interval": 6},
                             interleave=True),
@@ -109,10 +108,10 @@ CASES = {
     "dynamic-n3": Case("dynamic", {"n_steps": 3}),
     "crm": Case("crm"),
     "crm-edges": Case("crm-edges"),  # CRM with a distilled target on edges only, rho = 1
-    "crm-n3": Case("crm", {"n_steps": 3}, sb3=False),
-    "crm-edges-n3": Case("crm-edges", {"n_steps": 3}, sb3=False),
-    "rs": Case("rs", sb3=False),
-    "dynamic-rs-n3": Case("dynamic-rs", {"n_steps": 3}, sb3=False),
+    "crm-n3": Case("crm", {"n_steps": 3}),
+    "crm-edges-n3": Case("crm-edges", {"n_steps": 3}),
+    "rs": Case("rs"),
+    "dynamic-rs-n3": Case("dynamic-rs", {"n_steps": 3}),
     # TD3: clipped double-Q, target smoothing, actor delay 2, Polyak, prioritized
     "td3": Case("td3"),
     "td3-uniform-layer-norm": Case("product-td3", {"prioritized": False, "layer_norm": True}),
@@ -122,7 +121,7 @@ CASES = {
     "td3-static-n3": Case("td3-static", {"n_steps": 3}),
     "td3-dynamic": Case("td3-dynamic"),
     "td3-crm-edges": Case("td3-crm-edges"),
-    "td3-rs-n3": Case("td3-rs", {"n_steps": 3}, sb3=False),
+    "td3-rs-n3": Case("td3-rs", {"n_steps": 3}),
 }
 
 
@@ -289,23 +288,6 @@ def observe(pop, s: dict) -> None:
                 each(s["terminated"].astype(np.float32)), each(transitions), each(s["terminated"] | s["truncated"]))
 
 
-class Recorder:
-    """A numpy ``Generator`` that keeps what it draws (the SB3 stack is given the same)."""
-
-    def __init__(self, rng):
-        self.rng, self.draws = rng, []
-
-    def random(self, size):
-        out = self.rng.random(size)
-        self.draws.append(("random", None, out))
-        return out
-
-    def integers(self, low, high, size):
-        out = self.rng.integers(low, high, size=size)
-        self.draws.append(("integers", (low, high), out))
-        return out
-
-
 @contextmanager
 def losses_backpropagated(into: list):
     """Every scalar ``backward`` is called on while inside, in order."""
@@ -353,8 +335,7 @@ def torch_seed(update: int) -> int:
 
 def run(name: str, sparse: bool = False, members: int = 1) -> dict:
     """Case ``name`` today: ``UPDATES`` updates of its population (``build``); member 0's
-    record, which a fixture keeps (and, under ``_draws``, the sampling stream's draws per
-    update, not kept)."""
+    record, which a fixture keeps."""
     pop, inputs = build(name, sparse, members)
     automaton = inputs["automaton"]
     learner, replay = pop.learner, pop.replay
@@ -364,11 +345,10 @@ def run(name: str, sparse: bool = False, members: int = 1) -> dict:
               "init_digest": np.array([p.detach()[0].double().sum().item() for net in learner.modules().values()
                                        for p in net.parameters()])}
     obs_dim = FEATURES[CASES[name].algorithm] + automaton.n_states
+    rng = replay.rng
     if members > 1:
-        replay.rng = MemberZero(replay.rng, np.random.default_rng(99))
-    recorder = Recorder(replay.rng)
-    replay.rng = recorder
-    batches, targets, tds, losses, draws = [], [], [], [], []
+        replay.rng = MemberZero(rng, np.random.default_rng(99))
+    batches, targets, tds, losses = [], [], [], []
     sample, td_target, update = replay.sample, learner.td_target, learner.update
 
     def spy_sample(batch_size):
@@ -387,7 +367,6 @@ def run(name: str, sparse: bool = False, members: int = 1) -> dict:
     replay.sample, learner.td_target, learner.update = spy_sample, spy_target, spy_update
     try:
         for i in range(UPDATES):
-            before = len(recorder.draws)
             scalars = []
             if CASES[name].interleave:
                 observe(pop, inputs["steps"][STEPS + i])
@@ -395,10 +374,9 @@ def run(name: str, sparse: bool = False, members: int = 1) -> dict:
             with losses_backpropagated(scalars):
                 pop.train()
             losses.append(scalars)
-            draws.append(recorder.draws[before:])
     finally:
         replay.sample, learner.td_target, learner.update = sample, td_target, update
-        replay.rng = recorder.rng if members == 1 else recorder.rng.rng
+        replay.rng = rng
     assert len(batches) == UPDATES == learner.n_updates, "one gradient step per train() call"
 
     def stacked(get, dtype):
@@ -434,7 +412,6 @@ def run(name: str, sparse: bool = False, members: int = 1) -> dict:
         record["max_priority"] = np.float64(replay.max_priority[0])
     if learner.targets is not None:
         record["counts"] = learner.targets.counts[0].copy()
-    record["_draws"] = draws
     return record
 
 
@@ -443,7 +420,7 @@ def path(name: str) -> Path:
 
 
 def write(name: str) -> Path:
-    record = {k: v for k, v in run(name).items() if not k.startswith("_")}
+    record = run(name)
     about = (f"frozen by tests/population/frozen/make.py: case {name!r} = {CASES[name]!r}; "
              f"torch {th.__version__}, numpy {np.__version__}")
     with open(path(name), "wb") as f:

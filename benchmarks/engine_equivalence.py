@@ -10,6 +10,9 @@ RUNS (default: the records kept in experiments/engine-equivalence/records) holds
     craftsuite transfer --suite quick --tasks Reach --methods td3 --seeds 10 --steps 150000 \\
         --engine population|sb3 --workers 1 --no-video --out RUNS/<engine>-Reach
 
+``--engine sb3`` trains no more (removed with the SB3 trainer): its runs train at the commit
+experiments/engine-equivalence/README.md names; this script only reads their records.
+
 Per task and metric: each engine's median over seeds, the two-sided Mann-Whitney U test's
 p-value (scipy), and the probability that a population run beats an SB3 run (ties half)
 with its 95% bootstrap interval (``stats.probability_of_improvement``). Steps to 80% greedy

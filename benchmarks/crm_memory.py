@@ -2,7 +2,7 @@
 
 Usage: python benchmarks/crm_memory.py [--steps 100000] [--page PATH | --no-page]
 
-Diamond Mine's automaton has 13 live states, and SB3's CRM buffer (``agents.crm``, removed
+Diamond Mine's automaton has 13 live states, and SB3's CRM buffer (``agents.crm``, whose storing of them went
 with the SB3 trainer) stored every real step once per live state: 7.5 GB was measured for a 100k-transition Grid10 run,
 and two such runs at once were killed for memory on a 24 GiB machine. The population
 engine stores each step once and makes the counterfactuals when a batch is sampled

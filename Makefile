@@ -48,6 +48,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/engine_equivalence.py
 	$(PY) benchmarks/teachers.py --quick
 	$(PY) benchmarks/interval_coverage.py
+	$(PY) benchmarks/code_size.py
 
 clean:
 	rm -rf out .pytest_cache

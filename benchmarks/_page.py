@@ -25,7 +25,7 @@ PAGE = ROOT / "docs" / "performance.md"
 
 # The page's order: the package's own speed first (automata, worlds, training), then its statistics.
 SECTIONS = ("automata", "grid_steps", "cont_steps", "vector_envs", "student_throughput", "crm_memory",
-            "engine_equivalence", "teachers", "interval_coverage")
+            "engine_equivalence", "teachers", "interval_coverage", "code_size")
 
 HEADER = """\
 # Performance

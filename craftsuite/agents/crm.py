@@ -22,7 +22,6 @@ class CRMReplayBuffer(AutomatonReplayBuffer):
     def __init__(self, buffer_size, observation_space, action_space, device="auto", n_envs: int = 1, *,
                  automaton: Automaton, completion_reward: float, **kwargs):
         self.automaton, self.completion_reward = automaton, completion_reward
-        self.n_real_envs = n_envs
         self.n_live = int((~(automaton.accepting | automaton.rejecting)).sum())
         if observation_space.shape[0] < automaton.n_states:
             raise ValueError("CRM needs the product observation (make the env with product=True)")

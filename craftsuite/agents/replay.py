@@ -6,7 +6,9 @@ A saved ``AutomatonDQN``/``AutomatonTD3`` names this class and its keywords, so 
 builds it; a replay pickled by the SB3 trainer (``replay.pkl`` of an old teacher run) is
 read back here, for ``craftsuite distill``. Sampling by priority, n-step windows and CRM's
 counterfactuals are the population engine's (``craftsuite.population.replay``); loaded with
-SB3's own ``DQN``/``TD3``, a model adds and samples as SB3's buffer does.
+SB3's own ``DQN``/``TD3``, a model adds and samples as SB3's buffer does, and
+``save_replay_buffer`` pickles it whole as it does SB3's (nothing in CraftSuite saves one:
+the engine checkpoints its own replay).
 """
 
 from __future__ import annotations
@@ -18,8 +20,9 @@ from stable_baselines3.common.buffers import ReplayBuffer
 
 
 class SumTree:
-    """The priorities of an old SB3 run's pickled replay, as a binary sum tree (leaves from
-    ``leaves`` on)."""
+    """The priorities in a replay the SB3 trainer pickled (a teacher's ``replay.pkl``), as a
+    binary sum tree (leaves from ``leaves`` on). Such a pickle names this class, so it stays
+    importable here; a buffer built now holds none."""
 
     def __init__(self, capacity: int):
         self.leaves = 1 << max(0, int(np.ceil(np.log2(max(capacity, 1)))))
@@ -53,10 +56,9 @@ class AutomatonReplayBuffer(ReplayBuffer):
         self.w = np.zeros((self.buffer_size, self.n_envs), dtype=np.int32)
         self.sigma = np.zeros((self.buffer_size, self.n_envs), dtype=np.int32)
         self.w_next = np.zeros((self.buffer_size, self.n_envs), dtype=np.int32)
+        # what the model was trained with, kept as settings only: nothing here samples by priority
         self.prioritized = prioritized
         self.alpha, self.beta, self.epsilon = alpha, beta, epsilon
-        self.tree = SumTree(self.buffer_size * self.n_envs) if prioritized else None
-        self.max_priority = 1.0
 
     _ROWS = ("observations", "next_observations", "actions", "rewards", "dones", "timeouts", "w", "sigma", "w_next")
 

@@ -150,8 +150,6 @@ class PopulationTD3:
         return {"actor_optimizer": self.actor_optimizer, "critic_optimizer": self.critic_optimizer}
 
 
-
-
 def delay_at(schedule: tuple, step: int) -> int:
     """The actor's delay in force at ``step`` under a ``delay_schedule``."""
     for until, delay in schedule:

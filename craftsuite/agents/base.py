@@ -6,9 +6,9 @@ import warnings
 
 from .replay import AutomatonReplayBuffer
 
-RETIRED = ("{cls} holds a trained CraftSuite model and does not learn: CraftSuite's learning rules live "
+RETIRED = ("{cls} holds a CraftSuite model and does not learn: CraftSuite's learning rules live "
            "in the population engine; train with craftsuite.population.train_population (or `craftsuite "
-           "student`), or load the model with SB3's own class to train it with SB3's rule")
+           "student`), or load the model (not CRM models) with SB3's own class to train it with SB3's rule")
 
 
 class AutomatonAlgorithm:

@@ -1,7 +1,7 @@
 """Saved agents: the models the SB3 trainer saved (``saved/``, made at the commit
 ``saved/make.py`` names) still load with ``load_agent`` and SB3's own classes and act; SB3's
-own classes go on training them with SB3's rule; CraftSuite's classes do not learn, and say
-what trains instead."""
+own classes go on training them with SB3's rule, but for CRM models, whose replay does not
+collect; CraftSuite's classes do not learn, and say what trains instead."""
 
 import gymnasium as gym
 import numpy as np
@@ -57,8 +57,9 @@ def test_sb3s_own_class_goes_on_training_a_saved_model(name):
 def test_craftsuites_classes_do_not_learn_and_name_the_trainer():
     agent = make_agent("dqn", "CraftSuite/FirstTool-Grid7-v0", buffer_size=16)
     for call in (lambda: agent.learn(10), lambda: agent.train(1)):
-        with pytest.raises(RuntimeError, match=r"^AutomatonDQN .*craftsuite\.population\.train_population"):
-            call()
+        with pytest.raises(RuntimeError, match=r"^AutomatonDQN holds a CraftSuite model and does not learn: "
+                                               r".*craftsuite\.population\.train_population.*\(not CRM models\)"):
+            call()  # a fresh agent too: it holds no trained model, and still does not learn
     loaded = load_agent(SAVED / "td3-dynamic.zip")
     with pytest.raises(RuntimeError, match=r"^AutomatonTD3 .*`craftsuite student`"):
         loaded.learn(10)

@@ -238,14 +238,15 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
 
     ``device``: the torch device of the population engine's students (``cpu``, the
     default, or ``cuda``). A suite of the ``sb3`` engine reuses its finished runs (from
-    ``out`` or the archive) and refuses to train the others. ``command``: how this run was asked
-    for, as ``provenance.json`` records it (the CLI passes its command line); by default,
-    this Python call. ``archive``: a results archive (``craftsuite.archive``; e.g.
+    ``out`` or the archive) and refuses to train the others, before anything is written.
+    ``command``: how this run was asked for, as ``provenance.json`` records it (the CLI
+    passes its command line); by default, this Python call. ``archive``: a results archive (``craftsuite.archive``; e.g.
     ``results``): the runs it holds under ``<archive>/<suite>`` are not trained again, and
     every run that finishes here is kept there, even if a later one fails.
 
     Bad input (a budget too small to train, a device this machine lacks, an output
-    directory or archive that cannot be one, a Ray cluster out of reach) is refused
+    directory or archive that cannot be one, a Ray cluster out of reach, an sb3 run
+    finished nowhere) is refused
     before anything is written."""
     from .archive import keep_all, restore
     from .archive import size as archive_size
@@ -266,6 +267,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     _check_students(configs, device, teachers.values())  # fail before any training
     read(out)  # a damaged provenance record, too
     _counting_acceptance([out / "students" / c.run_name() for c in configs])  # none unfinished
+    _refuse_sb3_not_kept(out, kept, configs, teachers.values())  # nothing written for a run it would not train
     # the pool, and a Ray cluster with it, before anything is written: one out of reach leaves no output behind
     pool = WorkerPool(len(cells(configs)) + len(teachers), workers, ray)
     if suite.eval_every is None and suite.student_steps is not None:  # the interval follows a budget given: say so
@@ -284,7 +286,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         for run in _counting_acceptance([out / "students" / name for name in sorted(names["students"])]):
             reread_in_place(run)  # (restored ones too)
             log(f"re-read {run.name}: its success counted the automaton's acceptance; now completion")
-        _refuse_unfinished_sb3(out, configs, teachers.values())  # after the archive's: restored ones are reused
+        _refuse_unfinished_sb3(out, configs, teachers.values())  # in case a restore left one out (a run in use)
     except BaseException:
         pool.close(abort=True)
         raise
@@ -339,14 +341,41 @@ def _counting_acceptance(runs: list[Path]) -> list[Path]:
     return found
 
 
+# where else a finished sb3 run can come from: ``--engine sb3`` alone turns the default archive off
+ARCHIVE_FIX = ", or give --archive DIR where the finished runs are kept"
+
+
+def _sb3_runs(out: Path, configs: list[StudentConfig], teachers) -> list[tuple[str, StudentConfig | TeacherConfig]]:
+    """The runs of the sb3 engine not finished in ``out``, each with its kind (``teachers``,
+    ``students``)."""
+    runs = [*(("teachers", t) for t in teachers), *(("students", c) for c in configs)]
+    return [(kind, config) for kind, config in runs
+            if config.engine == "sb3" and not (out / kind / config.run_name() / "result.json").is_file()]
+
+
+def _refuse_sb3_not_kept(out: Path, kept: Path | None, configs: list[StudentConfig], teachers) -> None:
+    """Refuse, before anything is written, a run of the sb3 engine finished neither in
+    ``out`` nor in the archive ``kept`` (None: none), whose usable runs ``archive.restore``
+    copies into ``out``: that engine's runs are reused, never trained."""
+    from .archive import archived
+    from .training import SB3_REFUSED
+
+    missing = _sb3_runs(out, configs, teachers)
+    if not missing:  # (an archive is read only when it must be: a large one takes a while)
+        return
+    held = {kind: set(archived(kept, kind)[0]) if kept is not None else set() for kind in ("teachers", "students")}
+    for kind, config in missing:
+        if config.run_name() not in held[kind]:
+            raise ValueError(SB3_REFUSED.format(name=config.run_name(), also=ARCHIVE_FIX))
+
+
 def _refuse_unfinished_sb3(out: Path, configs: list[StudentConfig], teachers) -> None:
     """Refuse, before any training, a run of the sb3 engine that is not finished in ``out``
-    (nor restored there from the archive): that engine's runs are reused, never trained."""
+    once the archive is restored there: that engine's runs are reused, never trained."""
     from .training import finished_sb3_run
 
-    for root, config in [*((out / "teachers", t) for t in teachers), *((out / "students", c) for c in configs)]:
-        if config.engine == "sb3" and not (root / config.run_name() / "result.json").is_file():
-            finished_sb3_run(config, root)  # raises, naming the run and the fix
+    for kind, config in _sb3_runs(out, configs, teachers):
+        finished_sb3_run(config, out / kind, also=ARCHIVE_FIX)  # raises, naming the run and the fix
 
 
 def _check_students(configs: list[StudentConfig], device: str | None = None, teachers=()) -> None:

@@ -42,13 +42,18 @@ def evaluate(agent, env_id: str, episodes: int, seed: int, product: bool, env_kw
     return Evaluation(float(wins.mean()), float(returns.mean()), float(lengths.mean()))
 
 
-def finished_sb3_run(config: StudentConfig | TeacherConfig, root) -> Path:
+SB3_REFUSED = ("{name}: the sb3 engine no longer trains (finished sb3 runs are reused, and this one is not "
+               "finished); train it with --engine population{also}")
+
+
+def finished_sb3_run(config: StudentConfig | TeacherConfig, root, also: str = "") -> Path:
     """The finished run of an ``sb3``-engine ``config`` under ``root``, reused as it is;
-    one that is not finished is refused (nothing is written): the sb3 engine trains no more."""
+    one that is not finished is refused (nothing is written): the sb3 engine trains no more.
+    ``also``: another way out the refusal names after ``--engine population`` (a command
+    that reads an archive names it)."""
     path = Path(root) / config.run_name()
     if not (path / "result.json").is_file():
-        raise ValueError(f"{path.name}: the sb3 engine no longer trains (finished sb3 runs are reused, and this "
-                         "one is not finished); train it with --engine population")
+        raise ValueError(SB3_REFUSED.format(name=path.name, also=also))
     with RunDir(path, config) as run:  # a finished run of another configuration is refused by name
         return run.path
 

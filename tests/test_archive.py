@@ -164,3 +164,81 @@ def test_restore_leaves_a_run_a_live_process_holds(tmp_path):
     finally:
         os.close(fd)
     assert archive.restore(store, out, {"students": {kept.name}})["students"] == 1  # released: restored
+
+
+class _InProcessPool:
+    """A worker pool that runs each job here, at once: a reused sb3 run needs no worker, and
+    training, were any asked for, would hit the spies this process holds."""
+
+    def __init__(self, *args):
+        self.jobs = []
+
+    def submit(self, job, *args):
+        from concurrent.futures import Future
+
+        self.jobs.append(job.__name__)
+        future = Future()
+        try:
+            future.set_result(job(*args))
+        except Exception as err:
+            future.set_exception(err)
+        return future
+
+    def close(self, abort=False):
+        pass
+
+
+def _finished_record(root, config, result: dict):
+    """A finished run's record under ``root`` (a ``teachers`` or ``students`` folder), named
+    and recorded as a run of ``config`` writes it."""
+    from craftsuite.runs import FORMAT
+
+    run = root / config.run_name()
+    run.mkdir(parents=True)
+    record = {**json.loads(json.dumps(settings(config))), "format": FORMAT, "provenance": [{"commit": "abc"}]}
+    (run / "config.json").write_text(json.dumps(record))
+    steps = result["steps"]
+    write_csv(run / "evals.csv", EVAL_FIELDS, [{"step": steps, "success": 0.75, "return": 1.0, "episodes": 4}])
+    write_csv(run / "episodes.csv", EPISODE_FIELDS,
+              [{"step": s, "return": -1.0, "length": 10, "success": 1} for s in (steps // 2, steps)])
+    (run / "result.json").write_text(json.dumps(result))
+    return run
+
+
+def test_a_transfer_on_the_sb3_engine_reuses_the_finished_runs_its_archive_holds(tmp_path, monkeypatch):
+    import torch
+
+    import craftsuite.population
+    import craftsuite.population.teacher
+    import craftsuite.suite_runner as suite_runner
+
+    def trains(*args, **kwargs):
+        raise AssertionError("an sb3 run was trained, not reused")
+
+    monkeypatch.setattr(craftsuite.population, "train_population", trains)
+    monkeypatch.setattr(craftsuite.population.teacher, "train_teacher", trains)
+    monkeypatch.setattr(torch, "set_num_threads", lambda n: None)  # a worker's setting, not this process's
+    pools = []
+    monkeypatch.setattr(suite_runner, "WorkerPool", lambda *a: pools.append(_InProcessPool()) or pools[-1])
+    suite = dataclasses.replace(SUITES["quick"], tasks=("Reach",), seeds=1, engine="sb3")
+    [teacher], students = suite.teachers().values(), suite.student_configs(tmp_path / "out" / "teachers")
+    assert teacher.engine == "sb3" and sorted(c.method for c in students) == ["td3", "td3-dynamic-edges"]
+    store = tmp_path / "results" / suite.name
+    _finished_record(store / "teachers", teacher, {"kind": "teacher", "steps": 5_000, "success": 0.95,
+                                                   "reached_target": True, "model": "teacher.zip"})
+    for c in students:
+        _finished_record(store / "students", c, {"kind": "student", "steps": c.steps, "task": c.task,
+                                                 "method": c.method, "seed": c.seed, "model": "model.zip"})
+    assert all(reason is None for reason in map(archive.check_record, (store / "students").iterdir()))
+    said = []
+    result = suite_runner.transfer(suite, tmp_path / "out", video=False, progress=False, log=said.append,
+                                   archive=tmp_path / "results")
+    assert f"results archive {store}: 2 of 2 student runs and 1 of 1 teachers are there already (not trained again)" \
+        in said
+    assert pools[0].jobs == ["_teacher_job"]  # the teacher's reuse goes through the pool; nothing trains
+    assert sorted(p.name for p in result.students) == sorted(c.run_name() for c in students)
+    for run in result.students:
+        assert json.loads((run / "result.json").read_text()) == json.loads(
+            (store / "students" / run.name / "result.json").read_text())  # reused as archived
+        assert not (run / "model.zip").exists()
+    assert result.leaderboard.is_file() and "Reach" in result.leaderboard.read_text()

@@ -166,8 +166,13 @@ def test_transfer_on_the_sb3_engine_trains_nothing_and_names_the_run_it_would(tm
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("craftsuite transfer: error: teacher-Reach-Grid7-")
     assert err.endswith(": the sb3 engine no longer trains (finished sb3 runs are reused, and this one is not "
-                        "finished); train it with --engine population\n")
-    assert not (out / "teachers").exists() and not (out / "students").exists()
+                        "finished); train it with --engine population, or give --archive DIR where the finished "
+                        "runs are kept\n")
+    assert not out.exists()  # a refused command leaves nothing behind: no suite.json, no provenance.json
+    empty = tmp_path / "results"  # an archive that does not hold the run refuses it alike
+    assert main([*QUICK_REACH, "--steps", "2000", "--engine", "sb3", "--archive", str(empty), "--out", str(out)]) == 2
+    assert capsys.readouterr().err.endswith("or give --archive DIR where the finished runs are kept\n")
+    assert not out.exists() and not empty.exists()
 
 
 def test_transfer_refuses_a_device_the_machine_lacks(tmp_path, capsys, monkeypatch):

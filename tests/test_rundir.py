@@ -129,6 +129,20 @@ def test_a_run_that_fails_before_training_leaves_no_directory(tmp_path):
     assert len(read_csv(fresh / "episodes.csv")) == 1
 
 
+def test_a_failed_run_removes_the_empty_folders_it_made_above_it_and_no_others(tmp_path):
+    before = tmp_path / "before"
+    before.mkdir()  # empty, but there before the run: not the run's to remove
+    with pytest.raises(RuntimeError), RunDir(before / "new" / "out" / "run", StudentConfig()):
+        raise RuntimeError("boom")  # (an agent that could not be built, in a new --out)
+    assert [p.name for p in tmp_path.iterdir()] == ["before"] and list(before.iterdir()) == []
+    # a folder it made that something filled meanwhile stays, and the folders above it
+    with pytest.raises(RuntimeError), RunDir(before / "new" / "out" / "run", StudentConfig()):
+        (before / "new" / "notes.txt").write_text("not the run's")
+        raise RuntimeError("boom")
+    assert [p.name for p in before.iterdir()] == ["new"] and [p.name for p in (before / "new").iterdir()] == [
+        "notes.txt"]
+
+
 def test_checkpoints_rotate_keeping_the_one_before_the_last(tmp_path):
     def save(run, step):
         new = run.new_checkpoint()

@@ -216,3 +216,41 @@ def test_env_keywords_the_run_sets_itself_are_refused_by_name(tmp_path, capsys):
     assert main(["student", "Reach", "--env", '{"product": true}', "--out", str(out)]) == 2
     assert "--env: product: whether the automaton state is observed" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_distill_reads_an_sb3_teacher_run_as_distilling_its_saved_replay(tmp_path, capsys):
+    """A teacher run as the SB3 trainer left one (its config.json, and its model and replay
+    in ``checkpoint/``), built from the saved teacher ``tests/agents/saved/product-dqn``: the
+    command finds the world in the config and the replay in the checkpoint."""
+    import numpy as np
+    from stable_baselines3.common.env_util import make_vec_env
+
+    from craftsuite.agents.distillation import AutomatonQTable
+    from craftsuite.agents.factory import distill_from_replay, load_agent
+    from craftsuite.configs import TeacherConfig
+    from craftsuite.runs import RunDir
+    from craftsuite.task_registry import resolve_task
+
+    from .agents.saved import make
+
+    _, env_id, env_kwargs, settings, _ = make.CASES["product-dqn"]
+    config = TeacherConfig(task="FirstTool", layout_seed=env_kwargs["layout_seed"],
+                           hyperparameters={**make.SMALL, **settings}, engine="sb3")
+    assert (config.env_id, config.env_kwargs) == (env_id, env_kwargs)  # the world the teacher was saved in
+    run = tmp_path / "teachers" / config.run_name()
+    with RunDir(run, config):  # its config.json
+        pass
+    (run / "checkpoint").mkdir()
+    shutil.copyfile(make.HERE / "product-dqn.zip", run / "checkpoint" / "model.zip")
+    shutil.copyfile(make.HERE / "product-dqn-replay.pkl", run / "checkpoint" / "replay.pkl")
+    assert main(["distill", str(run), "--out", str(tmp_path / "table.npz")]) == 0  # (the default --task is another)
+    assert "dynamic automaton Q-table for" in capsys.readouterr().out
+    table = AutomatonQTable.load(tmp_path / "table.npz", resolve_task("FirstTool").automaton)
+    teacher = load_agent(make.HERE / "product-dqn.zip",
+                         env=make_vec_env(env_id, n_envs=1, env_kwargs={"product": True, **env_kwargs}))
+    teacher.load_replay_buffer(make.HERE / "product-dqn-replay.pkl")
+    direct = distill_from_replay(teacher)
+    assert table.kind == "dynamic" and table.counts.sum() == 60  # the 60 transitions the teacher collected
+    np.testing.assert_array_equal(table.counts, direct.counts)
+    assert np.isfinite(table.q[table.seen]).all()
+    np.testing.assert_allclose(table.q[table.seen], direct.q[direct.seen])

@@ -3,7 +3,7 @@ was frozen (``frozen/<case>.npz``, made by ``frozen/make.py``, whose docstring s
 case runs, what a fixture holds and when regenerating one is right).
 
 The population engine holds every learning rule CraftSuite trains with, once; these
-fixtures are its rules' record. Until commit d8d7ccb the SB3 agents (``craftsuite.agents``)
+fixtures are its rules' record. Until commit 85ab46c the SB3 agents (``craftsuite.agents``)
 had rules of their own and were driven on the same inputs (the same replay contents,
 sampling draws, torch seeds and initial networks) to reproduce every fixture their rules
 covered (all but the residual CNN, n-step CRM and reward shaping). Also: the grid

@@ -1,6 +1,6 @@
-"""Write the saved models of ``tests/agents/test_saved.py``: small agents trained by the SB3
-trainer as CraftSuite had it, which runs at commit d8d7ccb (the last with SB3 training
-code), never at a later one. Run there from the repository root:
+"""Write the saved models of ``tests/agents/test_factory.py``: small agents trained by the SB3
+trainer as CraftSuite had it, which runs at commit 85ab46c (the last before the SB3 training
+code was retired), not at this one. Run there from the repository root:
 ``python tests/agents/saved/make.py``. The files are fixtures: they stand for the models
 users and the archive saved then, and are not made again."""
 

@@ -7,10 +7,13 @@ kinematic board, DQN on the 10x10 grid. Each row (``craftsuite.population``): th
 regimes (``craftsuite.suites.TD3_REGIME`` / ``DQN_REGIME``: several envs per update, small
 networks) for ``--members`` seeds in one process (5: a suite's cell; 10: as many as the
 engines were compared with), collecting from one vector env, counted over all members,
-after the warm-up of random actions (``learning_starts``). Each row trains for about
+after the warm-up of random actions (``learning_starts``). The rows named after the learner
+regime add the standard and hard suites' regime (``craftsuite.regimes``: n-step targets,
+wider networks) to those settings: what the suites train now. Each row trains for about
 ``--seconds``. The reference column is each row's target. Under the table, the standard
-suite's student time projected from these rates. With ``--device cuda --members 20`` it
-measures a GPU population.
+and hard suites' student time projected from the learner-regime rows at the suite's seeds
+per population (or the nearest population size measured). With ``--device cuda --members
+20`` it measures a GPU population.
 """
 
 from __future__ import annotations
@@ -20,7 +23,8 @@ import time
 
 import craftsuite  # noqa: F401
 from craftsuite.hyperparameters import algorithm_settings
-from craftsuite.suites import DQN_REGIME, TD3_REGIME
+from craftsuite.regimes import REGIMES
+from craftsuite.suites import DQN_REGIME, SUITES, TD3_REGIME
 from _page import Report, add_page_argument  # benchmarks/ is on sys.path as a script
 
 CONT, GRID = "CraftSuite/BlindCraftsman-Cont-v0", "CraftSuite/BlindCraftsman-Grid10-v0"
@@ -32,6 +36,16 @@ POPULATION_ROWS = [  # (label, method, env id, n_envs, settings, env keywords, t
     ("TD3, kinematic, suites' regime", "td3", KINEMATIC, TD3_N, TD3_SET, {}, ">= 8,000"),
     ("DQN, Grid10, suites' regime", "dqn", GRID, DQN_N, DQN_SET, {"layout_seed": 1}, ">= 5,000"),
     ("CRM (DQN), Grid10, suites' regime", "crm", GRID, DQN_N, DQN_SET, {"layout_seed": 1}, ""),
+]
+# the learner regime the standard and hard suites train in, over their collection regime
+LEARNER = SUITES["standard"].regime
+assert SUITES["hard"].regime == LEARNER, "the projection assumes one learner regime for both suites"
+TD3_WIDE = {**TD3_SET, **REGIMES[LEARNER].settings("td3")}
+DQN_WIDE = {**DQN_SET, **REGIMES[LEARNER].settings("dqn")}
+LEARNER_ROWS = [
+    (f"TD3, MuJoCo, {LEARNER}", "td3", CONT, TD3_N, TD3_WIDE, {}, ""),
+    (f"DQN, Grid10, {LEARNER}", "dqn", GRID, DQN_N, DQN_WIDE, {"layout_seed": 1}, ""),
+    (f"CRM (DQN), Grid10, {LEARNER}", "crm", GRID, DQN_N, DQN_WIDE, {"layout_seed": 1}, ""),
 ]
 
 
@@ -81,26 +95,26 @@ def _kind(method: str, env_id: str) -> tuple[str, bool]:
 
 
 def suite_projection(name: str, rates: dict, cores: int = 2) -> str:
-    """The suite's student transitions over the rates just measured, on ``cores`` cores: a
-    projection (teachers, evaluations and the tail of the last runs left out)."""
+    """The suite's student transitions over the learner-regime rates just measured (``rates``:
+    transitions/s by population size, then by world kind and CRM), at the population size
+    nearest the suite's seeds, on ``cores`` cores: a projection (teachers, evaluations and the
+    tail of the last runs left out)."""
     from craftsuite.ids import parse_id
     from craftsuite.methods import METHODS
-    from craftsuite.suites import SUITES
 
-    configs = SUITES[name].student_configs("teachers")
+    suite = SUITES[name]
+    members = min(rates, key=lambda m: (abs(m - suite.seeds), -m))
+    configs = suite.student_configs("teachers")
     seconds = 0.0
     for c in configs:
         kind = (parse_id(c.env_id)[1].rstrip("0123456789"), METHODS[c.method].crm)
-        seconds += c.steps / rates.get(kind, rates.get((kind[0], False), float("nan")))
+        seconds += c.steps / rates[members].get(kind, rates[members].get((kind[0], False), float("nan")))
     total = sum(c.steps for c in configs)
-
-    def hours(s):
-        return f"{s / cores / 3600:.1f} h"
-
-    return (f"The `{name}` suite's students ({len(configs)} runs, {total:,} transitions) at these rates on "
-            f"{cores} cores: {hours(seconds)} with the population engine (5 seeds a population; a projection "
-            "from one process alone, teachers and evaluations not counted; on these 2 cores two grid populations "
-            "kept about these rates, two MuJoCo populations about half each).")
+    return (f"The `{name}` suite's students ({len(configs)} runs, {total:,} transitions, {suite.regime} regime) "
+            f"at these rates on {cores} cores: {seconds / cores / 3600:.1f} h ({suite.seeds} seeds a population, "
+            f"projected from the populations of {members}; from one process alone, teachers and evaluations not "
+            "counted; on 2 cores two grid populations kept about these rates, two MuJoCo populations about half "
+            "each).")
 
 
 def main():
@@ -117,14 +131,14 @@ def main():
     report = Report()
     report("| student | engine | transitions/s | updates/s (all members) | reference transitions/s |")
     report("|---|---|---|---|---|")
-    rates = {}  # transitions/s per (world kind, crm), for the projection
-    for label, method, env_id, n_envs, settings, env_kwargs, target in POPULATION_ROWS:
+    rates = {}  # transitions/s of the learner-regime rows, by members, then (world kind, crm): the projection's
+    for label, method, env_id, n_envs, settings, env_kwargs, target in POPULATION_ROWS + LEARNER_ROWS:
         for members in args.members:
             tps, ups = measure_population(method, env_id, n_envs, settings, env_kwargs, members, args.seconds,
                                           args.device)
             report(f"| {label} | population of {members} ({args.device}) | {tps:,.0f} | {ups:,.0f} | {target} |")
-            if members == 5:
-                rates[_kind(method, env_id)] = tps
+            if settings in (TD3_WIDE, DQN_WIDE):
+                rates.setdefault(members, {})[_kind(method, env_id)] = tps
     report("")
     for suite in ("standard", "hard"):
         report(suite_projection(suite, rates))

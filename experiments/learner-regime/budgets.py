@@ -58,7 +58,7 @@ def choose(curve: list[tuple[int, float]], budget: int) -> tuple[int, str]:
     return max(GRID, step // GRID * GRID), f"the mean jumps past the band after {step:,}"
 
 
-def grid_candidates(driver, setting: str, wave: int, ns: dict, winners: dict) -> list:
+def grid_candidates(driver, setting: str, wave: int, ns: dict, winners: dict, budgets=GRID_BUDGETS) -> list:
     """The adopted setting's Grid10 scratch runs at each candidate budget: its standard-suite
     config with the budget (and the suite's evaluation interval for it) replaced."""
     import dataclasses
@@ -68,15 +68,18 @@ def grid_candidates(driver, setting: str, wave: int, ns: dict, winners: dict) ->
     suite = SUITES["standard"]
     return [dataclasses.replace(c, steps=b, eval_every=suite.eval_interval(b, c.world))
             for name, c in driver.configs("standard", wave, ns, winners) if name == setting and c.world == "Grid10"
-            for b in GRID_BUDGETS]
+            for b in budgets]
 
 
 def grid_choice(finals: dict[int, float], budget: int) -> tuple[int, str]:
-    """Grid10's rule: the largest candidate whose mean final success lies in the zone."""
+    """Grid10's rule: the largest candidate whose mean final success lies in the zone; where
+    none does (the amendment of 2026-11-27, made before the second candidates were read),
+    the candidate nearest the zone, the smaller budget on a tie."""
     inside = [b for b in sorted(finals) if GRID_LOW <= finals[b] <= GRID_HIGH]
     if inside:
         return inside[-1], f"mean final {finals[inside[-1]]:.2f} at {inside[-1]:,}"
-    return budget, "no candidate lands in the zone: the budget stays"
+    near = min(sorted(finals), key=lambda b: max(GRID_LOW - finals[b], finals[b] - GRID_HIGH))
+    return near, f"no candidate in the zone; nearest: mean final {finals[near]:.2f} at {near:,}"
 
 
 def main(argv=None) -> None:
@@ -86,10 +89,13 @@ def main(argv=None) -> None:
     parser.add_argument("--grid-runs", action="store_true", help="train the Grid10 candidates first (into --out)")
     parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results")
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--grid-budgets", type=int, nargs="+", default=list(GRID_BUDGETS),
+                        help="Grid10's candidate budgets (default: the plan's first ones, %(default)s); the plan's "
+                             "confirmation clause runs further ones where none lands in the zone")
     driver.reader_arguments(parser)
     args = parser.parse_args(argv)
     ns, winners = driver.read_settings(args)
-    candidates = grid_candidates(driver, args.setting, args.wave, ns, winners)
+    candidates = grid_candidates(driver, args.setting, args.wave, ns, winners, args.grid_budgets)
     if args.grid_runs:
         from craftsuite.suite_runner import run_students
 
@@ -105,7 +111,7 @@ def main(argv=None) -> None:
     for c in [c for name, c in driver.configs("standard", args.wave, ns, winners)
               if name == args.setting and c.world == "Grid10" and c.seed == 0]:
         finals, shown = {}, []
-        for b in GRID_BUDGETS:
+        for b in sorted(args.grid_budgets):
             runs = [found[r.run_name()] for r in candidates if r.task == c.task and r.steps == b
                     and r.run_name() in found]
             if runs:

@@ -384,7 +384,7 @@ def _transfer(args) -> int:
         print(f"({'rungs, worlds or methods' if beyond else 'settings'} beyond the suite's: no results archive "
               "unless --archive DIR is given)")
     result = transfer(suite, out, workers=args.workers, ray=args.ray, video=not args.no_video, command=command_line(),
-                      device=args.device, archive=archive)
+                      device=args.device, archive=archive, members=args.members)
     print(f"leaderboard: {result.leaderboard} (and .csv)")
     for plot in result.plots:
         print(f"learning curves: {plot}")
@@ -648,6 +648,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dqn-hyper", help="JSON overrides of the DQN settings of the grid students and the teachers, "
                    "merged over the suite's, e.g. '{\"features_extractor\": \"flatten\"}'")
     p.add_argument("--workers", type=_positive, help="parallel local processes (default: one per core)")
+    p.add_argument("--members", type=_positive, help="at most this many seeds of a cell trained as one population "
+                   "(default: all of them); smaller populations finish sooner and more run at once, for many cores "
+                   "or a GPU")
     p.add_argument("--ray", metavar="ADDRESS", help="run the students on Ray ('local' starts one here)")
     p.add_argument("--no-video", action="store_true", help="skip the rollout video of the best student")
     p.add_argument("--archive", metavar="DIR", help="the results archive: runs found in DIR/<suite> are not trained "

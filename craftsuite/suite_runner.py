@@ -46,14 +46,17 @@ def _population_job(configs: list[dict], root: str, task: str | dict | None = No
                                                  device=device)]
 
 
-def cells(configs: list[StudentConfig]) -> list[list[StudentConfig]]:
-    """The population engine's jobs: configs equal but for the seed, together, in order;
-    each SB3 config alone (a finished run, reused)."""
+def cells(configs: list[StudentConfig], members: int | None = None) -> list[list[StudentConfig]]:
+    """The population engine's jobs: configs equal but for the seed, together, in order, at
+    most ``members`` to a job (default: a cell's seeds all in one); each SB3 config alone (a
+    finished run, reused). Smaller populations finish sooner and more of them run at once:
+    on many cores, or on a GPU that one process cannot keep busy."""
     groups: dict[str, list[StudentConfig]] = {}
     for c in {c.run_name(): c for c in configs}.values():  # a run asked for twice is one run
         key = json.dumps(c.cell(), sort_keys=True) if c.engine == "population" else c.run_name()
         groups.setdefault(key, []).append(c)
-    return list(groups.values())
+    size = members or max(map(len, groups.values()), default=1)
+    return [group[i:i + size] for group in groups.values() for i in range(0, len(group), size)]
 
 
 def _teacher_job(config: dict, root: str, task: str | dict | None = None, device: str = "cpu") -> str:
@@ -93,7 +96,8 @@ def _carried(task: str) -> str | dict:
 
 def run_students(configs: list[StudentConfig], root, workers: int | None = None, ray: str | None = None,
                  progress: bool = True, teachers: dict[str, TeacherConfig] | None = None, teacher_root=None,
-                 log=print, device: str = "cpu", pool: WorkerPool | None = None) -> list[Path]:
+                 log=print, device: str = "cpu", pool: WorkerPool | None = None,
+                 members: int | None = None) -> list[Path]:
     """Run students in parallel (processes or Ray) with one progress bar over all their
     transitions: one job per population (the seeds of a cell, ``cells``); a finished run of
     the sb3 engine is reused, an unfinished one refused (``training.finished_sb3_run``).
@@ -106,7 +110,7 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     teachers = teachers or {}
-    jobs = cells(configs)
+    jobs = cells(configs, members)
     waiting = {task: [job for job in jobs if job[0].task == task and METHODS[job[0].method].needs_table]
                for task in teachers}
     ready = [job for job in jobs if not (job[0].task in teachers and METHODS[job[0].method].needs_table)]
@@ -233,7 +237,7 @@ class TransferResult:
 
 def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None = None, video: bool = True,
              progress: bool = True, log=print, command: list[str] | None = None, device: str | None = None,
-             archive=None) -> TransferResult:
+             archive=None, members: int | None = None) -> TransferResult:
     """The suite end to end: teachers and distillation, students, leaderboard, plots, video.
 
     ``device``: the torch device of the population engine's students (``cpu``, the
@@ -269,7 +273,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     _counting_acceptance([out / "students" / c.run_name() for c in configs])  # none unfinished
     _refuse_sb3_not_kept(out, kept, configs, teachers.values())  # nothing written for a run it would not train
     # the pool, and a Ray cluster with it, before anything is written: one out of reach leaves no output behind
-    pool = WorkerPool(len(cells(configs)) + len(teachers), workers, ray)
+    pool = WorkerPool(len(cells(configs, members)) + len(teachers), workers, ray)
     if suite.eval_every is None and suite.student_steps is not None:  # the interval follows a budget given: say so
         every = sorted({c.eval_every for c in configs})
         log(f"(students evaluated every {' or '.join(f'{e:,}' for e in every)} transitions, a 20th of their "
@@ -292,7 +296,8 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         raise
     try:
         students = run_students(configs, out / "students", progress=progress, teachers=teachers,
-                                teacher_root=out / "teachers", log=log, device=device or "cpu", pool=pool)
+                                teacher_root=out / "teachers", log=log, device=device or "cpu", pool=pool,
+                                members=members)
     except BaseException:
         pool.close(abort=True)  # (run_students closes it too, but not if it failed before its jobs; twice is harmless)
         raise

@@ -254,3 +254,24 @@ def test_distill_reads_an_sb3_teacher_run_as_distilling_its_saved_replay(tmp_pat
     np.testing.assert_array_equal(table.counts, direct.counts)
     assert np.isfinite(table.q[table.seen]).all()
     np.testing.assert_allclose(table.q[table.seen], direct.q[direct.seen])
+
+
+def test_transfer_hands_members_to_the_populations(tmp_path, monkeypatch):
+    """``--members N`` reaches the students' jobs (a cell's seeds split into populations of N)."""
+    import craftsuite.suite_runner as runner
+
+    seen = {}
+
+    class Stop(Exception):
+        pass
+
+    def fake_run_students(configs, root, **kwargs):
+        seen.update(kwargs, jobs=[len(job) for job in runner.cells(configs, kwargs["members"])])
+        kwargs["pool"].close()
+        raise Stop
+
+    monkeypatch.setattr(runner, "run_students", fake_run_students)
+    with pytest.raises(Stop):
+        main(["transfer", "--suite", "quick", "--tasks", "Reach", "--methods", "td3", "--seeds", "3",
+              "--members", "2", "--workers", "1", "--no-archive", "--no-video", "--out", str(tmp_path / "out")])
+    assert seen["members"] == 2 and seen["jobs"] == [2, 1]

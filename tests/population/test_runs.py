@@ -240,6 +240,19 @@ def test_suites_train_each_cell_as_one_population():
     assert len(cells(sb3)) == len(sb3)  # one job per SB3 run: each reused alone
 
 
+def test_a_cell_splits_into_populations_of_at_most_members_seeds_in_seed_order():
+    from craftsuite.suite_runner import cells
+    from craftsuite.suites import SUITES
+
+    configs = SUITES["standard"].student_configs("teachers")
+    whole, split = cells(configs), cells(configs, members=3)
+    assert [len(job) for job in split[:4]] == [3, 3, 3, 1]  # 10 seeds
+    assert [c.seed for job in split[:4] for c in job] == [c.seed for c in whole[0]]
+    assert {c.cell() == whole[0][0].cell() for job in split[:4] for c in job} == {True}
+    assert sorted(c.run_name() for job in split for c in job) == sorted(c.run_name() for c in configs)
+    assert cells(configs, members=50) == whole
+
+
 def test_each_member_logs_to_tensorboard_as_an_sb3_run_and_a_resume_drops_what_the_kill_logged(tmp_path,
                                                                                              monkeypatch):
     from ..scalars import hparams_sessions, scalar_steps

@@ -200,9 +200,9 @@ TRANSFER_METHODS = ("dqn", "dynamic", "crm-edges", "td3", "td3-dynamic", "td3-cr
 # collapse that follows their first success (greedy success falls for 30-80k transitions
 # before it settles: experiments/collection-regime, "Stability"), so that the last
 # evaluation reads what was learned. The middle rungs (tagged ``middle``) each get the
-# budget at which TD3 from scratch, in the suite's learner regime, lands between 20% and 80%
-# greedy success in MuJoCo (experiments/learner-regime, plan part 2): where methods can
-# differ. The paper's tasks get 1M transitions per run, in their own suite.
+# budget at which TD3 from scratch (MuJoCo) or DQN from scratch (Grid10), in the suite's
+# learner regime, lands between 20% and 80% greedy success (experiments/learner-regime, plan
+# part 2): where methods can differ. The paper's tasks get 1M transitions per run, in their own suite.
 SUITES = {s.name: s for s in (
     Suite("quick", "the calibration rung and the two-stage rung in MuJoCo: TD3 from scratch and distilled "
           "(about 12 minutes on 2 cores)",
@@ -214,7 +214,8 @@ SUITES = {s.name: s for s in (
           tags=("easy", "medium"), worlds=("Grid10", "Cont"), methods=SUITE_METHODS, seeds=10,
           budgets={"Cont": {"easy": 250_000, "medium": 800_000, "KeySwordDragon": 100_000, "ToolHome": 250_000,
                             "TwoToolsHome": 300_000},
-                   "Grid": {"easy": 30_000, "medium": 150_000}},
+                   "Grid": {"easy": 30_000, "medium": 150_000, "KeySwordDragon": 10_000, "ToolHome": 15_000,
+                            "TwoToolsHome": 20_000}},
           regime="n-step-wide", **TD3_REGIME, **DQN_REGIME),
     Suite("hard", "the paper's tasks x the paper's methods and baselines at 1M transitions per run, Grid10 and "
           "MuJoCo, 10 seeds, in the n-step-wide learner regime (on 2 cores well over a day: run it in parts, with "

@@ -33,8 +33,9 @@ run_part() {  # run_part NAME WORKERS ARGS...: one transfer, stopped at the dead
   echo "== $name: rc $?, $(( $(date +%s) - start )) s" | tee -a "$out/campaign.log"
 }
 
-# RUNGS and WORKERS pick another first part (e.g. RUNGS="--tasks KeySwordDragon" WORKERS=6)
-run_part middle "${WORKERS:-21}" ${RUNGS:---tags middle}
+# RUNGS and WORKERS pick another first part (e.g. RUNGS="--tasks KeySwordDragon" WORKERS=6); about
+# 15 population processes fill an H100 (parts 1-2), more only queue for it
+run_part middle "${WORKERS:-15}" ${RUNGS:---tags middle}
 # the easy rungs' cells take 2.5M transitions each: only where the time left can hold them
 if [ $(( end - $(date +%s) )) -gt 300 ]; then run_part easy 14 --tags easy; fi
 

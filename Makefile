@@ -1,11 +1,13 @@
 # The two commands a new user needs (both do the whole set-up first, once):
 #   make demo   the main job: the quick transfer benchmark (grid teachers -> MuJoCo students),
 #               ending in a leaderboard, learning curves and a video in runs/quick
-#   make test   the linter (ruff), then the default test run (slow tests excluded;
+#   make test   the linter (ruff), then the default test run over TEST_WORKERS processes (slow tests excluded;
 #               `make test-slow` runs them)
 VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.craftsuite-setup
+# the default test run's processes (pytest-xdist): one per core of the 2-core machines it is sized for
+TEST_WORKERS ?= 2
 
 .PHONY: setup demo test test-slow bench docs clean
 
@@ -20,7 +22,7 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(PY) -m ruff check .
-	$(PY) -m pytest -q --nbmake tests notebooks
+	$(PY) -m pytest -q -n $(TEST_WORKERS) --nbmake tests notebooks
 
 # the slow tests alone (spawned transfers, Ray, kills, the wheel, the transfer notebook);
 # this -m replaces the default run's -m 'not slow' (pyproject.toml's addopts)

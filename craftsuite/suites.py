@@ -204,7 +204,8 @@ TRANSFER_METHODS = ("dqn", "dynamic", "crm-edges", "td3", "td3-dynamic", "td3-cr
 # learner regime, lands between 20% and 80% greedy success (experiments/learner-regime, plan
 # part 2): where methods can differ. The paper's tasks get 1M transitions per run in MuJoCo, in
 # their own suite; on Grid10, where DQN learns some of them in a few tens of thousands, the first of
-# 50k/100k/200k/500k at which DQN from scratch does (experiments/suite-campaign, part 5's rule).
+# 50k/100k/200k/500k at which DQN from scratch does (experiments/suite-campaign, its plan's item 5),
+# 1M for a task whose candidates have not run or none of which learns it.
 SUITES = {s.name: s for s in (
     Suite("quick", "the calibration rung and the two-stage rung in MuJoCo: TD3 from scratch and distilled "
           "(about 12 minutes on 2 cores)",

@@ -60,3 +60,10 @@ def test_the_learner_regime_budget_rule_reads_the_curve_as_fixed():
     assert budgets.choose(curve, 250_000)[0] == 200_000  # never beyond today's budget
     assert budgets.choose([(100_000, 0.1), (200_000, 0.2)], 200_000)[0] == 200_000  # below the band: kept
     assert budgets.choose([(100_000, 0.1), (200_000, 0.9)], 200_000)[0] == 100_000  # jumps past it
+
+
+def test_the_hard_grid_budget_rule_takes_the_first_candidate_that_learns():
+    rule = _load(Path(__file__).resolve().parents[1] / "experiments" / "suite-campaign" / "grid_budgets.py")
+    assert rule.choose({50_000: 1.0}) == 50_000
+    assert rule.choose({50_000: 0.4, 100_000: 0.8, 200_000: 1.0}) == 100_000  # 0.8 counts as learned
+    assert rule.choose({50_000: 0.4, 100_000: 0.79}) == rule.FALLBACK == 1_000_000  # none learns: 1M

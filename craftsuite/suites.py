@@ -225,7 +225,9 @@ SUITES = {s.name: s for s in (
           "in the n-step-wide learner regime (on 2 cores well over a day: run it in parts, with --worlds, --tasks "
           "or --methods, on any machines; the results archive gathers them)",
           tags=("hard",), worlds=("Grid10", "Cont"), methods=SUITE_METHODS, seeds=10,
-          budgets={"Cont": {"hard": 1_000_000}, "Grid": {"hard": 1_000_000, "DungeonQuest": 50_000}},
+          budgets={"Cont": {"hard": 1_000_000},
+                   "Grid": {"hard": 1_000_000, "DungeonQuest": 50_000, "BlindCraftsman": 50_000,
+                            "BlindCraftsmanObstacles": 50_000}},
           regime="n-step-wide", **TD3_REGIME, **DQN_REGIME),
     Suite("paper", "the paper's protocol as the authors' code ran it: the paper's methods and baselines on its tasks "
           "in the grid, MuJoCo and kinematic worlds, 20 seeds, 2M steps of 10 envs (20M transitions) per run",

@@ -67,3 +67,10 @@ def test_the_hard_grid_budget_rule_takes_the_first_candidate_that_learns():
     assert rule.choose({50_000: 1.0}) == 50_000
     assert rule.choose({50_000: 0.4, 100_000: 0.8, 200_000: 1.0}) == 100_000  # 0.8 counts as learned
     assert rule.choose({50_000: 0.4, 100_000: 0.79}) == rule.FALLBACK == 1_000_000  # none learns: 1M
+
+
+def test_the_learner_regime_grid_rule_takes_the_largest_in_the_zone_else_the_nearest():
+    budgets = _load(Path(__file__).resolve().parents[1] / "experiments" / "learner-regime" / "budgets.py")
+    assert budgets.grid_choice({10_000: 0.31, 15_000: 0.74, 20_000: 0.78, 30_000: 1.0})[0] == 20_000
+    assert budgets.grid_choice({10_000: 0.9, 15_000: 1.0})[0] == 10_000  # none inside: the nearest
+    assert budgets.grid_choice({10_000: 0.85, 15_000: 0.85})[0] == 10_000  # a tie: the smaller budget

@@ -71,7 +71,7 @@ def grid_candidates(driver, setting: str, wave: int, ns: dict, winners: dict, bu
             for b in budgets]
 
 
-def grid_choice(finals: dict[int, float], budget: int) -> tuple[int, str]:
+def grid_choice(finals: dict[int, float]) -> tuple[int, str]:
     """Grid10's rule: the largest candidate whose mean final success lies in the zone; where
     none does (the amendment of 2026-11-27, made before the second candidates were read),
     the candidate nearest the zone, the smaller budget on a tie."""
@@ -117,7 +117,7 @@ def main(argv=None) -> None:
             if runs:
                 finals[b] = float(np.mean([float(read_csv(r / "evals.csv")[-1]["success"]) for r in runs]))
                 shown.append(f"{b // 1000}k: {len(runs)}, {finals[b]:.2f}")
-        budget, why = grid_choice(finals, c.steps) if finals else (c.steps, "no runs found")
+        budget, why = grid_choice(finals) if finals else (c.steps, "no runs found")
         print(f"| {c.task} | {c.steps:,} | {'; '.join(shown)} | {budget:,} | {why} |")
     print()
     found = driver.finished_runs(args.runs)

@@ -34,6 +34,7 @@ from .board import (
     verdict,
 )
 from .coverage import coverage_markdown
+from .learned import learned_markdown
 from .plots import draw_curves, draw_profiles, file_part, save_figures
 from .sources import read_runs, session_line
 
@@ -240,12 +241,15 @@ def comparisons_markdown(boards: list[Board]) -> list[str]:
     ``boards``: the difference in final greedy success and the verdict (``board.compare``),
     and how many rungs decide it."""
     rows, decided, trivial = [], 0, 0
+    per_regime: dict[str, list[int]] = {}  # regime -> [comparisons, decided, decided only by all-0/all-1 seeds]
     for board in boards:
         entries = list(board)
         for task, world, regime in sorted({(e.task, e.world_label, e.regime) for e in entries},
                                           key=lambda k: (rung_order(k[0]), k[1], k[2])):
             here = [e for e in entries if (e.task, e.world_label, e.regime) == (task, world, regime)]
             for entry, base in distilled_against_scratch(here):
+                tally = per_regime.setdefault(regime, [0, 0, 0])
+                tally[0] += 1
                 if entry.budget != base.budget:  # never set side by side as if they were one comparison
                     rows.append(f"| {task} | {world} | {regime} | `{entry.label}` − `{base.label}` | | "
                                 f"| {entry.budget:,} against {base.budget:,} | not compared: other budgets |")
@@ -256,8 +260,14 @@ def comparisons_markdown(boards: list[Board]) -> list[str]:
                             f"| {c.verdict} |")
                 decided += c.decided
                 trivial += c.trivial
+                tally[1] += c.decided
+                tally[2] += c.trivial
     if not rows:
         return []
+    # a regime's runs are never pooled with another's: each regime's share is read apart
+    by_regime = ("By learner regime, decided and not only by all-0/all-1 seeds: " + "; ".join(
+        f"`{regime}` {n_decided - n_trivial} of {n}" for regime, (n, n_decided, n_trivial)
+        in sorted(per_regime.items(), key=lambda kv: _regime_order(kv[0]))) + "." if len(per_regime) > 1 else "")
     return ["| rung | world | learner regime | distilled − scratch | difference in success [95% Welch t] "
             "| P(distilled > scratch) [95% bootstrap] | transitions per run | verdict |",
             "|---|---|---|---|---|---|---|---|", *rows, "",
@@ -265,7 +275,15 @@ def comparisons_markdown(boards: list[Board]) -> list[str]:
             f"{decided} of {len(rows)} comparisons, {trivial} of them only because every seed of both sat "
             "at 0 or at 1: *ahead*/*behind* where the two t-intervals are apart or the "
             "probability's interval excludes one half; *no difference* where the difference's interval lies within "
-            f"±{SMALLEST_DIFFERENCE:g}.", ""]
+            f"±{SMALLEST_DIFFERENCE:g}." + (f" {by_regime}" if by_regime else ""), ""]
+
+
+def _regime_order(regime: str) -> tuple:
+    """The regimes' table's order (``craftsuite.regimes``), as the leaderboards list them."""
+    from ..regimes import REGIMES
+
+    order = list(REGIMES)
+    return (order.index(regime) if regime in order else len(order), regime)
 
 
 def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = None, level: int = 3) -> list[str]:
@@ -385,7 +403,7 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
                   f"Runs in `{runs.path.as_posix()}`." + _suite_scope(suite), ""]
         lines += [session_line(s, to_the_minute=True) for s in runs.sessions]
         lines += wall_time_lines(runs.sessions)
-        lines += ["", *coverage_markdown(runs.path, name)] if name in SUITES else []
+        lines += ["", *coverage_markdown(runs.path, name), *learned_markdown(board, name)] if name in SUITES else []
         if not runs.sessions:
             lines.append(f"- runs in `{runs.path}` (no provenance.json: not made by `craftsuite transfer`)")
         # named after the directory, not the suite: two directories of one suite keep their own plots

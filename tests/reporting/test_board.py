@@ -283,8 +283,27 @@ def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_pa
     text = "\n".join(comparisons_markdown([board]))
     assert "Decided (ahead, behind, or no difference of 0.2 or more) on 3 of 6 comparisons, 1 of them only" in text
     assert "| ToolHome | Cont | one-step | `td3-dynamic` − `td3` | -0.80 [" in text
+    assert "By learner regime" not in text  # one regime: the sentence above says it all
     # the best run: the highest final success, then the hardest rung, then the return
     run, entry, i = best_run(board)
     assert (entry.task, entry.method, entry.values["success"][i]) == ("DungeonQuest", "td3-dynamic", 1.0)
     assert best_run(board, among=[r for x in board if x.task == "ToolHome" for r in x.runs])[0].name.startswith(
         "student-ToolHome-Cont-td3-s2")
+
+
+def test_each_learner_regime_s_share_of_decided_comparisons_is_read_apart(tmp_path):
+    from craftsuite.regimes import check_regime
+    from craftsuite.reporting.pages import comparisons_markdown
+
+    wide = check_regime("n-step-wide").settings("td3")
+    for seed in range(5):
+        fake_run(tmp_path, "td3", seed, [(1000, 0.9)], [(950, 1.0)], task="ToolHome")  # one-step, both at 0.9
+        fake_run(tmp_path, "td3-dynamic", seed, [(1000, 0.9 - 0.01 * seed)], [(950, 1.0)], task="ToolHome")
+        fake_run(tmp_path, "td3", seed, [(1000, 1.0)], [(950, 1.0)], task="ToolHome", hyperparameters=wide)
+        fake_run(tmp_path, "td3-dynamic", seed, [(1000, 1.0)], [(950, 1.0)], task="ToolHome", hyperparameters=wide)
+    text = "\n".join(comparisons_markdown([build(tmp_path)]))
+    assert "| ToolHome | Cont | n-step-wide | `td3-dynamic` − `td3` | +0.00 [+0.00, +0.00] |" in text
+    # both decided; the n-step-wide one only because every seed of both sat at 1
+    assert "on 2 of 2 comparisons, 1 of them only" in text
+    assert text.rstrip().endswith("By learner regime, decided and not only by all-0/all-1 seeds: `one-step` 1 of 1; "
+                                  "`n-step-wide` 0 of 1.")

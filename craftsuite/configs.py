@@ -171,20 +171,30 @@ def _effective(method: str, hyperparameters: dict, env_id: str, env_kwargs: dict
             "world": {"id": env_id, "kwargs": env_kwargs, "rules": resolve_task(task).digest()}}
 
 
-def student_result(config: StudentConfig, algorithm: str, steps: int, updates: int, seconds: float,
+def student_result(config: StudentConfig, algorithm: str, steps: int, updates: int, seconds: tuple[float, float],
                    **more) -> dict:
     """A finished student's ``result.json``, whichever engine trained it (``more``: what
-    that engine adds, e.g. the population's size)."""
+    that engine adds, e.g. the population's size); ``seconds``: this session's training
+    time and every session's since step 0 (a run stopped and resumed counts both)."""
     return {"kind": "student", "env_id": config.env_id, "method": config.method, "algorithm": algorithm,
             "task": config.task, "seed": config.seed, "steps": int(steps), "updates": int(updates),
             "product": config.product, "env_kwargs": config.env_kwargs, "model": "model.zip",
-            **more, "seconds_this_session": round(seconds, 1)}
+            **more, **_timing(seconds)}
 
 
 def teacher_result(config: TeacherConfig, algorithm: str, steps: int, updates: int, success: float,
-                   seconds: float, **more) -> dict:
+                   seconds: tuple[float, float], **more) -> dict:
     """A finished teacher's ``result.json``, whichever engine trained it: its last greedy
     ``success`` and whether that reached its target, beside its model and table."""
     return {"kind": "teacher", "env_id": config.env_id, "algorithm": algorithm, "steps": int(steps),
             "updates": int(updates), "success": success, "reached_target": success >= config.target_success,
-            **more, "seconds_this_session": round(seconds, 1), "table": "table.npz", "model": "teacher.zip"}
+            **more, **_timing(seconds), "table": "table.npz", "model": "teacher.zip"}
+
+
+def _timing(seconds: tuple[float, float]) -> dict:
+    """A result's training time: this session's, and every session's since step 0, with the
+    machine (a population's members share both: its wall time, not a member's own)."""
+    from .provenance import machine
+
+    this, total = seconds
+    return {"seconds_this_session": round(this, 1), "seconds": round(total, 1), "machine": machine()}

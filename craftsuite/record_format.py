@@ -54,6 +54,10 @@ RESULT = (
     Field("seed", "integer", False, "the seed, as config.json says it"),
     Field("method", "string", False, "the method, as config.json says it"),
     Field("self_reported", "boolean", False, "as config.json says it"),
+    Field("seconds", "number >= 0", False, "training wall time since step 0, every session's, in seconds (a "
+          "population's: its members share it)"),
+    Field("members", "integer > 0", False, "the runs trained together as one population"),
+    Field("machine", "string", False, "the machine it finished on (system, cores, memory, Python)"),
 )
 EVALS = (
     Field("step", "integer in [0, steps]", True, "the transitions at the evaluation"),

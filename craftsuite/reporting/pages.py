@@ -37,6 +37,7 @@ from .coverage import coverage_markdown
 from .learned import learned_markdown
 from .plots import draw_curves, draw_profiles, file_part, save_figures
 from .sources import read_runs, session_line
+from .timing import training_time_lines, wall_time_lines
 
 # The authors' shipped continuous results, one run each, mean episode reward over the last
 # 5% of 2e6 steps (not the same metric window as ours, nor our MuJoCo world).
@@ -402,7 +403,7 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
         lines += [f"## {name}" + (f": {suite['description']}" if suite.get("description") else ""), "",
                   f"Runs in `{runs.path.as_posix()}`." + _suite_scope(suite), ""]
         lines += [session_line(s, to_the_minute=True) for s in runs.sessions]
-        lines += wall_time_lines(runs.sessions)
+        lines += wall_time_lines(runs.sessions) + training_time_lines(board)
         lines += ["", *coverage_markdown(runs.path, name), *learned_markdown(board, name)] if name in SUITES else []
         if not runs.sessions:
             lines.append(f"- runs in `{runs.path}` (no provenance.json: not made by `craftsuite transfer`)")
@@ -439,31 +440,6 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
         shutil.copy(video, copy)
     atomic_write(path, "\n".join(lines))
     return path
-
-
-def wall_time_lines(sessions: list[dict]) -> list[str]:
-    """The directory's training time as its sessions measured it, summed per kind of machine
-    (its cores): what running the suite's cells here took. Sessions that did not finish are
-    counted apart (their time is not known)."""
-    import re
-
-    took: dict[str, float] = {}
-    unfinished = 0
-    for s in sessions:
-        if not s["command"].startswith("craftsuite transfer"):
-            continue  # archiving and the like train nothing
-        if s.get("seconds") is None:
-            unfinished += 1
-            continue
-        cores = re.search(r"(\d+) cores?", s.get("machine", ""))
-        kind = f"{cores.group(1)} cores" if cores else "machine unknown"
-        took[kind] = took.get(kind, 0.0) + s["seconds"]
-    if not took:
-        return []
-    parts = [f"{seconds / 3600:.1f} h on {kind}" for kind, seconds in sorted(took.items())]
-    return [f"- Wall time of the sessions that trained these runs: {', '.join(parts)}"
-            + (f" ({unfinished} session{'s' if unfinished > 1 else ''} not finished, not counted)" if unfinished
-               else "")]
 
 
 def teachers_markdown(root: Path) -> list[str]:

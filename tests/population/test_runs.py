@@ -103,10 +103,19 @@ def test_a_killed_population_resumes_from_its_checkpoint(tmp_path, monkeypatch):
         loaded["replay"] = self.replay.size
 
     monkeypatch.setattr(population_train.Population, "load_states", spy)
+    # the training time the checkpoint records (as if the first session had run 1,000 s)
+    # carries over into the result, beside the resumed session's own
+    for step in tmp_path.glob("*/*/step.json"):
+        saved = json.loads(step.read_text())
+        assert saved["num_timesteps"] == 400 and saved["seconds"] > 0
+        step.write_text(json.dumps({**saved, "seconds": 1_000.0}))
     paths = train_population(configs, tmp_path, progress=False)
     assert loaded == {"steps": [400, 400], "replay": 400}  # resumed with its replay, not from step 0
     for path, before in zip(paths, first):
-        assert json.loads((path / "result.json").read_text())["updates"] == 2 * (1_200 - 200) // 4  # none lost
+        result = json.loads((path / "result.json").read_text())
+        assert result["seconds"] == pytest.approx(1_000.0 + result["seconds_this_session"], abs=0.2)
+        assert result["machine"].split(", ")[1].endswith("cores")
+        assert result["updates"] == 2 * (1_200 - 200) // 4  # none lost
         evals = read_csv(path / "evals.csv")
         assert evals[0] == before[0] and [int(r["step"]) for r in evals] == [400, 800, 1200]
         steps = [int(r["step"]) for r in read_csv(path / "episodes.csv")]

@@ -151,7 +151,7 @@ def test_a_task_no_method_learned_says_where_its_episodes_stopped(tmp_path):
 
 
 def test_the_wall_time_is_summed_per_kind_of_machine():
-    from craftsuite.reporting.pages import wall_time_lines
+    from craftsuite.reporting.timing import wall_time_lines
 
     sessions = [{"command": "craftsuite transfer --suite standard", "seconds": 3600.0, "machine": "Linux, 2 cores"},
                 {"command": "craftsuite transfer --suite standard", "seconds": 1800.0, "machine": "Linux, 2 cores"},
@@ -161,3 +161,23 @@ def test_the_wall_time_is_summed_per_kind_of_machine():
     assert wall_time_lines(sessions) == ["- Wall time of the sessions that trained these runs: 0.1 h on 16 cores, "
                                          "1.5 h on 2 cores (1 session not finished, not counted)"]
     assert wall_time_lines(sessions[-1:]) == []
+
+
+def test_the_runs_training_time_counts_each_population_once_per_machine_and_regime(tmp_path):
+    from craftsuite.reporting.timing import training_time_lines
+
+    def timed(method, seed, **result):
+        run = fake_run(tmp_path, method, seed, [(1000, 0.5)], [(995, 1.0)])
+        record = json.loads((run / "result.json").read_text())
+        (run / "result.json").write_text(json.dumps({**record, **result}))
+
+    for seed in range(4):  # a population of 4 that ran 2 h in all, across a stop
+        timed("td3", seed, seconds=7200.0, seconds_this_session=600.0, members=4, device="cpu",
+              machine="Linux x86_64, 2 cores, 23.5 GiB, Python 3.11.7")
+    timed("td3-dynamic", 0, seconds=1800.0, members=1, device="cuda", machine="Linux x86_64, 16 cores")
+    timed("td3-dynamic", 1, seconds_this_session=900.0)  # an older record: its last session's time only
+    [line] = training_time_lines(build(tmp_path))
+    assert line.endswith("`one-step` 2.0 h (2 cores, cpu), 0.5 h (16 cores, cuda), 0.2 h (cpu) (1 of the runs come "
+                         "from before their records kept the time across a stop and resume: their last session's "
+                         "time only)")
+    assert line.startswith("- Training time recorded by the 6 runs")

@@ -171,11 +171,10 @@ def _effective(method: str, hyperparameters: dict, env_id: str, env_kwargs: dict
             "world": {"id": env_id, "kwargs": env_kwargs, "rules": resolve_task(task).digest()}}
 
 
-def student_result(config: StudentConfig, algorithm: str, steps: int, updates: int, seconds: tuple[float, float],
-                   **more) -> dict:
+def student_result(config: StudentConfig, algorithm: str, steps: int, updates: int,
+                   seconds: tuple[float, float | None], **more) -> dict:
     """A finished student's ``result.json``, whichever engine trained it (``more``: what
-    that engine adds, e.g. the population's size); ``seconds``: this session's training
-    time and every session's since step 0 (a run stopped and resumed counts both)."""
+    that engine adds, e.g. the population's size); ``seconds``: see ``_timing``."""
     return {"kind": "student", "env_id": config.env_id, "method": config.method, "algorithm": algorithm,
             "task": config.task, "seed": config.seed, "steps": int(steps), "updates": int(updates),
             "product": config.product, "env_kwargs": config.env_kwargs, "model": "model.zip",
@@ -183,7 +182,7 @@ def student_result(config: StudentConfig, algorithm: str, steps: int, updates: i
 
 
 def teacher_result(config: TeacherConfig, algorithm: str, steps: int, updates: int, success: float,
-                   seconds: tuple[float, float], **more) -> dict:
+                   seconds: tuple[float, float | None], **more) -> dict:
     """A finished teacher's ``result.json``, whichever engine trained it: its last greedy
     ``success`` and whether that reached its target, beside its model and table."""
     return {"kind": "teacher", "env_id": config.env_id, "algorithm": algorithm, "steps": int(steps),
@@ -191,10 +190,13 @@ def teacher_result(config: TeacherConfig, algorithm: str, steps: int, updates: i
             **more, **_timing(seconds), "table": "table.npz", "model": "teacher.zip"}
 
 
-def _timing(seconds: tuple[float, float]) -> dict:
-    """A result's training time: this session's, and every session's since step 0, with the
-    machine (a population's members share both: its wall time, not a member's own)."""
+def _timing(seconds: tuple[float, float | None]) -> dict:
+    """A result's training time: the wall time of the session that finished it (its
+    population's), the run's share of every session's since step 0 (each session's wall time
+    divided among its population's members; absent where an earlier session's is not known)
+    and the machine it finished on."""
     from .provenance import machine
 
-    this, total = seconds
-    return {"seconds_this_session": round(this, 1), "seconds": round(total, 1), "machine": machine()}
+    this, share = seconds
+    return {"seconds_this_session": round(this, 1),
+            **({} if share is None else {"seconds_share": round(share, 1)}), "machine": machine()}

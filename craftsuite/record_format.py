@@ -54,8 +54,8 @@ RESULT = (
     Field("seed", "integer", False, "the seed, as config.json says it"),
     Field("method", "string", False, "the method, as config.json says it"),
     Field("self_reported", "boolean", False, "as config.json says it"),
-    Field("seconds", "number >= 0", False, "training wall time since step 0, every session's, in seconds (a "
-          "population's: its members share it)"),
+    Field("seconds_share", "number >= 0", False, "the run's share of its training's wall time since step 0, in "
+          "seconds: each session's, to its last checkpoint or the finish, divided among its population's members"),
     Field("members", "integer > 0", False, "the runs trained together as one population"),
     Field("machine", "string", False, "the machine it finished on (system, cores, memory, Python)"),
 )
@@ -86,6 +86,10 @@ def _int(value) -> bool:
     return isinstance(value, int) and not isinstance(value, bool)
 
 
+def _finite(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
 def check_config(config: dict, path) -> None:
     """``config.json``'s required fields, and the types of those a reader uses."""
     missing = [f.name for f in CONFIG if f.required and f.name not in config]
@@ -113,6 +117,11 @@ def check_result(result: dict, config: dict, path) -> None:
                           f"({config['steps']:,}): a finished run collects its budget")
     if "updates" in result and result["updates"] is not None and (not _int(result["updates"]) or result["updates"] < 0):
         raise RecordError(f"{path}: updates must be an integer >= 0, got {result['updates']!r}")
+    for name, valid, wanted in (("seconds_share", lambda v: _finite(v) and v >= 0, "a number >= 0"),
+                                ("members", lambda v: _int(v) and v > 0, "an integer > 0"),
+                                ("machine", lambda v: isinstance(v, str), "a string")):
+        if name in result and not valid(result[name]):
+            raise RecordError(f"{path}: {name} must be {wanted}, got {result[name]!r}")
     for name in ("task", "seed", "method"):
         if name in result and result[name] != config[name]:
             raise RecordError(f"{path}: {name} {result[name]!r} is not config.json's ({config[name]!r}): the result "

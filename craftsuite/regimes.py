@@ -78,6 +78,13 @@ def regime_of(algorithm: str, settings: dict) -> str:
     return ", ".join(f"{name}={mine[name]!r}" for name in FACTORS if mine[name] != default[name])
 
 
+def order(name: str) -> tuple:
+    """A regime's place wherever regimes are listed: the table's order, then any other
+    (a run's own settings, a self-reported learner) by name."""
+    names = list(REGIMES)
+    return (names.index(name) if name in names else len(names), name)
+
+
 def check_regime(name: str) -> Regime:
     if name not in REGIMES:
         raise ValueError(f"unknown learner regime {name!r}; regimes: {list(REGIMES)}")

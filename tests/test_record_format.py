@@ -34,6 +34,12 @@ CONFIG = {"task": "Reach", "world": "Cont", "method": "my-sac", "seed": 0, "step
     (lambda: check_config({**CONFIG, "seed": -1}, "c.json"), "seed must be an integer >= 0, got -1"),
     (lambda: check_result({"kind": "student", "steps": 999}, CONFIG, "r.json"), "steps 999 is short of the budget"),
     (lambda: check_result({"kind": "student", "steps": 1000, "updates": -2}, CONFIG, "r.json"), "updates must be"),
+    (lambda: check_result({"kind": "student", "steps": 1000, "seconds_share": -1.0}, CONFIG, "r.json"),
+     "r.json: seconds_share must be a number >= 0, got -1.0"),
+    (lambda: check_result({"kind": "student", "steps": 1000, "members": "5"}, CONFIG, "r.json"),
+     "members must be an integer > 0, got '5'"),
+    (lambda: check_result({"kind": "student", "steps": 1000, "machine": 2}, CONFIG, "r.json"),
+     "machine must be a string"),
     (lambda: check_result({"kind": "student", "steps": 1000, "seed": 4}, CONFIG, "r.json"),
      "seed 4 is not config.json's \\(0\\): the result of another run"),
     (lambda: check_evals([{"step": "1000", "success": "inf"}], 1000, "e.csv"), "e.csv: line 2: success is inf"),
@@ -47,6 +53,7 @@ def test_a_record_that_breaks_the_format_is_named(check, message):
 
 def test_a_good_record_passes():
     check_config(CONFIG, "c.json")
-    check_result({"kind": "student", "steps": 1010, "updates": 3, "task": "Reach"}, CONFIG, "r.json")
+    check_result({"kind": "student", "steps": 1010, "updates": 3, "task": "Reach", "seconds_share": 12.5,
+                  "members": 5, "machine": "Linux x86_64, 2 cores"}, CONFIG, "r.json")
     check_evals([{"step": "1000", "success": "0.5", "return": "1.5", "length": ""}], 1010, "e.csv")
     check_episodes([{"step": "10", "return": "-3.0"}], 1010, "p.csv")

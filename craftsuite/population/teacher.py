@@ -41,7 +41,8 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True, device: st
         return run.path
 
 
-def _finish_teacher(pop: Population, k: int, config: TeacherConfig, run: RunDir, seconds: tuple[float, float]) -> None:
+def _finish_teacher(pop: Population, k: int, config: TeacherConfig, run: RunDir,
+                    seconds: tuple[float, float | None]) -> None:
     from ..task_registry import resolve_task
 
     distill(pop, resolve_task(config.task).automaton)[k].save(run.path / "table.npz")

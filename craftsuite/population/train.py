@@ -108,7 +108,8 @@ def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=No
     """Train the ``todo`` (config, run) pairs together to their budget, or until every
     member's greedy success reaches ``stop_at`` (a teacher's target); then
     ``finish(pop, k, config, run, seconds)`` each member (a student's model and result by
-    default; ``seconds``: this session's, and every session's since step 0)."""
+    default; ``seconds``: the population's wall time this session, and the member's share of
+    every session's since step 0, None where a checkpoint it resumed from did not record it)."""
     from ..progress import progress_bar
 
     configs, runs = [c for c, _ in todo], [r for _, r in todo]
@@ -125,8 +126,11 @@ def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=No
         pop = build_population(config, [c.seed for c in configs], settings, spec, table, device, envs)
         earlier = _resume(pop, runs)
 
-        def clock() -> float:  # training seconds since step 0, the sessions before this one's included
-            return earlier + time.perf_counter() - start
+        def shares() -> list[float | None]:
+            # each member's share of the wall time since step 0: a population of K shares each
+            # session's among its members, so a cell regrouped between sessions still sums right
+            session = (time.perf_counter() - start) / K
+            return [None if e is None else e + session for e in earlier]
 
         logs = [Scalars(run, pop.num_timesteps) for run in runs]
         for log in logs:
@@ -135,13 +139,13 @@ def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=No
         eval_envs = make_envs(config.env_id, K * config.eval_episodes, config.env_kwargs, config.product)
         stack.callback(eval_envs.close)
         with progress_bar(K * total, desc, initial=K * pop.num_timesteps, enabled=progress) as bar:
-            _loop(pop, envs, eval_envs, configs, runs, logs, bar, spec.automaton, clock, on_evaluation, stop_at)
+            _loop(pop, envs, eval_envs, configs, runs, logs, bar, spec.automaton, shares, on_evaluation, stop_at)
+        session, share = time.perf_counter() - start, shares()
         for k, (c, run) in enumerate(todo):
-            seconds = (time.perf_counter() - start, clock())
             if finish is None:
-                _finish(pop, k, c, run, table, seconds, str(device))
+                _finish(pop, k, c, run, table, (session, share[k]), str(device))
             else:
-                finish(pop, k, c, run, seconds)
+                finish(pop, k, c, run, (session, share[k]))
     finally:
         stack.close()
         th.set_num_threads(threads)
@@ -156,7 +160,7 @@ def build_population(config, seeds: list[int], settings: dict, spec, table, devi
                       observation_planes(config.env_id, config.env_kwargs, config.product, settings))
 
 
-def _loop(pop: Population, envs, eval_envs, configs, runs, logs, bar, automaton, clock, on_evaluation=None,
+def _loop(pop: Population, envs, eval_envs, configs, runs, logs, bar, automaton, shares, on_evaluation=None,
           stop_at=None) -> None:
     config = configs[0]
     K, n, total, every = pop.K, pop.n_envs, config.steps, config.eval_every
@@ -198,11 +202,11 @@ def _loop(pop: Population, envs, eval_envs, configs, runs, logs, bar, automaton,
             if on_evaluation is not None:
                 on_evaluation(pop, t, results)
             if stop_at is not None and all(r[0] >= stop_at for r in results):
-                _checkpoint(pop, runs, clock())  # a teacher's replay, which `craftsuite distill` reads again
+                _checkpoint(pop, runs, shares())  # a teacher's replay, which `craftsuite distill` reads again
                 return  # before this step's updates, as SB3's callback stops a teacher before its train()
         pop.train()
         if evaluate:  # after them, so that a resumed population has taken every update of its steps
-            _checkpoint(pop, runs, clock())
+            _checkpoint(pop, runs, shares())
 
 
 def _flush(runs, logs, pending, step: int, total: int) -> None:
@@ -256,16 +260,17 @@ def _evaluate(pop, configs, runs, logs, step, bar, envs=None) -> list[tuple[floa
     return results
 
 
-def _checkpoint(pop: Population, runs, seconds: float) -> None:
+def _checkpoint(pop: Population, runs, shares: list[float | None]) -> None:
     """Every member's state into its run's next checkpoint (``population.pt``, and
-    ``step.json`` saying its step and the training seconds since step 0, read on resume
+    ``step.json`` saying its step and its share of the wall time since step 0, read on resume
     without loading the state), then each committed (``RunDir.commit_checkpoint``: the one
     before is kept)."""
     for k, run in enumerate(runs):
         new = run.new_checkpoint()
         with atomic_path(new / CHECKPOINT) as tmp:
             th.save(pop.member_state(k), tmp)
-        atomic_write(new / STEP, json.dumps({"num_timesteps": pop.num_timesteps, "seconds": round(seconds, 1)}))
+        share = {} if shares[k] is None else {"seconds_share": round(shares[k], 1)}
+        atomic_write(new / STEP, json.dumps({"num_timesteps": pop.num_timesteps, **share}))
     for run in runs:
         run.commit_checkpoint()
 
@@ -282,16 +287,18 @@ def _saved_steps(run: RunDir) -> dict[int, Path]:
     return found
 
 
-def _saved_seconds(checkpoint: Path) -> float:
-    """The training seconds since step 0 a checkpoint's ``step.json`` records (0 where it
-    records none: a checkpoint written before it did)."""
+def _saved_share(checkpoint: Path) -> float | None:
+    """A member's share of the wall time since step 0 that its checkpoint's ``step.json``
+    records (time after a session's last checkpoint is not in it); None where it records
+    none (a checkpoint written before it did): that run's time is then not known whole."""
     try:
-        return float(json.loads((checkpoint.parent / STEP).read_text()).get("seconds", 0.0))
+        share = json.loads((checkpoint.parent / STEP).read_text()).get("seconds_share")
+        return None if share is None else float(share)
     except (OSError, ValueError, TypeError, AttributeError):
-        return 0.0
+        return None
 
 
-def _resume(pop: Population, runs) -> float:
+def _resume(pop: Population, runs) -> list[float | None]:
     """Load the newest step every member has a checkpoint of that loads (a kill between two
     members' commits leaves the one before), and trim each member's logs to it. With no
     checkpoint at all, the population starts at step 0. A checkpoint that cannot be loaded
@@ -299,8 +306,8 @@ def _resume(pop: Population, runs) -> float:
     aside as ``checkpoint-unloadable`` (a member's newest such; its other checkpoints newer
     than the step resumed from are removed, so that the next commits keep the one resumed
     from); when no step loads, the error names each file, why, and what to do, and nothing
-    is moved or deleted. So is a population whose members share no step. Returns the
-    training seconds the checkpoint resumed from records (0 from step 0)."""
+    is moved or deleted. So is a population whose members share no step. Returns each
+    member's share of the wall time its checkpoint records (``_saved_share``; 0 from step 0)."""
     import warnings
 
     from ..runs import CheckpointError
@@ -309,7 +316,7 @@ def _resume(pop: Population, runs) -> float:
     if not any(found):
         for run in runs:
             run.trim_logs(0)
-        return 0.0
+        return [0.0] * len(runs)
     common = set(found[0]).intersection(*found[1:])
     if not common:
         raise CheckpointError(
@@ -334,7 +341,7 @@ def _resume(pop: Population, runs) -> float:
                           f"{damaged[0][1]} (kept as {aside})", RuntimeWarning, stacklevel=2)
         for newer in [path.parent for at, path in steps.items() if at > step and path.parent.exists()]:
             shutil.rmtree(newer)  # damaged too, or of the steps the population cannot resume from
-    seconds = _saved_seconds(found[0][step])  # read before a commit below renames its directory
+    earlier = [_saved_share(steps[step]) for steps in found]  # before a commit below renames a directory
     pop.load_states(states)
     print(f"{', '.join(str(r.path) for r in runs)}: resuming from their checkpoints at step {step} "
           "(episodes logged after it are dropped and played again)")
@@ -342,7 +349,7 @@ def _resume(pop: Population, runs) -> float:
         if steps[step].parent.name == run.CHECKPOINTS[0]:  # a kill came between its writing and its commit
             run.commit_checkpoint()  # as a single run does: the next checkpoint keeps this one
         run.trim_logs(step)
-    return seconds
+    return earlier
 
 
 def _load_step(pop: Population, runs, found, step: int, failed: list) -> list[dict] | None:
@@ -380,7 +387,7 @@ def save_member(pop: Population, k: int, config, path: Path, table=None) -> None
     agent.get_env().close()
 
 
-def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, seconds: tuple[float, float],
+def _finish(pop: Population, k: int, config: StudentConfig, run: RunDir, table, seconds: tuple[float, float | None],
             device: str) -> None:
     """Member ``k``'s model as an SB3 agent (``model.zip``), its result, its checkpoints gone."""
     from ..configs import student_result

@@ -50,6 +50,14 @@ THRESHOLD = 0.8  # greedy success at which a run counts as having learned the ta
 AGGREGATED = ("success", "auc")  # the metrics aggregated across tasks (rates: comparable across tasks)
 
 
+def finite_mean(values) -> float:
+    """The mean of the values that are numbers (-inf if none is: a run with no evaluation
+    yet ranks last and has learned nothing)."""
+    x = np.asarray(values, dtype=float)
+    x = x[np.isfinite(x)]
+    return float(x.mean()) if len(x) else -math.inf
+
+
 def world_of(config: dict) -> tuple[str, dict]:
     """A student's world as its ``config.json`` records it: the world's name and the
     keywords that change it (a fixed grid instance, a frame skip, a board size)."""
@@ -222,12 +230,12 @@ class Board:
         """The learner regimes of CraftSuite's runs here, the regimes' table's order first
         (self-reported runs have a learner of their own: they stand beside every regime's
         runs, and make a regime of their own only where CraftSuite's runs are absent)."""
-        from ..regimes import REGIMES
+        from ..regimes import order
 
         mine = {e.regime for e in self.entries} | {u.regime for u in self.unfinished}
         if mine - {SELF_REPORTED}:
             mine.discard(SELF_REPORTED)
-        return [r for r in REGIMES if r in mine] + sorted(mine - set(REGIMES))
+        return sorted(mine, key=order)
 
     def of_regime(self, regime: str) -> Board:
         """The runs of one learner regime, and the self-reported runs beside them (an

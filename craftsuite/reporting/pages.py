@@ -15,6 +15,7 @@ from .. import stats
 from ..files import atomic_write
 from ..ids import CONT, world_kind
 from ..regimes import describe
+from ..regimes import order as regime_order
 from ..runs import RunError, read_config, read_result
 from ..suites import SUITES
 from ..archive import size as archive_size
@@ -30,6 +31,7 @@ from .board import (
     best_run,
     compare,
     distilled_against_scratch,
+    finite_mean,
     rung_order,
     verdict,
 )
@@ -77,16 +79,9 @@ def _fmt(estimate: stats.Estimate, digits: int = 2, signed: bool = False) -> str
     return f"{estimate.value:{sign}.{digits}f} [{estimate.low:{sign}.{digits}f}, {estimate.high:{sign}.{digits}f}]"
 
 
-def _finite_mean(values) -> float:
-    """The mean of the values that are numbers (-inf if none is: a run with no episode yet ranks last)."""
-    x = np.asarray(values, dtype=float)
-    x = x[np.isfinite(x)]
-    return float(x.mean()) if len(x) else -math.inf
-
-
 def ranked(rows: list[Entry]) -> list[Entry]:
     """One task's rows as its table orders them: by AUC, then return, best first."""
-    return sorted(rows, key=lambda e: (-_finite_mean(e.values["auc"]), -_finite_mean(e.values["return"]), e.label))
+    return sorted(rows, key=lambda e: (-finite_mean(e.values["auc"]), -finite_mean(e.values["return"]), e.label))
 
 
 def task_table(rows: list[Entry]) -> list[str]:
@@ -189,7 +184,7 @@ def obstacles_markdown(rows: list[Entry]) -> list[str]:
     from ..task_registry import resolve_task
     from .obstacles import completed_per_100k, method_progress, route
 
-    if not rows or any(_finite_mean(e.values["success"]) >= THRESHOLD for e in rows):
+    if not rows or any(finite_mean(e.values["success"]) >= THRESHOLD for e in rows):
         return []
     found, unread = [], []
     for e in ranked(rows):
@@ -268,7 +263,7 @@ def comparisons_markdown(boards: list[Board]) -> list[str]:
     # a regime's runs are never pooled with another's: each regime's share is read apart
     by_regime = ("By learner regime, decided and not only by all-0/all-1 seeds: " + "; ".join(
         f"`{regime}` {n_decided - n_trivial} of {n}" for regime, (n, n_decided, n_trivial)
-        in sorted(per_regime.items(), key=lambda kv: _regime_order(kv[0]))) + "." if len(per_regime) > 1 else "")
+        in sorted(per_regime.items(), key=lambda kv: regime_order(kv[0]))) + "." if len(per_regime) > 1 else "")
     return ["| rung | world | learner regime | distilled − scratch | difference in success [95% Welch t] "
             "| P(distilled > scratch) [95% bootstrap] | transitions per run | verdict |",
             "|---|---|---|---|---|---|---|---|", *rows, "",
@@ -277,14 +272,6 @@ def comparisons_markdown(boards: list[Board]) -> list[str]:
             "at 0 or at 1: *ahead*/*behind* where the two t-intervals are apart or the "
             "probability's interval excludes one half; *no difference* where the difference's interval lies within "
             f"±{SMALLEST_DIFFERENCE:g}." + (f" {by_regime}" if by_regime else ""), ""]
-
-
-def _regime_order(regime: str) -> tuple:
-    """The regimes' table's order (``craftsuite.regimes``), as the leaderboards list them."""
-    from ..regimes import REGIMES
-
-    order = list(REGIMES)
-    return (order.index(regime) if regime in order else len(order), regime)
 
 
 def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = None, level: int = 3) -> list[str]:

@@ -1,14 +1,21 @@
 """How long a directory's runs took to train, as measured: by the sessions that trained them
 (``provenance.json``: a session stopped part way has no duration) and by the runs
-themselves (``result.json``: a population's training seconds since step 0, across every
-stop and resume, and the machine it finished on)."""
+themselves (``result.json``: each run's share of its populations' wall time since step 0,
+across every stop and resume, and the machine it finished on)."""
 
 from __future__ import annotations
 
 import re
 
+from ..regimes import order
 from ..runs import RunError, read_result
 from .board import Board
+
+
+def _cores(machine: str | None, unknown: str) -> str:
+    """``2 cores`` from a machine as provenance describes it (``Linux x86_64, 2 cores, ...``)."""
+    found = re.search(r"(\d+) cores?", machine or "")
+    return f"{found.group(1)} cores" if found else unknown
 
 
 def wall_time_lines(sessions: list[dict]) -> list[str]:
@@ -23,8 +30,7 @@ def wall_time_lines(sessions: list[dict]) -> list[str]:
         if s.get("seconds") is None:
             unfinished += 1
             continue
-        cores = re.search(r"(\d+) cores?", s.get("machine", ""))
-        kind = f"{cores.group(1)} cores" if cores else "machine unknown"
+        kind = _cores(s.get("machine"), "machine unknown")
         took[kind] = took.get(kind, 0.0) + s["seconds"]
     if not took:
         return []
@@ -35,11 +41,12 @@ def wall_time_lines(sessions: list[dict]) -> list[str]:
 
 
 def training_time_lines(board: Board) -> list[str]:
-    """The training time the board's runs record, per learner regime and per machine (its
-    cores) and device: each population's once (its members share its wall time, so each
-    member counts its share). On a machine that runs one population per core, the wall
-    time is about this divided by the cores. Runs whose records keep only their last
-    session's time are counted apart."""
+    """The training time the board's runs record, per learner regime and per the machine
+    (its cores) and device each finished on: each run's share of its populations' wall time
+    (``seconds_share``), so that a population counts once. On a machine that runs one
+    population per core, the wall time is about this divided by the cores. A run whose
+    record has no share (its time across a stop is not known) counts its last session's
+    wall time divided among its population, and is counted apart."""
     took: dict[str, dict[str, float]] = {}  # regime -> machine and device -> seconds
     runs = partial = 0
     for entry in board:
@@ -48,22 +55,25 @@ def training_time_lines(board: Board) -> list[str]:
                 result = read_result(run)
             except RunError:
                 continue
-            seconds = result.get("seconds", result.get("seconds_this_session"))
-            if not isinstance(seconds, (int, float)):
-                continue
-            cores = re.search(r"(\d+) cores?", result.get("machine", ""))
-            kind = (f"{cores.group(1)} cores, " if cores else "") + result.get("device", "cpu")
+            share = result.get("seconds_share")
+            if share is None:
+                session = result.get("seconds_this_session")
+                if not isinstance(session, (int, float)):
+                    continue
+                share = session / max(1, int(result.get("members", 1)))
+                partial += 1
+            kind = (f"{_cores(result.get('machine'), 'machine not recorded')}, "
+                    f"{result.get('device', 'device not recorded')}")
             mine = took.setdefault(entry.regime, {})
-            mine[kind] = mine.get(kind, 0.0) + seconds / max(1, int(result.get("members", 1)))
+            mine[kind] = mine.get(kind, 0.0) + share
             runs += 1
-            partial += "seconds" not in result
     if not took:
         return []
     parts = ["`" + regime + "` " + ", ".join(f"{seconds / 3600:.1f} h ({kind})"
-                                             for kind, seconds in sorted(kinds.items(), key=lambda kv: -kv[1]))
-             for regime, kinds in took.items()]
-    return [f"- Training time recorded by the {runs} runs, per learner regime (a population's wall time counted "
-            "once, its members sharing it; with a population per core, the wall time on N cores is about this / N): "
-            + "; ".join(parts)
+                                             for kind, seconds in sorted(took[regime].items(), key=lambda kv: -kv[1]))
+             for regime in sorted(took, key=order)]
+    return [f"- Training time recorded by the {runs} runs, per learner regime and the machine each finished on (a "
+            "population's wall time counted once, its members sharing it; with a population per core, the wall time "
+            "on N cores is about this / N): " + "; ".join(parts)
             + (f" ({partial} of the runs come from before their records kept the time across a stop and resume: "
                "their last session's time only)" if partial else "")]

@@ -103,17 +103,19 @@ def test_a_killed_population_resumes_from_its_checkpoint(tmp_path, monkeypatch):
         loaded["replay"] = self.replay.size
 
     monkeypatch.setattr(population_train.Population, "load_states", spy)
-    # the training time the checkpoint records (as if the first session had run 1,000 s)
-    # carries over into the result, beside the resumed session's own
-    for step in tmp_path.glob("*/*/step.json"):
+    # each member's share of the wall time its checkpoint records (as if the first session had
+    # run long) carries over into its result, beside the resumed session's own
+    for k, config in enumerate(configs):
+        [step] = (tmp_path / config.run_name()).glob("*/step.json")
         saved = json.loads(step.read_text())
-        assert saved["num_timesteps"] == 400 and saved["seconds"] > 0
-        step.write_text(json.dumps({**saved, "seconds": 1_000.0}))
+        assert saved["num_timesteps"] == 400 and saved["seconds_share"] > 0
+        step.write_text(json.dumps({**saved, "seconds_share": 1_000.0 * (k + 1)}))
     paths = train_population(configs, tmp_path, progress=False)
     assert loaded == {"steps": [400, 400], "replay": 400}  # resumed with its replay, not from step 0
-    for path, before in zip(paths, first):
+    for k, (path, before) in enumerate(zip(paths, first)):
         result = json.loads((path / "result.json").read_text())
-        assert result["seconds"] == pytest.approx(1_000.0 + result["seconds_this_session"], abs=0.2)
+        # two members share the resumed session's wall time
+        assert result["seconds_share"] == pytest.approx(1_000.0 * (k + 1) + result["seconds_this_session"] / 2, abs=0.2)
         assert result["machine"].split(", ")[1].endswith("cores")
         assert result["updates"] == 2 * (1_200 - 200) // 4  # none lost
         evals = read_csv(path / "evals.csv")
@@ -121,6 +123,18 @@ def test_a_killed_population_resumes_from_its_checkpoint(tmp_path, monkeypatch):
         steps = [int(r["step"]) for r in read_csv(path / "episodes.csv")]
         assert steps == sorted(steps)
         assert len(json.loads((path / "config.json").read_text())["provenance"]) == 2
+
+
+def test_a_run_resumed_from_a_checkpoint_without_its_time_records_no_share(tmp_path, monkeypatch):
+    """A checkpoint written before checkpoints kept the time: the run's time across the stop
+    is not known, so its result says nothing of it rather than this session's alone."""
+    configs = _cell(seeds=(0,))
+    _killed_at_the_second_evaluation(configs, tmp_path, monkeypatch)
+    [step] = (tmp_path / configs[0].run_name()).glob("*/step.json")
+    step.write_text(json.dumps({"num_timesteps": json.loads(step.read_text())["num_timesteps"]}))
+    [path] = train_population(configs, tmp_path, progress=False)
+    result = json.loads((path / "result.json").read_text())
+    assert "seconds_share" not in result and result["seconds_this_session"] > 0
 
 
 def test_a_checkpoint_written_but_not_committed_is_committed_when_resumed(tmp_path, monkeypatch):

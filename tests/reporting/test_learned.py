@@ -26,7 +26,7 @@ def test_learned_rungs_are_counted_per_world_and_the_rest_named(tmp_path):
     cont = next(line for line in lines if line.startswith("| Cont |"))
     learned, short, absent = cont.split(" | ")[1:4]
     assert learned == (f"2 of {len(suite.rungs())}: BlindCraftsman (`td3-dynamic` 0.90 ({2 * budget:,} transitions)); "
-                       "DungeonQuest (`td3-dynamic` 0.97 and 1 more)")
+                       "DungeonQuest (`td3-dynamic` 0.97 and 1 other method)")
     assert short == "none"
     assert absent.rstrip(" |") == ", ".join(s.name for s in suite.rungs()
                                            if s.name not in ("BlindCraftsman", "DungeonQuest"))
@@ -40,3 +40,16 @@ def test_a_rung_nobody_learned_names_its_best_and_an_unknown_suite_has_no_lines(
     cont = next(line for line in learned_markdown(build(tmp_path), "hard") if line.startswith("| Cont |"))
     assert "| BlindCraftsman (best `td3-dynamic` 0.30 (one-step)) |" in cont
     assert learned_markdown(build(tmp_path), "no-such-suite") == []
+
+
+def test_a_rung_names_its_best_at_the_suite_s_own_setting_before_a_better_run_elsewhere(tmp_path):
+    suite = SUITES["hard"]
+    wide = {"hyperparameters": check_regime(suite.regime).settings("td3")}
+    _cell(tmp_path, "DungeonQuest", "td3", [0.9, 0.8, 0.9], 1_000_000, **wide)  # the suite's setting
+    _cell(tmp_path, "DungeonQuest", "td3-dynamic", [1.0, 1.0, 1.0], 1_000_000)  # higher, but one-step
+    _cell(tmp_path, "DungeonQuest", "td3-dynamic", [1.0, 1.0, 1.0], 1_000_000, world_kwargs={"frame_skip": 2},
+          **wide)  # higher, but in another world's settings
+    _cell(tmp_path, "GoldMine", "td3", [0.0, 0.1, 0.2], 1_000_000, world_kwargs={"frame_skip": 2}, **wide)
+    cont = next(line for line in learned_markdown(build(tmp_path), "hard") if line.startswith("| Cont |"))
+    assert "DungeonQuest (`td3` 0.87 and 1 other method)" in cont
+    assert "GoldMine (best `td3` 0.10 (Cont: frame_skip=2))" in cont

@@ -171,13 +171,13 @@ def test_the_runs_training_time_counts_each_population_once_per_machine_and_regi
         record = json.loads((run / "result.json").read_text())
         (run / "result.json").write_text(json.dumps({**record, **result}))
 
-    for seed in range(4):  # a population of 4 that ran 2 h in all, across a stop
-        timed("td3", seed, seconds=7200.0, seconds_this_session=600.0, members=4, device="cpu",
+    for seed in range(4):  # a population of 4 that ran 2 h in all, across a stop: half an hour each
+        timed("td3", seed, seconds_share=1800.0, seconds_this_session=600.0, members=4, device="cpu",
               machine="Linux x86_64, 2 cores, 23.5 GiB, Python 3.11.7")
-    timed("td3-dynamic", 0, seconds=1800.0, members=1, device="cuda", machine="Linux x86_64, 16 cores")
-    timed("td3-dynamic", 1, seconds_this_session=900.0)  # an older record: its last session's time only
+    timed("td3-dynamic", 0, seconds_share=1800.0, members=1, device="cuda", machine="Linux x86_64, 16 cores")
+    timed("td3-dynamic", 1, seconds_this_session=1800.0, members=2)  # an older record: its last session's only
     [line] = training_time_lines(build(tmp_path))
-    assert line.endswith("`one-step` 2.0 h (2 cores, cpu), 0.5 h (16 cores, cuda), 0.2 h (cpu) (1 of the runs come "
-                         "from before their records kept the time across a stop and resume: their last session's "
-                         "time only)")
+    assert line.endswith("`one-step` 2.0 h (2 cores, cpu), 0.5 h (16 cores, cuda), 0.2 h (machine not recorded, "
+                         "device not recorded) (1 of the runs come from before their records kept the time across a "
+                         "stop and resume: their last session's time only)")
     assert line.startswith("- Training time recorded by the 6 runs")

@@ -218,7 +218,7 @@ SUITES = {s.name: s for s in (
           budgets={"Cont": {"easy": 250_000, "medium": 800_000, "KeySwordDragon": 100_000, "ToolHome": 250_000,
                             "TwoToolsHome": 300_000},
                    "Grid": {"easy": 30_000, "medium": 150_000, "KeySwordDragon": 10_000, "ToolHome": 15_000,
-                            "TwoToolsHome": 20_000}},
+                            "TwoToolsHome": 15_000}},
           regime="n-step-wide", **TD3_REGIME, **DQN_REGIME),
     Suite("hard", "the paper's tasks x the paper's methods and baselines at 1M transitions per run in MuJoCo and "
           "on Grid10 at the first budget at which DQN from scratch learns the task (1M until measured), 10 seeds, "

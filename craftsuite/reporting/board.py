@@ -218,6 +218,7 @@ class Board:
     entries: list[Entry]
     unfinished: list[Unfinished] = field(default_factory=list)
     unreadable: list[str] = field(default_factory=list)  # runs whose record is damaged: the file and the reason
+    apart: Board | None = None  # the runs ``build`` was asked to set apart, as a board of their own
 
     def __iter__(self):
         return iter(self.entries)
@@ -244,13 +245,17 @@ class Board:
         return Board([e for e in self.entries if e.regime in mine], [u for u in self.unfinished if u.regime in mine])
 
 
-def build(students_root, *more) -> Board:
+def build(students_root, *more, apart=None) -> Board:
     """The leaderboard of the runs under ``students_root`` (and the ``more`` directories of
     runs beside it: one board of them all): one entry per task, world, method and setting
     (runs that differ in more than the seed are never pooled). A run whose record is
-    damaged is left out and named in ``Board.unreadable``, as is a run found twice."""
+    damaged is left out and named in ``Board.unreadable``, as is a run found twice.
+    ``apart``: a test of a run's ``config.json``; the runs it holds true for make a board of
+    their own, ``Board.apart`` (e.g. a suite's runs at a budget it no longer asks for)."""
     groups: dict[tuple, list[tuple[dict, dict]]] = {}
+    set_apart: dict[tuple, list[tuple[dict, dict]]] = {}
     board = Board([])
+    elsewhere = Board([])
     found: dict[str, Path] = {}
     for root in map(Path, (students_root, *more)):
         for run in sorted(root.iterdir()) if root.is_dir() else []:
@@ -271,10 +276,12 @@ def build(students_root, *more) -> Board:
         try:
             m = run_metrics(run)
             config = read_config(run)
+            away = apart is not None and apart(config)
             if m is None:
                 if not (run / "result.json").exists() and run.name.startswith("student-"):
-                    board.unfinished.append(Unfinished(config["task"], *world_of(config), config["method"],
-                                                       config["seed"], run.name, regime_of(config)))
+                    (elsewhere if away else board).unfinished.append(Unfinished(
+                        config["task"], *world_of(config), config["method"], config["seed"], run.name,
+                        regime_of(config)))
                 continue
         except RunError as err:
             board.unreadable.append(str(err))
@@ -286,7 +293,18 @@ def build(students_root, *more) -> Board:
         # a regime's runs are never variants of another's: each regime is a board of its own (of_regime)
         key = (m["task"], world_label(m["world"], m["world_kwargs"]), m["method"], m["regime"],
                json.dumps(setting, sort_keys=True))
-        groups.setdefault(key, []).append(({**m, "run": run}, setting))
+        (set_apart if away else groups).setdefault(key, []).append(({**m, "run": run}, setting))
+    board.entries = _entries(groups)
+    if apart is not None:
+        elsewhere.entries = _entries(set_apart)
+        board.apart = elsewhere
+    return board
+
+
+def _entries(groups: dict[tuple, list[tuple[dict, dict]]]) -> list[Entry]:
+    """One entry per group of runs (task, world, method, regime, setting); a method's
+    settings on a task, where it has several, told apart as variants."""
+    entries = []
     by_method: dict[tuple, list[tuple]] = {}
     for key in groups:
         by_method.setdefault(key[:4], []).append(key)
@@ -298,7 +316,7 @@ def build(students_root, *more) -> Board:
             runs = sorted((m for m, _ in groups[key]), key=lambda m: m["seed"])
             setting = flatten(groups[key][0][1])
             updates = [r["updates"] for r in runs]
-            board.entries.append(Entry(
+            entries.append(Entry(
                 task, runs[0]["world"], method, [r["seed"] for r in runs], {m: [r[m] for r in runs] for m in METRICS},
                 stats.reached([r["steps_to_80"] for r in runs]), budget=max(r["budget"] for r in runs),
                 updates=None if None in updates else round(float(np.mean(updates))),
@@ -306,7 +324,7 @@ def build(students_root, *more) -> Board:
                 differs={name: setting.get(name, "(not recorded)") for name in differing},
                 runs=[r["run"] for r in runs], world_kwargs=runs[0]["world_kwargs"],
                 lengths=[r["length"] for r in runs], regime=regime))
-    return board
+    return entries
 
 
 def best_run(board: Board, among=None) -> tuple[Path, Entry, int] | None:

@@ -7,6 +7,7 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..suites import SUITES
 from .board import Board, build
 
 
@@ -19,8 +20,28 @@ class RunsDirectory:
     sessions: list[dict]  # the sessions that made it (``provenance.json``; empty: none)
 
 
-def read_runs(path, *, transfer: bool = False) -> RunsDirectory:
-    """The runs under ``path``; ``transfer``: ``path`` must be a transfer output (with ``students/``).
+def superseded(suite):
+    """A test of a run's ``config.json``: a run of ``suite``'s rungs, worlds and learner
+    regime at a budget other than the one the suite asks for now (its budget re-calibrated
+    since the run trained). Such runs stay in the archive but are no longer the suite's cell."""
+    from ..ids import world_kind
+    from .board import regime_of
+
+    rungs = {spec.name: spec for spec in suite.rungs()}
+
+    def test(config: dict) -> bool:
+        spec = rungs.get(config["task"])
+        if spec is None or world_kind(config["world"]) not in {world_kind(w) for w in suite.worlds}:
+            return False
+        return regime_of(config) == suite.regime and config["steps"] != suite.budget(spec, config["world"])
+
+    return test
+
+
+def read_runs(path, *, transfer: bool = False, suite_cells: bool = False) -> RunsDirectory:
+    """The runs under ``path``; ``transfer``: ``path`` must be a transfer output (with ``students/``);
+    ``suite_cells``: in the directory of a suite of this version, its runs at budgets the suite
+    no longer asks for are set apart (``superseded``, ``Board.apart``).
 
     Raises:
         FileNotFoundError: no such directory.
@@ -35,18 +56,24 @@ def read_runs(path, *, transfer: bool = False) -> RunsDirectory:
         raise FileNotFoundError(f"{path} is not a transfer output directory (no students/)")
     if not students.is_dir():
         raise FileNotFoundError(f"no run directory at {path}")
-    board = build(students)
-    if not board.entries:
+    suite = _suite_json(path)
+    asked = SUITES.get(suite.get("name")) if suite_cells else None
+    board = build(students, apart=None if asked is None else superseded(asked))
+    if not board.entries and not (board.apart and board.apart.entries):
         raise ValueError(f"no finished student runs under {students}"
                          + (f" ({len(board.unfinished)} unfinished)" if board.unfinished else "")
                          + "".join(f"; not read: {reason}" for reason in board.unreadable))
-    suite = {}
-    if (path / "suite.json").exists():
-        try:
-            suite = json.loads((path / "suite.json").read_text())
-        except ValueError as err:
-            raise ValueError(f"{path / 'suite.json'} is not valid JSON ({err})") from None
     return RunsDirectory(path, students, board, suite, read(path))
+
+
+def _suite_json(path: Path) -> dict:
+    """The suite as last run into ``path`` (``suite.json``; empty: none)."""
+    if not (path / "suite.json").exists():
+        return {}
+    try:
+        return json.loads((path / "suite.json").read_text())
+    except ValueError as err:
+        raise ValueError(f"{path / 'suite.json'} is not valid JSON ({err})") from None
 
 
 def session_line(session: dict, *, to_the_minute: bool) -> str:

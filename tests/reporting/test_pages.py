@@ -181,3 +181,29 @@ def test_the_runs_training_time_counts_each_population_once_per_machine_and_regi
                          "device not recorded) (1 of the runs come from before their records kept the time across a "
                          "stop and resume: their last session's time only)")
     assert line.startswith("- Training time recorded by the 6 runs")
+
+
+def test_a_suite_s_runs_at_a_budget_it_no_longer_asks_for_are_set_apart_not_pooled(tmp_path):
+    """A rung re-calibrated after its cells ran: the runs at the old budget stay on the page,
+    in a section of their own, and the comparisons read the cells at today's budget."""
+    from craftsuite.regimes import check_regime
+    from craftsuite.suites import SUITES
+
+    suite = SUITES["standard"]
+    spec = next(s for s in suite.rungs() if s.name == "KeySwordDragon")
+    now = suite.budget(spec, "Grid10")
+    wide = check_regime(suite.regime).settings("dqn")
+    root = tmp_path / "standard"
+    (root / "students").mkdir(parents=True)
+    (root / "suite.json").write_text(json.dumps({"name": "standard"}))
+    for budget, scratch, distilled in ((now, 0.3, 0.9), (2 * now, 0.9, 0.9)):
+        for seed in range(3):
+            for method, value in (("dqn", scratch), ("dynamic", distilled)):
+                fake_run(root / "students", method, seed, [(budget, value)], [(budget, 1.0)], budget=budget,
+                         task="KeySwordDragon", world="Grid10", hyperparameters=wide, layout_seed=1)
+    text = write_results_page([root], tmp_path / "results.md").read_text()
+    compared = [line for line in text.splitlines() if line.startswith("| KeySwordDragon | Grid10")]
+    assert len(compared) == 1 and f"| {now:,} | " in compared[0] and "+0.60" in compared[0]
+    assert "(a)" not in text and "(b)" not in text  # never variants of one another
+    apart = text[text.index("### At budgets the suite no longer asks for"):]
+    assert "| dqn | 3 | 0.90 [0.90, 0.90] | 0.90 0.90 0.90 |" in apart and f"{2 * now:,} / " in apart

@@ -12,9 +12,11 @@ from ..suites import SUITES
 from .board import rung_order
 
 
-def coverage_markdown(root: Path, suite_name: str) -> list[str]:
+def coverage_markdown(root: Path, suite_name: str, rates: dict[str, float] | None = None) -> list[str]:
     """Lines of Markdown for the archive directory ``root`` of the suite ``suite_name``; none
-    for a name that is not a suite of this version (an archive of a removed or renamed one)."""
+    for a name that is not a suite of this version (an archive of a removed or renamed one).
+    ``rates``: per world, the transitions per second of one population process
+    (``timing.rates``), from which the time still to train is projected."""
     suite = SUITES.get(suite_name)
     if suite is None:
         return []
@@ -32,7 +34,8 @@ def coverage_markdown(root: Path, suite_name: str) -> list[str]:
     left = sum(c[2] for c in cells.values())
     lines = [f"The suite as defined now ({suite.regime} learner regime, {suite.seeds} seeds a cell) asks for "
              f"{asked:,} student runs; {archived:,} of them are archived here"
-             + (f", and {left / 1e6:,.1f}M transitions are still to train." if left else ", all of them."), ""]
+             + (f", and {left / 1e6:,.1f}M transitions are still to train." if left else ", all of them.")
+             + (" " + _projection(cells, rates) if left and rates else ""), ""]
     if not left:
         return lines
     lines += ["| world | rung | runs archived / asked | transitions to train | methods not yet archived |",
@@ -42,3 +45,19 @@ def coverage_markdown(root: Path, suite_name: str) -> list[str]:
         missing = ", ".join(f"`{m}`" for m in suite.methods if m in methods) or "none"
         lines.append(f"| {world} | {task} | {done} / {total} | {todo / 1e6:,.1f}M | {missing} |")
     return [*lines, ""]
+
+
+def _projection(cells: dict, rates: dict[str, float]) -> str:
+    """The time still to train at the rates the archived runs recorded, per world and in all."""
+    left: dict[str, float] = {}
+    for (world, _), (_, _, todo, _) in cells.items():
+        left[world] = left.get(world, 0.0) + todo
+    known = {w: t / rates[w] for w, t in left.items() if t and rates.get(w)}
+    unknown = sorted(w for w, t in left.items() if t and not rates.get(w))
+    if not known:
+        return ""
+    hours = sum(known.values()) / 3600
+    return ("At the rates its runs recorded on CPUs, one population process each ("
+            + ", ".join(f"{w} {rates[w]:,.0f} transitions/s" for w in sorted(known)) + f"), that is about "
+            f"{hours:,.1f} h of one process, {hours / 2:,.1f} h on 2 cores with a population on each"
+            + (f" ({', '.join(unknown)} not counted: none of its runs recorded its time)" if unknown else "") + ".")

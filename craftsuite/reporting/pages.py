@@ -39,7 +39,7 @@ from .coverage import coverage_markdown
 from .learned import learned_markdown
 from .plots import draw_curves, draw_profiles, file_part, save_figures
 from .sources import read_runs, session_line
-from .timing import training_time_lines, wall_time_lines
+from .timing import rates, training_time_lines, wall_time_lines
 
 # The authors' shipped continuous results, one run each, mean episode reward over the last
 # 5% of 2e6 steps (not the same metric window as ours, nor our MuJoCo world).
@@ -392,7 +392,9 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
                   f"Runs in `{runs.path.as_posix()}`." + _suite_scope(suite), ""]
         lines += [session_line(s, to_the_minute=True) for s in runs.sessions]
         lines += wall_time_lines(runs.sessions) + training_time_lines(board)
-        lines += ["", *coverage_markdown(runs.path, name), *learned_markdown(board, name)] if name in SUITES else []
+        if name in SUITES:
+            lines += ["", *coverage_markdown(runs.path, name, rates(board, SUITES[name].regime)),
+                      *learned_markdown(board, name)]
         if not runs.sessions:
             lines.append(f"- runs in `{runs.path}` (no provenance.json: not made by `craftsuite transfer`)")
         # named after the directory, not the suite: two directories of one suite keep their own plots

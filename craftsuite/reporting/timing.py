@@ -77,3 +77,27 @@ def training_time_lines(board: Board) -> list[str]:
             "on N cores is about this / N): " + "; ".join(parts)
             + (f" ({partial} of the runs come from before their records kept the time across a stop and resume: "
                "their last session's time only)" if partial else "")]
+
+
+def rates(board: Board, regime: str) -> dict[str, float]:
+    """Per world, the transitions per second one population process trained at on a CPU, as
+    the board's runs of ``regime`` recorded it: their transitions over their shares of the
+    wall time (a run's last session's share where its record has no other)."""
+    steps: dict[str, float] = {}
+    seconds: dict[str, float] = {}
+    for entry in board:
+        if entry.regime != regime:
+            continue
+        for run in entry.runs:
+            try:
+                result = read_result(run)
+            except RunError:
+                continue
+            share = result.get("seconds_share")
+            if share is None and isinstance(result.get("seconds_this_session"), (int, float)):
+                share = result["seconds_this_session"] / max(1, int(result.get("members", 1)))
+            if result.get("device", "cpu") != "cpu" or not share:
+                continue
+            steps[entry.world] = steps.get(entry.world, 0.0) + result["steps"]
+            seconds[entry.world] = seconds.get(entry.world, 0.0) + share
+    return {world: steps[world] / seconds[world] for world in steps}

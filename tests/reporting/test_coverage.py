@@ -37,3 +37,32 @@ def test_a_whole_suite_has_no_table_and_an_unknown_one_no_lines(tmp_path):
     lines = coverage_markdown(tmp_path, "quick")
     assert lines[0].endswith("all of them.") and not any(line.startswith("|") for line in lines)
     assert coverage_markdown(tmp_path, "no-such-suite") == []
+
+
+def test_the_time_still_to_train_is_projected_from_the_rates_the_runs_recorded(tmp_path):
+    configs = SUITES["quick"].student_configs(tmp_path / "teachers")
+    left = sum(c.steps for c in configs)  # nothing archived; the quick suite is MuJoCo only
+    line = coverage_markdown(tmp_path, "quick", {"Cont": 1_000.0})[0]
+    hours = left / 1_000 / 3600
+    assert line.endswith(f"At the rates its runs recorded on CPUs, one population process each (Cont 1,000 "
+                         f"transitions/s), that is about {hours:,.1f} h of one process, {hours / 2:,.1f} h on 2 "
+                         "cores with a population on each.")
+    # no rate for the suite's world: no projection
+    assert "At the rates" not in coverage_markdown(tmp_path, "quick", {"Grid10": 1_000.0})[0]
+
+
+def test_rates_are_transitions_over_each_population_s_time_on_cpus(tmp_path):
+    from craftsuite.reporting.board import build
+    from craftsuite.reporting.timing import rates
+
+    from .fakes import fake_run
+
+    for seed in range(2):  # a population of 2: 2 x 1,000 transitions in 4 s of one process
+        run = fake_run(tmp_path, "td3", seed, [(1000, 0.5)], [(995, 1.0)])
+        (run / "result.json").write_text(json.dumps({"kind": "student", "steps": 1000, "seconds_share": 2.0,
+                                                     "members": 2, "device": "cpu"}))
+    run = fake_run(tmp_path, "td3-dynamic", 0, [(1000, 0.5)], [(995, 1.0)])  # on a GPU: not a CPU's rate
+    (run / "result.json").write_text(json.dumps({"kind": "student", "steps": 1000, "seconds_share": 0.1,
+                                                 "device": "cuda"}))
+    assert rates(build(tmp_path), "one-step") == {"Cont": 500.0}
+    assert rates(build(tmp_path), "n-step-wide") == {}

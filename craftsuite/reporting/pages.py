@@ -434,14 +434,14 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
 
 
 def superseded_markdown(board: Board | None) -> list[str]:
-    """The suite's runs at budgets it no longer asks for: a table per task, kept beside the
+    """The suite's runs at budgets it does not ask for now: a table per task, kept beside the
     suite's cells rather than pooled with them or dropped."""
     if not board or not board.entries:
         return []
     lines = ["### At budgets the suite no longer asks for", "",
-             "Runs of the suite's learner regime at a budget it has since re-calibrated (its rung's budget moved "
-             "so that scratch lands between 20% and 80%): kept in the archive, not in the tables, comparisons and "
-             "counts above.", ""]
+             "Runs of the suite's learner regime at a budget other than the one it asks for now (their rung "
+             "re-calibrated since, or a candidate budget its calibration tried): kept in the archive, not in the "
+             "tables, comparisons and counts above.", ""]
     for task, world in sorted({(e.task, e.world_label) for e in board}, key=lambda k: (rung_order(k[0]), k[1])):
         rows = [e for e in board if (e.task, e.world_label) == (task, world)]
         lines += [f"#### {task} ({world})", "", *task_table(rows), ""]

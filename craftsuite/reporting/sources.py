@@ -23,7 +23,8 @@ class RunsDirectory:
 def superseded(suite):
     """A test of a run's ``config.json``: a run of ``suite``'s rungs, worlds and learner
     regime at a budget other than the one the suite asks for now (its budget re-calibrated
-    since the run trained). Such runs stay in the archive but are no longer the suite's cell."""
+    since the run trained, or a candidate its calibration tried). Such runs stay in the
+    archive but are not the suite's cell."""
     from .board import regime_of
 
     rungs = {spec.name: spec for spec in suite.rungs()}

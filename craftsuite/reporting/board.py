@@ -240,7 +240,8 @@ class Board:
 
     def of_regime(self, regime: str) -> Board:
         """The runs of one learner regime, and the self-reported runs beside them (an
-        unreadable record has none to tell: not among them)."""
+        unreadable record has none to tell: not among them; the runs set apart stay with
+        the whole board)."""
         mine = (regime, SELF_REPORTED)
         return Board([e for e in self.entries if e.regime in mine], [u for u in self.unfinished if u.regime in mine])
 

@@ -32,10 +32,11 @@ def coverage_markdown(root: Path, suite_name: str, rates: dict[str, float] | Non
     archived = sum(c[0] for c in cells.values())
     asked = sum(c[1] for c in cells.values())
     left = sum(c[2] for c in cells.values())
+    projected = _projection(cells, rates or {})
     lines = [f"The suite as defined now ({suite.regime} learner regime, {suite.seeds} seeds a cell) asks for "
              f"{asked:,} student runs; {archived:,} of them are archived here"
              + (f", and {left / 1e6:,.1f}M transitions are still to train." if left else ", all of them.")
-             + (" " + _projection(cells, rates) if left and rates else ""), ""]
+             + (f" {projected}" if projected else ""), ""]
     if not left:
         return lines
     lines += ["| world | rung | runs archived / asked | transitions to train | methods not yet archived |",
@@ -57,7 +58,8 @@ def _projection(cells: dict, rates: dict[str, float]) -> str:
     if not known:
         return ""
     hours = sum(known.values()) / 3600
-    return ("At the rates its runs recorded on CPUs, one population process each ("
+    return ("At the rates its runs recorded on CPUs (one population process each, averaged over the methods and "
+            "population sizes that ran: "
             + ", ".join(f"{w} {rates[w]:,.0f} transitions/s" for w in sorted(known)) + f"), that is about "
             f"{hours:,.1f} h of one process, {hours / 2:,.1f} h on 2 cores with a population on each"
-            + (f" ({', '.join(unknown)} not counted: none of its runs recorded its time)" if unknown else "") + ".")
+            + (f" ({', '.join(unknown)} not counted: no run of it recorded its whole time)" if unknown else "") + ".")

@@ -391,10 +391,12 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
         lines += [f"## {name}" + (f": {suite['description']}" if suite.get("description") else ""), "",
                   f"Runs in `{runs.path.as_posix()}`." + _suite_scope(suite), ""]
         lines += [session_line(s, to_the_minute=True) for s in runs.sessions]
-        lines += wall_time_lines(runs.sessions) + training_time_lines(board)
+        # the time and the rungs learned read every run, the suite's cells and those set apart
+        every = Board(board.entries + (board.apart.entries if board.apart else []))
+        lines += wall_time_lines(runs.sessions) + training_time_lines(every)
         if name in SUITES:
-            lines += ["", *coverage_markdown(runs.path, name, rates(board, SUITES[name].regime)),
-                      *learned_markdown(board, name)]
+            lines += ["", *coverage_markdown(runs.path, name, rates(every, SUITES[name].regime)),
+                      *learned_markdown(every, name)]
         if not runs.sessions:
             lines.append(f"- runs in `{runs.path}` (no provenance.json: not made by `craftsuite transfer`)")
         # named after the directory, not the suite: two directories of one suite keep their own plots
@@ -404,7 +406,7 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
         figures.append((images, profiles + curves))
         text = leaderboard_markdown(board, title=None, profiles={
             d.world_label: (images / f"{d.stem}.png").relative_to(path.parent) for d in profiles},
-            aggs=aggs, level=3)
+            aggs=aggs, level=3) if board.entries or board.unfinished else "No run of the suite's cells has finished."
         lines += ["", text.strip(), ""]
         lines += superseded_markdown(board.apart)
         for plot in curves:
@@ -436,15 +438,22 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
 def superseded_markdown(board: Board | None) -> list[str]:
     """The suite's runs at budgets it does not ask for now: a table per task, kept beside the
     suite's cells rather than pooled with them or dropped."""
-    if not board or not board.entries:
+    if not board or not (board.entries or board.unfinished):
         return []
     lines = ["### At budgets the suite no longer asks for", "",
              "Runs of the suite's learner regime at a budget other than the one it asks for now (their rung "
              "re-calibrated since, or a candidate budget its calibration tried): kept in the archive, not in the "
              "tables, comparisons and counts above.", ""]
-    for task, world in sorted({(e.task, e.world_label) for e in board}, key=lambda k: (rung_order(k[0]), k[1])):
-        rows = [e for e in board if (e.task, e.world_label) == (task, world)]
-        lines += [f"#### {task} ({world})", "", *task_table(rows), ""]
+    cells = {(e.task, e.world_label) for e in board} | {(u.task, u.world_label) for u in board.unfinished}
+    for task, world in sorted(cells, key=lambda k: (rung_order(k[0]), k[1])):
+        rows = ranked([e for e in board if (e.task, e.world_label) == (task, world)])
+        waiting = sorted((u.method, u.seed) for u in board.unfinished if (u.task, u.world_label) == (task, world))
+        lines += [f"#### {task} ({world})", "", *(task_table(rows) if rows else [])]
+        lines += [f"- *{e.label}: " + "; ".join(f"{k} = {json.dumps(v)}" for k, v in e.differs.items()) + "*"
+                  for e in rows if e.variant]
+        if waiting:
+            lines += ["", "Unfinished, not counted: " + ", ".join(f"{m} seed {seed}" for m, seed in waiting)]
+        lines.append("")
     return lines
 
 

@@ -59,9 +59,10 @@ def read_runs(path, *, transfer: bool = False, suite_cells: bool = False) -> Run
     suite = _suite_json(path)
     asked = SUITES.get(suite.get("name")) if suite_cells else None
     board = build(students, apart=None if asked is None else superseded(asked))
+    unfinished = len(board.unfinished) + (len(board.apart.unfinished) if board.apart else 0)
     if not board.entries and not (board.apart and board.apart.entries):
         raise ValueError(f"no finished student runs under {students}"
-                         + (f" ({len(board.unfinished)} unfinished)" if board.unfinished else "")
+                         + (f" ({unfinished} unfinished)" if unfinished else "")
                          + "".join(f"; not read: {reason}" for reason in board.unreadable))
     return RunsDirectory(path, students, board, suite, read(path))
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 import re
 
 from ..regimes import order
-from ..runs import RunError, read_result
+from ..runs import RunError, read_config, read_result
 from .board import Board
 
 
@@ -40,33 +40,40 @@ def wall_time_lines(sessions: list[dict]) -> list[str]:
                else "")]
 
 
-def training_time_lines(board: Board) -> list[str]:
-    """The training time the board's runs record, per learner regime and per the machine
-    (its cores) and device each finished on: each run's share of its populations' wall time
-    (``seconds_share``), so that a population counts once. On a machine that runs one
-    population per core, the wall time is about this divided by the cores. A run whose
-    record has no share (its time across a stop is not known) counts its last session's
-    wall time divided among its population, and is counted apart."""
-    took: dict[str, dict[str, float]] = {}  # regime -> machine and device -> seconds
-    runs = partial = 0
+def _timed(board: Board):
+    """Each run of the board with its share of the wall time (``seconds_share``), as
+    ``(entry, result, share, whole)``: ``whole`` where the share covers its whole training,
+    i.e. its record holds one, or it trained in one session (then that session's wall time
+    divided among its population's members is its share). A run resumed before records kept
+    the share has only its last session's: not whole. Runs with no time are left out."""
     for entry in board:
         for run in entry.runs:
             try:
-                result = read_result(run)
+                result, config = read_result(run), read_config(run)
             except RunError:
                 continue
-            share = result.get("seconds_share")
-            if share is None:
-                session = result.get("seconds_this_session")
-                if not isinstance(session, (int, float)):
-                    continue
-                share = session / max(1, int(result.get("members", 1)))
-                partial += 1
-            kind = (f"{_cores(result.get('machine'), 'machine not recorded')}, "
-                    f"{result.get('device', 'device not recorded')}")
-            mine = took.setdefault(entry.regime, {})
-            mine[kind] = mine.get(kind, 0.0) + share
-            runs += 1
+            if isinstance(result.get("seconds_share"), (int, float)):
+                yield entry, result, float(result["seconds_share"]), True
+            elif isinstance(result.get("seconds_this_session"), (int, float)):
+                share = result["seconds_this_session"] / max(1, int(result.get("members", 1)))
+                yield entry, result, share, len(config.get("provenance") or []) == 1
+
+
+def training_time_lines(board: Board) -> list[str]:
+    """The training time the board's runs record, per learner regime and per the machine
+    (its cores) and device each finished on: each run's share of its populations' wall time
+    (``_timed``), so that a population counts once. On a machine that runs one population
+    per core, the wall time is about this divided by the cores. Runs whose share covers
+    only their last session are counted apart."""
+    took: dict[str, dict[str, float]] = {}  # regime -> machine and device -> seconds
+    runs = partial = 0
+    for entry, result, share, whole in _timed(board):
+        kind = (f"{_cores(result.get('machine'), 'machine not recorded')}, "
+                f"{result.get('device', 'device not recorded')}")
+        mine = took.setdefault(entry.regime, {})
+        mine[kind] = mine.get(kind, 0.0) + share
+        runs += 1
+        partial += not whole
     if not took:
         return []
     parts = ["`" + regime + "` " + ", ".join(f"{seconds / 3600:.1f} h ({kind})"
@@ -75,29 +82,21 @@ def training_time_lines(board: Board) -> list[str]:
     return [f"- Training time recorded by the {runs} runs, per learner regime and the machine each finished on (a "
             "population's wall time counted once, its members sharing it; with a population per core, the wall time "
             "on N cores is about this / N): " + "; ".join(parts)
-            + (f" ({partial} of the runs come from before their records kept the time across a stop and resume: "
+            + (f" ({partial} of the runs were stopped and resumed before records kept the time across a stop: "
                "their last session's time only)" if partial else "")]
 
 
 def rates(board: Board, regime: str) -> dict[str, float]:
     """Per world, the transitions per second one population process trained at on a CPU, as
     the board's runs of ``regime`` recorded it: their transitions over their shares of the
-    wall time (a run's last session's share where its record has no other)."""
+    wall time, from the runs whose share covers their whole training (``_timed``). An
+    average over the methods and population sizes that ran (a population of 10 runs more
+    transitions per process than one of 5)."""
     steps: dict[str, float] = {}
     seconds: dict[str, float] = {}
-    for entry in board:
-        if entry.regime != regime:
+    for entry, result, share, whole in _timed(board):
+        if entry.regime != regime or result.get("device") != "cpu" or not whole or share <= 0:
             continue
-        for run in entry.runs:
-            try:
-                result = read_result(run)
-            except RunError:
-                continue
-            share = result.get("seconds_share")
-            if share is None and isinstance(result.get("seconds_this_session"), (int, float)):
-                share = result["seconds_this_session"] / max(1, int(result.get("members", 1)))
-            if result.get("device", "cpu") != "cpu" or not share:
-                continue
-            steps[entry.world] = steps.get(entry.world, 0.0) + result["steps"]
-            seconds[entry.world] = seconds.get(entry.world, 0.0) + share
+        steps[entry.world] = steps.get(entry.world, 0.0) + result["steps"]
+        seconds[entry.world] = seconds.get(entry.world, 0.0) + share
     return {world: steps[world] / seconds[world] for world in steps}

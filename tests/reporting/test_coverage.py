@@ -44,9 +44,9 @@ def test_the_time_still_to_train_is_projected_from_the_rates_the_runs_recorded(t
     left = sum(c.steps for c in configs)  # nothing archived; the quick suite is MuJoCo only
     line = coverage_markdown(tmp_path, "quick", {"Cont": 1_000.0})[0]
     hours = left / 1_000 / 3600
-    assert line.endswith(f"At the rates its runs recorded on CPUs, one population process each (Cont 1,000 "
-                         f"transitions/s), that is about {hours:,.1f} h of one process, {hours / 2:,.1f} h on 2 "
-                         "cores with a population on each.")
+    assert line.endswith("At the rates its runs recorded on CPUs (one population process each, averaged over the "
+                         "methods and population sizes that ran: Cont 1,000 transitions/s), that is about "
+                         f"{hours:,.1f} h of one process, {hours / 2:,.1f} h on 2 cores with a population on each.")
     # no rate for the suite's world: no projection
     assert "At the rates" not in coverage_markdown(tmp_path, "quick", {"Grid10": 1_000.0})[0]
 
@@ -64,5 +64,13 @@ def test_rates_are_transitions_over_each_population_s_time_on_cpus(tmp_path):
     run = fake_run(tmp_path, "td3-dynamic", 0, [(1000, 0.5)], [(995, 1.0)])  # on a GPU: not a CPU's rate
     (run / "result.json").write_text(json.dumps({"kind": "student", "steps": 1000, "seconds_share": 0.1,
                                                  "device": "cuda"}))
+    # older records: their last session's time, whole only where they trained in one session
+    for seed, sessions, seconds in ((0, 1, 4.0), (1, 2, 1.0)):
+        run = fake_run(tmp_path, "td3-static", seed, [(1000, 0.5)], [(995, 1.0)])
+        config = json.loads((run / "config.json").read_text())
+        (run / "config.json").write_text(json.dumps({**config, "provenance": [{"commit": "x"}] * sessions}))
+        (run / "result.json").write_text(json.dumps({"kind": "student", "steps": 1000,
+                                                     "seconds_this_session": seconds, "members": 2, "device": "cpu"}))
+    # 3,000 transitions in 2 + 2 + 2 s: the resumed run's last session alone would read faster than it ran
     assert rates(build(tmp_path), "one-step") == {"Cont": 500.0}
     assert rates(build(tmp_path), "n-step-wide") == {}

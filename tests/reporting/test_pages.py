@@ -2,6 +2,7 @@
 
 import csv
 import json
+import shutil
 
 import pytest
 
@@ -178,8 +179,8 @@ def test_the_runs_training_time_counts_each_population_once_per_machine_and_regi
     timed("td3-dynamic", 1, seconds_this_session=1800.0, members=2)  # an older record: its last session's only
     [line] = training_time_lines(build(tmp_path))
     assert line.endswith("`one-step` 2.0 h (2 cores, cpu), 0.5 h (16 cores, cuda), 0.2 h (machine not recorded, "
-                         "device not recorded) (1 of the runs come from before their records kept the time across a "
-                         "stop and resume: their last session's time only)")
+                         "device not recorded) (1 of the runs were stopped and resumed before records kept the time "
+                         "across a stop: their last session's time only)")
     assert line.startswith("- Training time recorded by the 6 runs")
 
 
@@ -207,3 +208,11 @@ def test_a_suite_s_runs_at_a_budget_it_no_longer_asks_for_are_set_apart_not_pool
     assert "(a)" not in text and "(b)" not in text  # never variants of one another
     apart = text[text.index("### At budgets the suite no longer asks for"):]
     assert "| dqn | 3 | 0.90 [0.90, 0.90] | 0.90 0.90 0.90 |" in apart and f"{2 * now:,} / " in apart
+    # the rungs learned read both: `dqn` learned it only at the old budget
+    assert "KeySwordDragon (`dynamic` 0.90 and 1 other method)" in text
+    # a directory whose finished runs are all set apart still makes a page, and says so
+    for run in (root / "students").iterdir():
+        if json.loads((run / "config.json").read_text())["steps"] == now:
+            shutil.rmtree(run)
+    text = write_results_page([root], tmp_path / "results.md").read_text()
+    assert "No run of the suite's cells has finished." in text and "### At budgets the suite no longer" in text

@@ -4,6 +4,8 @@ archived runs rather than left to be counted from the tables."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from ..methods import scratch
 from ..suites import SUITES
 from .board import THRESHOLD, Board, Entry, finite_mean, world_label
@@ -23,21 +25,33 @@ def _named(entry: Entry, own: tuple[str, int, str]) -> str:
     return f"`{entry.label}` {_mean(entry):.2f}" + (f" ({', '.join(extra)})" if extra else "")
 
 
-def learned_markdown(board: Board, suite_name: str) -> list[str]:
-    """Lines of Markdown: per world of the suite ``suite_name`` (as defined now), the rungs
-    some method learned (mean final greedy success at least ``THRESHOLD``), those whose
-    finished runs none learned (with the best method's mean) and those with no finished run.
-    No lines for a name that is not a suite of this version."""
+@dataclass
+class Learned:
+    """One world of a suite: its rungs some method learned, those whose finished runs none
+    learned and those with no finished run, each as the page names it."""
+
+    world: str
+    rungs: int
+    learned: dict[str, str]  # rung -> the method named, as the page says it
+    short: dict[str, str]  # rung -> its best method, as the page says it
+    absent: list[str]
+
+
+def learned(board: Board, suite_name: str) -> list[Learned]:
+    """Per world of the suite ``suite_name`` (as defined now), the rungs some method learned
+    (mean final greedy success at least ``THRESHOLD``), those whose finished runs none
+    learned (with the best method's mean) and those with no finished run. None for a name
+    that is not a suite of this version (an empty list)."""
     suite = SUITES.get(suite_name)
     if suite is None:
         return []
-    rows = []
+    out = []
     for world in suite.worlds:
-        learned, short, absent = [], [], []
+        row = Learned(world, len(suite.rungs()), {}, {}, [])
         for spec in suite.rungs():
             here = [e for e in board if e.task == spec.name and e.world == world and _mean(e) > -1]
             if not here:
-                absent.append(spec.name)
+                row.absent.append(spec.name)
                 continue
             config = suite.student_config(spec, world, scratch(world))
             own = (suite.regime, config.steps, world_label(world, config.env_kwargs))
@@ -47,12 +61,23 @@ def learned_markdown(board: Board, suite_name: str) -> list[str]:
             if winners:
                 others = len({e.method for e in winners} - {winners[0].method})
                 more = f" and {others} other method{'s' if others > 1 else ''}" if others else ""
-                learned.append(f"{spec.name} ({_named(winners[0], own)}{more})")
+                row.learned[spec.name] = f"{_named(winners[0], own)}{more}"
             else:
-                short.append(f"{spec.name} (best {_named(best[0], own)})")
-        rows.append(f"| {world} | {len(learned)} of {len(suite.rungs())}"
-                    + (": " + "; ".join(learned) if learned else "") + " | " + ("; ".join(short) or "none")
-                    + " | " + (", ".join(absent) or "none") + " |")
+                row.short[spec.name] = f"best {_named(best[0], own)}"
+        out.append(row)
+    return out
+
+
+def learned_markdown(board: Board, suite_name: str) -> list[str]:
+    """Lines of Markdown: ``learned``'s table; no lines for a name that is not a suite."""
+    def named(rungs: dict[str, str]) -> str:
+        return "; ".join(f"{rung} ({text})" for rung, text in rungs.items())
+
+    rows = [f"| {r.world} | {len(r.learned)} of {r.rungs}" + (": " + named(r.learned) if r.learned else "")
+            + " | " + (named(r.short) or "none") + " | " + (", ".join(r.absent) or "none") + " |"
+            for r in learned(board, suite_name)]
+    if not rows:
+        return []
     return [f"Rungs learned: some method's mean final greedy success at least {THRESHOLD:.0%}. Each rung names "
             "one method, the best at the suite's own regime, budget and world where one ran there (else the best "
             "of the others, its setting named), and how many other methods reached it in any setting:", "",

@@ -26,6 +26,7 @@ from .board import (
     SMALLEST_DIFFERENCE,
     Aggregate,
     Board,
+    Comparison,
     Entry,
     aggregates,
     best_run,
@@ -35,8 +36,8 @@ from .board import (
     rung_order,
     verdict,
 )
-from .coverage import coverage_markdown
-from .learned import learned_markdown
+from .coverage import coverage, coverage_markdown
+from .learned import learned, learned_markdown
 from .plots import draw_curves, draw_profiles, file_part, save_figures
 from .sources import read_runs, session_line
 from .timing import rates, training_time_lines, wall_time_lines
@@ -232,38 +233,51 @@ def _comparison_text(entry: Entry, baseline: Entry) -> str:
             f"**{c.verdict}**")
 
 
-def comparisons_markdown(boards: list[Board]) -> list[str]:
+def comparisons(boards: list[Board]) -> list[tuple[Entry, Entry, Comparison | None]]:
     """Every distilled method against its algorithm from scratch, rung by rung, across
-    ``boards``: the difference in final greedy success and the verdict (``board.compare``),
-    and how many rungs decide it."""
-    rows, decided, trivial = [], 0, 0
-    per_regime: dict[str, list[int]] = {}  # regime -> [comparisons, decided, decided only by all-0/all-1 seeds]
+    ``boards`` (easiest rung first): each pair with its verdict (``board.compare``), None
+    where the two ran at other budgets (never set side by side as one comparison)."""
+    out = []
     for board in boards:
         entries = list(board)
         for task, world, regime in sorted({(e.task, e.world_label, e.regime) for e in entries},
                                           key=lambda k: (rung_order(k[0]), k[1], k[2])):
             here = [e for e in entries if (e.task, e.world_label, e.regime) == (task, world, regime)]
-            for entry, base in distilled_against_scratch(here):
-                tally = per_regime.setdefault(regime, [0, 0, 0])
-                tally[0] += 1
-                if entry.budget != base.budget:  # never set side by side as if they were one comparison
-                    rows.append(f"| {task} | {world} | {regime} | `{entry.label}` − `{base.label}` | | "
-                                f"| {entry.budget:,} against {base.budget:,} | not compared: other budgets |")
-                    continue
-                c = compare(entry, base)
-                rows.append(f"| {task} | {world} | {regime} | `{entry.label}` − `{base.label}` "
-                            f"| {_fmt(c.difference, signed=True)} | {_fmt(c.improvement)} | {entry.budget:,} "
-                            f"| {c.verdict} |")
-                decided += c.decided
-                trivial += c.trivial
-                tally[1] += c.decided
-                tally[2] += c.trivial
-    if not rows:
+            out += [(entry, base, compare(entry, base) if entry.budget == base.budget else None)
+                    for entry, base in distilled_against_scratch(here)]
+    return out
+
+
+def decided_by_regime(pairs) -> dict[str, tuple[int, int, int]]:
+    """Per learner regime (a regime's runs are never pooled with another's): the
+    comparisons, those decided, and those decided only because every seed of both sat at 0
+    or at 1, in the regimes' order."""
+    tally: dict[str, list[int]] = {}
+    for entry, _, c in pairs:
+        mine = tally.setdefault(entry.regime, [0, 0, 0])
+        mine[0] += 1
+        mine[1] += bool(c and c.decided)
+        mine[2] += bool(c and c.trivial)
+    return {regime: tuple(tally[regime]) for regime in sorted(tally, key=regime_order)}
+
+
+def comparisons_markdown(boards: list[Board]) -> list[str]:
+    """The table of ``comparisons``: the difference in final greedy success and the verdict
+    of each, and how many decide it."""
+    pairs = comparisons(boards)
+    if not pairs:
         return []
-    # a regime's runs are never pooled with another's: each regime's share is read apart
+    rows = []
+    for entry, base, c in pairs:
+        head = f"| {entry.task} | {entry.world_label} | {entry.regime} | `{entry.label}` − `{base.label}` "
+        rows.append(head + (f"| | | {entry.budget:,} against {base.budget:,} | not compared: other budgets |"
+                            if c is None else f"| {_fmt(c.difference, signed=True)} | {_fmt(c.improvement)} "
+                            f"| {entry.budget:,} | {c.verdict} |"))
+    tally = decided_by_regime(pairs)
+    decided, trivial = sum(t[1] for t in tally.values()), sum(t[2] for t in tally.values())
     by_regime = ("By learner regime, decided and not only by all-0/all-1 seeds: " + "; ".join(
-        f"`{regime}` {n_decided - n_trivial} of {n}" for regime, (n, n_decided, n_trivial)
-        in sorted(per_regime.items(), key=lambda kv: regime_order(kv[0]))) + "." if len(per_regime) > 1 else "")
+        f"`{regime}` {n_decided - n_trivial} of {n}" for regime, (n, n_decided, n_trivial) in tally.items())
+        + "." if len(tally) > 1 else "")
     return ["| rung | world | learner regime | distilled − scratch | difference in success [95% Welch t] "
             "| P(distilled > scratch) [95% bootstrap] | transitions per run | verdict |",
             "|---|---|---|---|---|---|---|---|", *rows, "",
@@ -374,6 +388,7 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
              " do not edit -->", ""]
     # every directory read before anything is written
     directories = [read_runs(d, suite_cells=True) for d in run_dirs]
+    lines += summary_markdown(directories)
     compared = comparisons_markdown([runs.board for runs in directories])
     if compared:
         lines += ["## Distilled against scratch", "",
@@ -392,7 +407,7 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
                   f"Runs in `{runs.path.as_posix()}`." + _suite_scope(suite), ""]
         lines += [session_line(s, to_the_minute=True) for s in runs.sessions]
         # the time and the rungs learned read every run, the suite's cells and those set apart
-        every = Board(board.entries + (board.apart.entries if board.apart else []))
+        every = _every(board)
         lines += wall_time_lines(runs.sessions) + training_time_lines(every)
         if name in SUITES:
             lines += ["", *coverage_markdown(runs.path, name, rates(every, SUITES[name].regime)),
@@ -433,6 +448,43 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
         shutil.copy(video, copy)
     atomic_write(path, "\n".join(lines))
     return path
+
+
+def _every(board: Board) -> Board:
+    """A directory's runs, the suite's cells and those set apart, as one board."""
+    return Board(board.entries + (board.apart.entries if board.apart else []))
+
+
+def summary_markdown(directories) -> list[str]:
+    """The page's answer in three lines, from the sections below: the comparisons decided
+    per learner regime, the rungs some method learned per suite and world, and how much of
+    each suite is archived and still to train."""
+    tally = decided_by_regime(comparisons([runs.board for runs in directories]))
+    lines = []
+    if tally:
+        lines.append("- Distilled against scratch, final greedy success: " + "; ".join(
+            f"`{regime}` {n_decided} of {n} comparisons decided, {n_decided - n_trivial} of them not only because "
+            "every seed of both sat at 0 or at 1" for regime, (n, n_decided, n_trivial) in tally.items()) + ".")
+    learned_parts, coverage_parts = [], []
+    for runs in directories:
+        name = runs.suite.get("name", runs.path.name)
+        if name not in SUITES:
+            continue
+        every = _every(runs.board)
+        learned_parts.append(f"{name}: " + ", ".join(
+            f"{r.world} {len(r.learned)} of {r.rungs}" + (f" ({', '.join(r.learned)})" if r.learned else "")
+            for r in learned(every, name)))
+        found = coverage(runs.path, name, rates(every, SUITES[name].regime))
+        coverage_parts.append(f"{name} {found.archived:,} of {found.asked:,} runs"
+                              + (f" ({found.left / 1e6:,.1f}M transitions to train" + (
+                                  f", about {found.hours / 2:,.1f} h on 2 cores at the rates recorded)"
+                                  if found.hours else ")") if found.left else ""))
+    if learned_parts:
+        lines.append("- Rungs some method learned (mean final greedy success at least "
+                     f"{THRESHOLD:.0%}, in any learner regime or budget: each suite's table names them): "
+                     + "; ".join(learned_parts) + ".")
+        lines.append("- Archived of each suite as defined now: " + "; ".join(coverage_parts) + ".")
+    return ["## In short", "", *lines, ""] if lines else []
 
 
 def superseded_markdown(board: Board | None) -> list[str]:

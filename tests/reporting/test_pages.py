@@ -210,6 +210,12 @@ def test_a_suite_s_runs_at_a_budget_it_no_longer_asks_for_are_set_apart_not_pool
     assert "| dqn | 3 | 0.90 [0.90, 0.90] | 0.90 0.90 0.90 |" in apart and f"{2 * now:,} / " in apart
     # the rungs learned read both: `dqn` learned it only at the old budget
     assert "KeySwordDragon (`dynamic` 0.90 and 1 other method)" in text
+    short = text[text.index("## In short"):text.index("## Distilled against scratch")]
+    assert "- Distilled against scratch, final greedy success: `n-step-wide` 1 of 1 comparisons decided, 1 of " \
+           "them not only because" in short
+    assert ": standard: Grid10 1 of 6 (KeySwordDragon), Cont 0 of 6." in short
+    asked = len(suite.student_configs(root / "teachers"))
+    assert f"- Archived of each suite as defined now: standard 0 of {asked:,} runs (" in short
     # a directory whose finished runs are all set apart still makes a page, and says so
     for run in (root / "students").iterdir():
         if json.loads((run / "config.json").read_text())["steps"] == now:

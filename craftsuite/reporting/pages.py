@@ -358,14 +358,17 @@ def seeds_csv(board: Board) -> str:
 
 def write_leaderboard(board: Board, out) -> Path:
     """``leaderboard.md``, ``leaderboard.csv``, ``seeds.csv`` (a row per run) and the
-    performance profiles in ``out``; returns the Markdown path. All is drawn and rendered
-    before the first file is written."""
+    performance profiles in ``out``; returns the Markdown path. Runs the board set apart
+    (``Board.apart``) follow the leaderboard under their own heading and are rows of the
+    CSVs, their budgets telling them apart. All is drawn and rendered before the first file
+    is written."""
     out = Path(out)
     aggs = aggregates(list(board))
     drawn = draw_profiles(board, aggs)
     profiles = {d.world_label: Path(f"{d.stem}.png") for d in drawn}
-    table, text = leaderboard_csv(board), leaderboard_markdown(board, profiles=profiles, aggs=aggs)
-    per_seed = seeds_csv(board)
+    text = leaderboard_markdown(board, profiles=profiles, aggs=aggs)
+    text = "\n".join([text.rstrip(), "", *superseded_markdown(board.apart)]).rstrip() + "\n"
+    table, per_seed = leaderboard_csv(_every(board)), seeds_csv(_every(board))
     save_figures(drawn, out)
     atomic_write(out / "seeds.csv", per_seed)
     atomic_write(out / "leaderboard.csv", table)

@@ -41,7 +41,8 @@ def superseded(suite):
 def read_runs(path, *, transfer: bool = False, suite_cells: bool = False) -> RunsDirectory:
     """The runs under ``path``; ``transfer``: ``path`` must be a transfer output (with ``students/``);
     ``suite_cells``: in the directory of a suite of this version, its runs at budgets the suite
-    no longer asks for are set apart (``superseded``, ``Board.apart``).
+    no longer asks for are set apart (``superseded``, ``Board.apart``), unless the directory
+    last ran with one budget for every run (``--steps``: ``student_steps`` in its suite.json).
 
     Raises:
         FileNotFoundError: no such directory.
@@ -57,7 +58,8 @@ def read_runs(path, *, transfer: bool = False, suite_cells: bool = False) -> Run
     if not students.is_dir():
         raise FileNotFoundError(f"no run directory at {path}")
     suite = _suite_json(path)
-    asked = SUITES.get(suite.get("name")) if suite_cells else None
+    # a directory trained with every run at one budget (--steps) is not the suite's cells
+    asked = SUITES.get(suite.get("name")) if suite_cells and suite.get("student_steps") is None else None
     board = build(students, apart=None if asked is None else superseded(asked))
     unfinished = len(board.unfinished) + (len(board.apart.unfinished) if board.apart else 0)
     if not board.entries and not (board.apart and board.apart.entries):

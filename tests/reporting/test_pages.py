@@ -184,9 +184,9 @@ def test_the_runs_training_time_counts_each_population_once_per_machine_and_regi
     assert line.startswith("- Training time recorded by the 6 runs")
 
 
-def test_a_suite_s_runs_at_a_budget_it_no_longer_asks_for_are_set_apart_not_pooled(tmp_path):
-    """A rung re-calibrated after its cells ran: the runs at the old budget stay on the page,
-    in a section of their own, and the comparisons read the cells at today's budget."""
+def _rebudgeted(root):
+    """A standard suite directory whose KeySwordDragon Grid10 cells ran at today's budget
+    (scratch 0.3, distilled 0.9) and at twice it (both 0.9); returns today's budget."""
     from craftsuite.regimes import check_regime
     from craftsuite.suites import SUITES
 
@@ -194,7 +194,6 @@ def test_a_suite_s_runs_at_a_budget_it_no_longer_asks_for_are_set_apart_not_pool
     spec = next(s for s in suite.rungs() if s.name == "KeySwordDragon")
     now = suite.budget(spec, "Grid10")
     wide = check_regime(suite.regime).settings("dqn")
-    root = tmp_path / "standard"
     (root / "students").mkdir(parents=True)
     (root / "suite.json").write_text(json.dumps({"name": "standard"}))
     for budget, scratch, distilled in ((now, 0.3, 0.9), (2 * now, 0.9, 0.9)):
@@ -202,6 +201,17 @@ def test_a_suite_s_runs_at_a_budget_it_no_longer_asks_for_are_set_apart_not_pool
             for method, value in (("dqn", scratch), ("dynamic", distilled)):
                 fake_run(root / "students", method, seed, [(budget, value)], [(budget, 1.0)], budget=budget,
                          task="KeySwordDragon", world="Grid10", hyperparameters=wide, layout_seed=1)
+    return now
+
+
+def test_a_suite_s_runs_at_a_budget_it_no_longer_asks_for_are_set_apart_not_pooled(tmp_path):
+    """A rung re-calibrated after its cells ran: the runs at the old budget stay on the page,
+    in a section of their own, and the comparisons read the cells at today's budget."""
+    from craftsuite.suites import SUITES
+
+    suite = SUITES["standard"]
+    root = tmp_path / "standard"
+    now = _rebudgeted(root)
     text = write_results_page([root], tmp_path / "results.md").read_text()
     compared = [line for line in text.splitlines() if line.startswith("| KeySwordDragon | Grid10")]
     assert len(compared) == 1 and f"| {now:,} | " in compared[0] and "+0.60" in compared[0]
@@ -222,3 +232,21 @@ def test_a_suite_s_runs_at_a_budget_it_no_longer_asks_for_are_set_apart_not_pool
             shutil.rmtree(run)
     text = write_results_page([root], tmp_path / "results.md").read_text()
     assert "No run of the suite's cells has finished." in text and "### At budgets the suite no longer" in text
+
+
+def test_one_suite_directory_s_leaderboard_sets_them_apart_too_unless_it_ran_at_one_budget(tmp_path, capsys):
+    from craftsuite.cli import main
+
+    root = tmp_path / "standard"
+    now = _rebudgeted(root)
+    assert main(["leaderboard", str(root)]) == 0
+    text = (root / "leaderboard.md").read_text()
+    assert "### At budgets the suite no longer asks for" in text and "(a)" not in text
+    assert "| dynamic | 3 | 0.90" in text and "| dqn | 3 | 0.30" in text
+    budgets = [row["budget_transitions"] for row in csv.DictReader((root / "leaderboard.csv").open())]
+    assert sorted(budgets) == sorted([str(now)] * 2 + [str(2 * now)] * 2)  # every run a row of the CSVs
+    # a directory trained with --steps (one budget for every run) is not the suite's cells: variants
+    (root / "suite.json").write_text(json.dumps({"name": "standard", "student_steps": now}))
+    assert main(["leaderboard", str(root)]) == 0
+    text = (root / "leaderboard.md").read_text()
+    assert "At budgets the suite" not in text and "dqn (a)" in text

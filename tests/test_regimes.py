@@ -8,7 +8,7 @@ import pytest
 from craftsuite.methods import METHODS
 from craftsuite.regimes import REGIMES, regime_of
 from craftsuite.reporting.board import build
-from craftsuite.reporting.pages import comparisons_markdown, leaderboard_markdown
+from craftsuite.reporting.pages import comparisons, comparisons_markdown, leaderboard_markdown
 from craftsuite.suites import SUITES
 
 from .reporting.fakes import fake_run
@@ -79,6 +79,6 @@ def test_two_regimes_runs_are_two_leaderboards_never_variants(tmp_path):
     md = leaderboard_markdown(board)
     assert "## Learner regime `one-step`" in md and "## Learner regime `n-step`" in md
     assert "#### Cont, n-step regime" in md  # each regime's aggregate apart
-    table = "\n".join(comparisons_markdown([board]))
+    table = "\n".join(comparisons_markdown(comparisons([board])))
     assert "| BlindCraftsman | Cont | one-step | `td3-dynamic` − `td3` | +1.00" in table
     assert "| BlindCraftsman | Cont | n-step | `td3-dynamic` − `td3` | -1.00" in table

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..suites import SUITES
+from ..suites import SUITES, Suite
 from .board import rung_order
 
 
@@ -17,8 +17,10 @@ from .board import rung_order
 class Coverage:
     """How much of a suite, as defined now, an archive holds."""
 
+    suite: Suite
     cells: dict  # (world, task) -> [runs archived, runs asked, transitions to train, methods not archived]
     hours: float | None  # the time still to train at the recorded rates, one population process (None: no rate)
+    unknown: list[str]  # the worlds left to train that no rate covers (not in ``hours``)
     projection: str  # that time in words ("" without it)
 
     @property
@@ -51,17 +53,16 @@ def coverage(root: Path, suite_name: str, rates: dict[str, float] | None = None)
         else:
             cell[2] += config.steps
             cell[3].add(config.method)
-    hours, projection = _projection(cells, rates or {})
-    return Coverage(cells, hours, projection)
+    hours, unknown, projection = _projection(cells, rates or {})
+    return Coverage(suite, cells, hours, unknown, projection)
 
 
-def coverage_markdown(root: Path, suite_name: str, rates: dict[str, float] | None = None) -> list[str]:
+def coverage_markdown(found: Coverage | None) -> list[str]:
     """Lines of Markdown: ``coverage``'s sentence and, while runs are missing, its table per
-    world and rung; none for a name that is not a suite of this version."""
-    suite, found = SUITES.get(suite_name), coverage(root, suite_name, rates)
+    world and rung; none without a coverage (a directory of no suite of this version)."""
     if found is None:
         return []
-    left = found.left
+    suite, left = found.suite, found.left
     lines = [f"The suite as defined now ({suite.regime} learner regime, {suite.seeds} seeds a cell) asks for "
              f"{found.asked:,} student runs; {found.archived:,} of them are archived here"
              + (f", and {left / 1e6:,.1f}M transitions are still to train." if left else ", all of them.")
@@ -77,20 +78,21 @@ def coverage_markdown(root: Path, suite_name: str, rates: dict[str, float] | Non
     return [*lines, ""]
 
 
-def _projection(cells: dict, rates: dict[str, float]) -> tuple[float | None, str]:
-    """The time still to train at the rates the archived runs recorded, in hours of one
-    population process and in words (None and "" where no world left to train has a rate)."""
+def _projection(cells: dict, rates: dict[str, float]) -> tuple[float | None, list[str], str]:
+    """The time still to train at the rates the archived runs recorded: in hours of one
+    population process, the worlds left to train that no rate covers, and in words (None
+    and "" where no world left to train has a rate)."""
     left: dict[str, float] = {}
     for (world, _), (_, _, todo, _) in cells.items():
         left[world] = left.get(world, 0.0) + todo
     known = {w: t / rates[w] for w, t in left.items() if t and rates.get(w)}
     unknown = sorted(w for w, t in left.items() if t and not rates.get(w))
     if not known:
-        return None, ""
+        return None, unknown, ""
     hours = sum(known.values()) / 3600
-    return hours, ("At the rates its runs recorded on CPUs (one population process each, averaged over the methods "
-                   "and population sizes that ran: "
-                   + ", ".join(f"{w} {rates[w]:,.0f} transitions/s" for w in sorted(known)) + f"), that is about "
-                   f"{hours:,.1f} h of one process, {hours / 2:,.1f} h on 2 cores with a population on each"
-                   + (f" ({', '.join(unknown)} not counted: no run of it recorded its whole time)" if unknown else "")
-                   + ".")
+    words = ("At the rates its runs recorded on CPUs (one population process each, averaged over the methods and "
+             "population sizes that ran: "
+             + ", ".join(f"{w} {rates[w]:,.0f} transitions/s" for w in sorted(known)) + f"), that is about "
+             f"{hours:,.1f} h of one process, {hours / 2:,.1f} h on 2 cores with a population on each"
+             + (f" ({', '.join(unknown)} not counted: no run of it recorded its whole time)" if unknown else "") + ".")
+    return hours, unknown, words

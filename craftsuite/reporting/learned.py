@@ -40,8 +40,8 @@ class Learned:
 def learned(board: Board, suite_name: str) -> list[Learned]:
     """Per world of the suite ``suite_name`` (as defined now), the rungs some method learned
     (mean final greedy success at least ``THRESHOLD``), those whose finished runs none
-    learned (with the best method's mean) and those with no finished run. None for a name
-    that is not a suite of this version (an empty list)."""
+    learned (with the best method's mean) and those with no finished run; an empty list for
+    a name that is not a suite of this version."""
     suite = SUITES.get(suite_name)
     if suite is None:
         return []
@@ -68,14 +68,14 @@ def learned(board: Board, suite_name: str) -> list[Learned]:
     return out
 
 
-def learned_markdown(board: Board, suite_name: str) -> list[str]:
-    """Lines of Markdown: ``learned``'s table; no lines for a name that is not a suite."""
+def learned_markdown(found: list[Learned]) -> list[str]:
+    """Lines of Markdown: ``learned``'s table (``found``); none where it has no row."""
     def named(rungs: dict[str, str]) -> str:
         return "; ".join(f"{rung} ({text})" for rung, text in rungs.items())
 
     rows = [f"| {r.world} | {len(r.learned)} of {r.rungs}" + (": " + named(r.learned) if r.learned else "")
             + " | " + (named(r.short) or "none") + " | " + (", ".join(r.absent) or "none") + " |"
-            for r in learned(board, suite_name)]
+            for r in found]
     if not rows:
         return []
     return [f"Rungs learned: some method's mean final greedy success at least {THRESHOLD:.0%}. Each rung names "

@@ -36,8 +36,8 @@ from .board import (
     rung_order,
     verdict,
 )
-from .coverage import coverage, coverage_markdown
-from .learned import learned, learned_markdown
+from .coverage import Coverage, coverage, coverage_markdown
+from .learned import Learned, learned, learned_markdown
 from .plots import draw_curves, draw_profiles, file_part, save_figures
 from .sources import read_runs, session_line
 from .timing import rates, training_time_lines, wall_time_lines
@@ -248,23 +248,28 @@ def comparisons(boards: list[Board]) -> list[tuple[Entry, Entry, Comparison | No
     return out
 
 
-def decided_by_regime(pairs) -> dict[str, tuple[int, int, int]]:
-    """Per learner regime (a regime's runs are never pooled with another's): the
-    comparisons, those decided, and those decided only because every seed of both sat at 0
-    or at 1, in the regimes' order."""
-    tally: dict[str, list[int]] = {}
+def decided_by_regime(pairs) -> dict[str, dict[str, int]]:
+    """Per learner regime (a regime's runs are never pooled with another's), in the regimes'
+    order: the comparisons, how many say *ahead*, *behind* and *no difference*, and how many
+    of those were decided only because every seed of both sat at 0 or at 1."""
+    tally: dict[str, dict[str, int]] = {}
     for entry, _, c in pairs:
-        mine = tally.setdefault(entry.regime, [0, 0, 0])
-        mine[0] += 1
-        mine[1] += bool(c and c.decided)
-        mine[2] += bool(c and c.trivial)
-    return {regime: tuple(tally[regime]) for regime in sorted(tally, key=regime_order)}
+        mine = tally.setdefault(entry.regime, dict.fromkeys(("comparisons", "ahead", "behind", "no difference",
+                                                             "trivial"), 0))
+        mine["comparisons"] += 1
+        if c is not None and c.decided:
+            mine[c.verdict if c.verdict in ("ahead", "behind") else "no difference"] += 1
+            mine["trivial"] += c.trivial
+    return {regime: tally[regime] for regime in sorted(tally, key=regime_order)}
 
 
-def comparisons_markdown(boards: list[Board]) -> list[str]:
-    """The table of ``comparisons``: the difference in final greedy success and the verdict
-    of each, and how many decide it."""
-    pairs = comparisons(boards)
+def _decided(t: dict[str, int]) -> int:
+    return t["ahead"] + t["behind"] + t["no difference"]
+
+
+def comparisons_markdown(pairs) -> list[str]:
+    """The table of ``comparisons`` (``pairs``): the difference in final greedy success and
+    the verdict of each, and how many decide it."""
     if not pairs:
         return []
     rows = []
@@ -274,9 +279,9 @@ def comparisons_markdown(boards: list[Board]) -> list[str]:
                             if c is None else f"| {_fmt(c.difference, signed=True)} | {_fmt(c.improvement)} "
                             f"| {entry.budget:,} | {c.verdict} |"))
     tally = decided_by_regime(pairs)
-    decided, trivial = sum(t[1] for t in tally.values()), sum(t[2] for t in tally.values())
+    decided, trivial = sum(_decided(t) for t in tally.values()), sum(t["trivial"] for t in tally.values())
     by_regime = ("By learner regime, decided and not only by all-0/all-1 seeds: " + "; ".join(
-        f"`{regime}` {n_decided - n_trivial} of {n}" for regime, (n, n_decided, n_trivial) in tally.items())
+        f"`{regime}` {_decided(t) - t['trivial']} of {t['comparisons']}" for regime, t in tally.items())
         + "." if len(tally) > 1 else "")
     return ["| rung | world | learner regime | distilled − scratch | difference in success [95% Welch t] "
             "| P(distilled > scratch) [95% bootstrap] | transitions per run | verdict |",
@@ -324,22 +329,28 @@ def leaderboard_csv(board: Board) -> str:
     writer.writerow(["task", "world", "regime", "method", "variant", "seeds",
                      *(f"{m}{s}" for m in METRICS for s in ("", "_lo", "_hi")),
                      "success_per_seed", "reached_80", "reached_80_median", "differs_in", "budget_transitions",
-                     "updates"])
-    for e in board:
+                     "updates", "set_apart"])
+    for e, apart in _rows(board):
         st = e.stats
         writer.writerow([e.task, e.world_label, e.regime, e.method, e.variant, len(e.seeds),
                          *(("" if math.isnan(v) else v) for m in METRICS
                            for v in (st[m].value, st[m].low, st[m].high)),
                          " ".join(str(v) for v in e.values["success"]), e.reached.k,
                          "" if e.reached.median is None else e.reached.median, " ".join(e.differs), e.budget,
-                         "" if e.updates is None else e.updates])
+                         "" if e.updates is None else e.updates, int(apart)])
     return buf.getvalue()
+
+
+def _rows(board: Board):
+    """The board's entries and then those it set apart (``Board.apart``), each with whether it was."""
+    yield from ((e, False) for e in board)
+    yield from ((e, True) for e in (board.apart or []))
 
 
 # the per-seed export's columns: DeepLTL's published per-seed results' (method, task, seed,
 # success rate, mean steps), then what places a run: its world, budget and learner regime
 SEED_FIELDS = ("method", "task", "seed", "success_rate", "mean_steps", "world", "budget_transitions", "regime",
-               "self_reported")
+               "self_reported", "set_apart")
 
 
 def seeds_csv(board: Board) -> str:
@@ -348,11 +359,11 @@ def seeds_csv(board: Board) -> str:
     buf = io.StringIO()
     writer = csv.writer(buf)
     writer.writerow(SEED_FIELDS)
-    for e in board:
+    for e, apart in _rows(board):
         for seed, success, length in zip(e.seeds, e.values["success"], e.lengths or [math.nan] * len(e.seeds)):
             writer.writerow([e.label, e.task, seed, "" if math.isnan(success) else success,
                              "" if math.isnan(length) else length, e.world_label, e.budget, e.regime,
-                             int(e.self_reported)])
+                             int(e.self_reported), int(apart)])
     return buf.getvalue()
 
 
@@ -360,15 +371,15 @@ def write_leaderboard(board: Board, out) -> Path:
     """``leaderboard.md``, ``leaderboard.csv``, ``seeds.csv`` (a row per run) and the
     performance profiles in ``out``; returns the Markdown path. Runs the board set apart
     (``Board.apart``) follow the leaderboard under their own heading and are rows of the
-    CSVs, their budgets telling them apart. All is drawn and rendered before the first file
-    is written."""
+    CSVs (``set_apart`` 1). All is drawn and rendered before the first file is written."""
     out = Path(out)
     aggs = aggregates(list(board))
     drawn = draw_profiles(board, aggs)
     profiles = {d.world_label: Path(f"{d.stem}.png") for d in drawn}
-    text = leaderboard_markdown(board, profiles=profiles, aggs=aggs)
-    text = "\n".join([text.rstrip(), "", *superseded_markdown(board.apart)]).rstrip() + "\n"
-    table, per_seed = leaderboard_csv(_every(board)), seeds_csv(_every(board))
+    text = (leaderboard_markdown(board, profiles=profiles, aggs=aggs) if board.entries or board.unfinished
+            else "# Leaderboard\n\nNo run of the suite's cells has finished.")
+    text = "\n".join([text.rstrip(), "", *superseded_markdown(board.apart, level=2)]).rstrip() + "\n"
+    table, per_seed = leaderboard_csv(board), seeds_csv(board)
     save_figures(drawn, out)
     atomic_write(out / "seeds.csv", per_seed)
     atomic_write(out / "leaderboard.csv", table)
@@ -391,8 +402,10 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
              " do not edit -->", ""]
     # every directory read before anything is written
     directories = [read_runs(d, suite_cells=True) for d in run_dirs]
-    lines += summary_markdown(directories)
-    compared = comparisons_markdown([runs.board for runs in directories])
+    pairs = comparisons([runs.board for runs in directories])
+    facts = {runs.path: _suite_facts(runs) for runs in directories}
+    lines += summary_markdown(pairs, directories, facts)
+    compared = comparisons_markdown(pairs)
     if compared:
         lines += ["## Distilled against scratch", "",
                   "Each distilled method against its algorithm from scratch on each rung, in final greedy success "
@@ -404,17 +417,14 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
                       "(the sections below aggregate each directory alone):", "", *aggregates_markdown(ladder)]
     figures, videos = [], []  # (images directory, its figures), (video, its copy): written once all is drawn
     for runs in directories:
-        suite, board = runs.suite, runs.board
-        name = suite.get("name", runs.path.name)
+        suite, board, name = runs.suite, runs.board, runs.name
         lines += [f"## {name}" + (f": {suite['description']}" if suite.get("description") else ""), "",
                   f"Runs in `{runs.path.as_posix()}`." + _suite_scope(suite), ""]
         lines += [session_line(s, to_the_minute=True) for s in runs.sessions]
-        # the time and the rungs learned read every run, the suite's cells and those set apart
-        every = _every(board)
-        lines += wall_time_lines(runs.sessions) + training_time_lines(every)
-        if name in SUITES:
-            lines += ["", *coverage_markdown(runs.path, name, rates(every, SUITES[name].regime)),
-                      *learned_markdown(every, name)]
+        lines += wall_time_lines(runs.sessions) + training_time_lines(_every(board))
+        found = facts[runs.path]
+        if found is not None:
+            lines += ["", *coverage_markdown(found[1]), *learned_markdown(found[0])]
         if not runs.sessions:
             lines.append(f"- runs in `{runs.path}` (no provenance.json: not made by `craftsuite transfer`)")
         # named after the directory, not the suite: two directories of one suite keep their own plots
@@ -458,30 +468,45 @@ def _every(board: Board) -> Board:
     return Board(board.entries + (board.apart.entries if board.apart else []))
 
 
-def summary_markdown(directories) -> list[str]:
-    """The page's answer in three lines, from the sections below: the comparisons decided
-    per learner regime, the rungs some method learned per suite and world, and how much of
-    each suite is archived and still to train."""
-    tally = decided_by_regime(comparisons([runs.board for runs in directories]))
+def _suite_facts(runs) -> tuple[list[Learned], Coverage] | None:
+    """For a directory of a suite of this version: the rungs learned and its coverage, both
+    read from every run (the suite's cells and those set apart); None for any other."""
+    if runs.name not in SUITES:
+        return None
+    every = _every(runs.board)
+    return learned(every, runs.name), coverage(runs.path, runs.name, rates(every, SUITES[runs.name].regime))
+
+
+def summary_markdown(pairs, directories, facts) -> list[str]:
+    """The page's answer in three lines, from the sections below: the comparisons per
+    learner regime and their verdicts, the rungs some method learned per suite and world,
+    and how much of each suite is archived and still to train (``facts``: ``_suite_facts``
+    per directory)."""
     lines = []
+    tally = decided_by_regime(pairs)
     if tally:
         lines.append("- Distilled against scratch, final greedy success: " + "; ".join(
-            f"`{regime}` {n_decided} of {n} comparisons decided, {n_decided - n_trivial} of them not only because "
-            "every seed of both sat at 0 or at 1" for regime, (n, n_decided, n_trivial) in tally.items()) + ".")
+            f"`{regime}` {t['comparisons']} comparison{'s' if t['comparisons'] > 1 else ''}: ahead on {t['ahead']}, "
+            f"behind on {t['behind']}, no "
+            f"difference of {SMALLEST_DIFFERENCE:g} or more on {t['no difference']} ({t['trivial']} of them only "
+            f"because every seed of both sat at 0 or at 1), undecided on {t['comparisons'] - _decided(t)}"
+            for regime, t in tally.items()) + ".")
+    names = [runs.name for runs in directories]
     learned_parts, coverage_parts = [], []
     for runs in directories:
-        name = runs.suite.get("name", runs.path.name)
-        if name not in SUITES:
+        if facts[runs.path] is None:
             continue
-        every = _every(runs.board)
+        rows, found = facts[runs.path]
+        # two directories of one suite: each named by its path
+        name = runs.name if names.count(runs.name) == 1 else f"{runs.name} (`{runs.path.as_posix()}`)"
         learned_parts.append(f"{name}: " + ", ".join(
             f"{r.world} {len(r.learned)} of {r.rungs}" + (f" ({', '.join(r.learned)})" if r.learned else "")
-            for r in learned(every, name)))
-        found = coverage(runs.path, name, rates(every, SUITES[name].regime))
-        coverage_parts.append(f"{name} {found.archived:,} of {found.asked:,} runs"
-                              + (f" ({found.left / 1e6:,.1f}M transitions to train" + (
-                                  f", about {found.hours / 2:,.1f} h on 2 cores at the rates recorded)"
-                                  if found.hours else ")") if found.left else ""))
+            for r in rows))
+        left = (f" ({found.left / 1e6:,.1f}M transitions to train"
+                + (f", about {found.hours / 2:,.1f} h on 2 cores at the rates recorded" if found.hours else "")
+                + (f"; {', '.join(found.unknown)} not counted: no rate recorded" if found.hours and found.unknown
+                   else "") + ")") if found.left else ""
+        coverage_parts.append(f"{name} {found.archived:,} of {found.asked:,} runs{left}")
     if learned_parts:
         lines.append("- Rungs some method learned (mean final greedy success at least "
                      f"{THRESHOLD:.0%}, in any learner regime or budget: each suite's table names them): "
@@ -490,20 +515,21 @@ def summary_markdown(directories) -> list[str]:
     return ["## In short", "", *lines, ""] if lines else []
 
 
-def superseded_markdown(board: Board | None) -> list[str]:
+def superseded_markdown(board: Board | None, level: int = 3) -> list[str]:
     """The suite's runs at budgets it does not ask for now: a table per task, kept beside the
-    suite's cells rather than pooled with them or dropped."""
+    suite's cells rather than pooled with them or dropped; their heading at ``level``."""
     if not board or not (board.entries or board.unfinished):
         return []
-    lines = ["### At budgets the suite no longer asks for", "",
+    h = "#" * level
+    lines = [f"{h} At budgets the suite no longer asks for", "",
              "Runs of the suite's learner regime at a budget other than the one it asks for now (their rung "
-             "re-calibrated since, or a candidate budget its calibration tried): kept in the archive, not in the "
-             "tables, comparisons and counts above.", ""]
+             "re-calibrated since, or a candidate budget its calibration tried): kept, but not in the tables, "
+             "comparisons and counts above.", ""]
     cells = {(e.task, e.world_label) for e in board} | {(u.task, u.world_label) for u in board.unfinished}
     for task, world in sorted(cells, key=lambda k: (rung_order(k[0]), k[1])):
         rows = ranked([e for e in board if (e.task, e.world_label) == (task, world)])
         waiting = sorted((u.method, u.seed) for u in board.unfinished if (u.task, u.world_label) == (task, world))
-        lines += [f"#### {task} ({world})", "", *(task_table(rows) if rows else [])]
+        lines += [f"{h}# {task} ({world})", "", *(task_table(rows) if rows else [])]
         lines += [f"- *{e.label}: " + "; ".join(f"{k} = {json.dumps(v)}" for k, v in e.differs.items()) + "*"
                   for e in rows if e.variant]
         if waiting:

@@ -19,6 +19,16 @@ class RunsDirectory:
     suite: dict  # the suite as last run into it (``suite.json``; empty: none)
     sessions: list[dict]  # the sessions that made it (``provenance.json``; empty: none)
 
+    @property
+    def name(self) -> str:
+        """The suite it holds runs of: its suite.json's, else the directory's name
+        (``results/<suite>``)."""
+        return _name(self.suite, self.path)
+
+
+def _name(suite: dict, path: Path) -> str:
+    return suite.get("name", path.name)
+
 
 def superseded(suite):
     """A test of a run's ``config.json``: a run of ``suite``'s rungs, worlds and learner
@@ -38,11 +48,15 @@ def superseded(suite):
     return test
 
 
-def read_runs(path, *, transfer: bool = False, suite_cells: bool = False) -> RunsDirectory:
+def read_runs(path, *, transfer: bool = False, suite_cells: bool = False, unless_steps: bool = False
+              ) -> RunsDirectory:
     """The runs under ``path``; ``transfer``: ``path`` must be a transfer output (with ``students/``);
-    ``suite_cells``: in the directory of a suite of this version, its runs at budgets the suite
-    no longer asks for are set apart (``superseded``, ``Board.apart``), unless the directory
-    last ran with one budget for every run (``--steps``: ``student_steps`` in its suite.json).
+    ``suite_cells``: in the directory of a suite of this version (``RunsDirectory.name``), its
+    runs at budgets the suite no longer asks for are set apart (``superseded``,
+    ``Board.apart``); with ``unless_steps``, not where the directory last ran with one budget
+    for every run other than the suite's own (``--steps``: its suite.json's ``student_steps``).
+    A results archive gathers sessions, so its suite.json says only what the last one ran:
+    the results page sets apart whatever it says.
 
     Raises:
         FileNotFoundError: no such directory.
@@ -58,8 +72,9 @@ def read_runs(path, *, transfer: bool = False, suite_cells: bool = False) -> Run
     if not students.is_dir():
         raise FileNotFoundError(f"no run directory at {path}")
     suite = _suite_json(path)
-    # a directory trained with every run at one budget (--steps) is not the suite's cells
-    asked = SUITES.get(suite.get("name")) if suite_cells and suite.get("student_steps") is None else None
+    asked = SUITES.get(_name(suite, path)) if suite_cells else None
+    if asked is not None and unless_steps and suite.get("student_steps") != asked.student_steps:
+        asked = None  # a directory trained with every run at one budget (--steps) is not the suite's cells
     board = build(students, apart=None if asked is None else superseded(asked))
     unfinished = len(board.unfinished) + (len(board.apart.unfinished) if board.apart else 0)
     if not board.entries and not (board.apart and board.apart.entries):

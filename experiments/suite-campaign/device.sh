@@ -10,13 +10,18 @@
 set -u
 commit=$1
 seconds=$2
+suite=${SUITE:-standard}
+case $suite in standard|hard) ;; *) echo "SUITE must be standard or hard, got $suite" >&2; exit 2 ;; esac
+if [ "$suite" != standard ] && [ -z "${RUNGS:-}" ]; then
+  # every hard cell at once would be 350M transitions: a part names the rungs (and methods) it can finish
+  echo "SUITE=$suite needs RUNGS, e.g. RUNGS=\"--tasks BlindCraftsman --methods td3 td3-dynamic\"" >&2; exit 2
+fi
 out=${OUT:-/tmp/out}
 mkdir -p "$out"
 export PYTHONPATH=${PYTHONPATH:-}:$PWD MUJOCO_GL=disable PYTHONUNBUFFERED=1 CRAFTSUITE_COMMIT=$commit \
   OMP_NUM_THREADS=1 MKL_NUM_THREADS=1
 py=${PYTHON:-python3}
 device=${DEVICE:-cuda}
-suite=${SUITE:-standard}
 end=$(( $(date +%s) + seconds ))
 { echo "cores: $(nproc --all)"; free -g | head -2; nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv 2>&1; } \
   >> "$out/campaign.log"
@@ -44,7 +49,7 @@ if [ "$suite" = standard ]; then
   # the easy rungs' cells take 2.5M transitions each: only where the time left can hold them
   if [ $(( end - $(date +%s) )) -gt 300 ]; then run_part easy 14 --tags easy; fi
 else
-  run_part "$suite" "${WORKERS:-15}" ${RUNGS:-}
+  run_part "$suite" "${WORKERS:-15}" $RUNGS
 fi
 
 # what finished goes into the archive there (unfinished runs are named and skipped)

@@ -249,7 +249,7 @@ def test_a_damaged_record_is_named_by_its_file_and_never_pooled(runs, name, text
 
 def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_path):
     from craftsuite.reporting.board import best_run, compare
-    from craftsuite.reporting.pages import comparisons_markdown
+    from craftsuite.reporting.pages import comparisons, comparisons_markdown
 
     def seeds(method, values, task):
         for seed, value in enumerate(values):
@@ -280,7 +280,7 @@ def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_pa
     assert said("BlindCraftsman").verdict.endswith("(every seed of both at 0)") and said("BlindCraftsman").trivial
     assert said("DungeonQuest").verdict == "too few seeds"
     assert said("Reach").improvement.low == 0.0 and said("Reach").verdict == "undecided"
-    text = "\n".join(comparisons_markdown([board]))
+    text = "\n".join(comparisons_markdown(comparisons([board])))
     assert "Decided (ahead, behind, or no difference of 0.2 or more) on 3 of 6 comparisons, 1 of them only" in text
     assert "| ToolHome | Cont | one-step | `td3-dynamic` − `td3` | -0.80 [" in text
     assert "By learner regime" not in text  # one regime: the sentence above says it all
@@ -293,7 +293,7 @@ def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_pa
 
 def test_each_learner_regime_s_share_of_decided_comparisons_is_read_apart(tmp_path):
     from craftsuite.regimes import check_regime
-    from craftsuite.reporting.pages import comparisons_markdown
+    from craftsuite.reporting.pages import comparisons, comparisons_markdown
 
     wide = check_regime("n-step-wide").settings("td3")
     for seed in range(5):
@@ -301,7 +301,7 @@ def test_each_learner_regime_s_share_of_decided_comparisons_is_read_apart(tmp_pa
         fake_run(tmp_path, "td3-dynamic", seed, [(1000, 0.9 - 0.01 * seed)], [(950, 1.0)], task="ToolHome")
         fake_run(tmp_path, "td3", seed, [(1000, 1.0)], [(950, 1.0)], task="ToolHome", hyperparameters=wide)
         fake_run(tmp_path, "td3-dynamic", seed, [(1000, 1.0)], [(950, 1.0)], task="ToolHome", hyperparameters=wide)
-    text = "\n".join(comparisons_markdown([build(tmp_path)]))
+    text = "\n".join(comparisons_markdown(comparisons([build(tmp_path)])))
     assert "| ToolHome | Cont | n-step-wide | `td3-dynamic` − `td3` | +0.00 [+0.00, +0.00] |" in text
     # both decided; the n-step-wide one only because every seed of both sat at 1
     assert "on 2 of 2 comparisons, 1 of them only" in text

@@ -2,7 +2,7 @@
 
 import json
 
-from craftsuite.reporting.coverage import coverage_markdown
+from craftsuite.reporting.coverage import coverage, coverage_markdown
 from craftsuite.suites import SUITES
 
 
@@ -19,7 +19,7 @@ def test_archived_runs_are_counted_per_cell_and_the_rest_named(tmp_path):
     for config in first:
         _finish(tmp_path, config)
     (tmp_path / "students" / "student-Reach-Cont-td3-s9-0000000000").mkdir()  # unfinished: no result.json
-    lines = coverage_markdown(tmp_path, "quick")
+    lines = coverage_markdown(coverage(tmp_path, "quick"))
     left = sum(c.steps for c in configs) - sum(c.steps for c in first)
     assert lines[0].startswith(f"The suite as defined now (one-step learner regime, {suite.seeds} seeds a cell) "
                                f"asks for {len(configs)} student runs; {len(first)} of them are archived here, "
@@ -34,21 +34,21 @@ def test_archived_runs_are_counted_per_cell_and_the_rest_named(tmp_path):
 def test_a_whole_suite_has_no_table_and_an_unknown_one_no_lines(tmp_path):
     for config in SUITES["quick"].student_configs(tmp_path / "teachers"):
         _finish(tmp_path, config)
-    lines = coverage_markdown(tmp_path, "quick")
+    lines = coverage_markdown(coverage(tmp_path, "quick"))
     assert lines[0].endswith("all of them.") and not any(line.startswith("|") for line in lines)
-    assert coverage_markdown(tmp_path, "no-such-suite") == []
+    assert coverage(tmp_path, "no-such-suite") is None and coverage_markdown(None) == []
 
 
 def test_the_time_still_to_train_is_projected_from_the_rates_the_runs_recorded(tmp_path):
     configs = SUITES["quick"].student_configs(tmp_path / "teachers")
     left = sum(c.steps for c in configs)  # nothing archived; the quick suite is MuJoCo only
-    line = coverage_markdown(tmp_path, "quick", {"Cont": 1_000.0})[0]
+    line = coverage_markdown(coverage(tmp_path, "quick", {"Cont": 1_000.0}))[0]
     hours = left / 1_000 / 3600
     assert line.endswith("At the rates its runs recorded on CPUs (one population process each, averaged over the "
                          "methods and population sizes that ran: Cont 1,000 transitions/s), that is about "
                          f"{hours:,.1f} h of one process, {hours / 2:,.1f} h on 2 cores with a population on each.")
     # no rate for the suite's world: no projection
-    assert "At the rates" not in coverage_markdown(tmp_path, "quick", {"Grid10": 1_000.0})[0]
+    assert "At the rates" not in coverage_markdown(coverage(tmp_path, "quick", {"Grid10": 1_000.0}))[0]
 
 
 def test_rates_are_transitions_over_each_population_s_time_on_cpus(tmp_path):

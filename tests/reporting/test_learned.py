@@ -2,7 +2,7 @@
 
 from craftsuite.regimes import check_regime
 from craftsuite.reporting.board import build
-from craftsuite.reporting.learned import learned_markdown
+from craftsuite.reporting.learned import learned, learned_markdown
 from craftsuite.suites import SUITES
 
 from .fakes import fake_run
@@ -22,10 +22,10 @@ def test_learned_rungs_are_counted_per_world_and_the_rest_named(tmp_path):
     _cell(tmp_path, "DungeonQuest", "td3-static", [0.0, 0.5, 0.0], budget, **wide)  # not
     _cell(tmp_path, "BlindCraftsman", "td3", [0.1, 0.0, 0.2], budget)  # one-step: named so
     _cell(tmp_path, "BlindCraftsman", "td3-dynamic", [0.9, 0.9, 0.9], 2 * budget, **wide)  # another budget: named
-    lines = learned_markdown(build(tmp_path), "hard")
+    lines = learned_markdown(learned(build(tmp_path), "hard"))
     cont = next(line for line in lines if line.startswith("| Cont |"))
-    learned, short, absent = cont.split(" | ")[1:4]
-    assert learned == (f"2 of {len(suite.rungs())}: BlindCraftsman (`td3-dynamic` 0.90 ({2 * budget:,} transitions)); "
+    said, short, absent = cont.split(" | ")[1:4]
+    assert said == (f"2 of {len(suite.rungs())}: BlindCraftsman (`td3-dynamic` 0.90 ({2 * budget:,} transitions)); "
                        "DungeonQuest (`td3-dynamic` 0.97 and 1 other method)")
     assert short == "none"
     assert absent.rstrip(" |") == ", ".join(s.name for s in suite.rungs()
@@ -37,9 +37,9 @@ def test_learned_rungs_are_counted_per_world_and_the_rest_named(tmp_path):
 def test_a_rung_nobody_learned_names_its_best_and_an_unknown_suite_has_no_lines(tmp_path):
     _cell(tmp_path, "BlindCraftsman", "td3", [0.1, 0.0, 0.2], 1_000_000)
     _cell(tmp_path, "BlindCraftsman", "td3-dynamic", [0.3, 0.2, 0.4], 1_000_000)
-    cont = next(line for line in learned_markdown(build(tmp_path), "hard") if line.startswith("| Cont |"))
+    cont = next(line for line in learned_markdown(learned(build(tmp_path), "hard")) if line.startswith("| Cont |"))
     assert "| BlindCraftsman (best `td3-dynamic` 0.30 (one-step)) |" in cont
-    assert learned_markdown(build(tmp_path), "no-such-suite") == []
+    assert learned(build(tmp_path), "no-such-suite") == [] and learned_markdown([]) == []
 
 
 def test_a_rung_names_its_best_at_the_suite_s_own_setting_before_a_better_run_elsewhere(tmp_path):
@@ -50,6 +50,6 @@ def test_a_rung_names_its_best_at_the_suite_s_own_setting_before_a_better_run_el
     _cell(tmp_path, "DungeonQuest", "td3-dynamic", [1.0, 1.0, 1.0], 1_000_000, world_kwargs={"frame_skip": 2},
           **wide)  # higher, but in another world's settings
     _cell(tmp_path, "GoldMine", "td3", [0.0, 0.1, 0.2], 1_000_000, world_kwargs={"frame_skip": 2}, **wide)
-    cont = next(line for line in learned_markdown(build(tmp_path), "hard") if line.startswith("| Cont |"))
+    cont = next(line for line in learned_markdown(learned(build(tmp_path), "hard")) if line.startswith("| Cont |"))
     assert "DungeonQuest (`td3` 0.87 and 1 other method)" in cont
     assert "GoldMine (best `td3` 0.10 (Cont: frame_skip=2))" in cont

@@ -456,7 +456,7 @@ def _leaderboard(args) -> int:
         directory_to_write(args.out, "--out")
     # several directories are one board: a user's runs beside the archive's, on the same rungs;
     # one directory of a suite sets its runs at budgets the suite no longer asks for apart
-    runs = [read_runs(d, suite_cells=len(args.runs) == 1, unless_steps=True) for d in args.runs]
+    runs = [read_runs(d, suite_cells=len(args.runs) == 1) for d in args.runs]
     board = runs[0].board if len(runs) == 1 else build(*(r.students for r in runs))
     out = Path(args.out or runs[0].path)
     curves = draw_curves(board)  # drawn before the leaderboard is written: a failure leaves no part of it

@@ -30,33 +30,45 @@ def _name(suite: dict, path: Path) -> str:
     return suite.get("name", path.name)
 
 
-def superseded(suite):
+def superseded(suite, students: Path):
     """A test of a run's ``config.json``: a run of ``suite``'s rungs, worlds and learner
     regime at a budget other than the one the suite asks for now (its budget re-calibrated
-    since the run trained, or a candidate its calibration tried). Such runs stay in the
-    archive but are not the suite's cell."""
+    since the run trained, or a candidate its calibration tried), on a rung and world whose
+    cell at today's budget has runs under ``students``. Such runs stay in the archive but
+    are not the suite's cell; where the cell has no run (a directory trained with
+    ``--steps``, say), the runs there are the rung's only ones and are not set apart."""
+    from ..runs import RunError, read_config
     from .board import regime_of
 
     rungs = {spec.name: spec for spec in suite.rungs()}
 
+    def mine(config: dict) -> bool | None:
+        """Whether the run is at the suite's budget; None: not a run of the suite's cells."""
+        spec = rungs.get(config.get("task"))
+        if spec is None or config.get("world") not in suite.worlds or regime_of(config) != suite.regime:
+            return None
+        return config["steps"] == suite.budget(spec, config["world"])
+
+    held = set()  # (task, world) whose cell at today's budget has runs here
+    for run in sorted(students.iterdir()) if students.is_dir() else []:
+        try:
+            config = read_config(run)
+            if mine(config):
+                held.add((config["task"], config["world"]))
+        except (RunError, OSError, ValueError, KeyError, TypeError):
+            continue  # build names the damaged records
+
     def test(config: dict) -> bool:
-        spec = rungs.get(config["task"])
-        if spec is None or config["world"] not in suite.worlds:
-            return False
-        return regime_of(config) == suite.regime and config["steps"] != suite.budget(spec, config["world"])
+        return mine(config) is False and (config["task"], config["world"]) in held
 
     return test
 
 
-def read_runs(path, *, transfer: bool = False, suite_cells: bool = False, unless_steps: bool = False
-              ) -> RunsDirectory:
+def read_runs(path, *, transfer: bool = False, suite_cells: bool = False) -> RunsDirectory:
     """The runs under ``path``; ``transfer``: ``path`` must be a transfer output (with ``students/``);
     ``suite_cells``: in the directory of a suite of this version (``RunsDirectory.name``), its
-    runs at budgets the suite no longer asks for are set apart (``superseded``,
-    ``Board.apart``); with ``unless_steps``, not where the directory last ran with one budget
-    for every run other than the suite's own (``--steps``: its suite.json's ``student_steps``).
-    A results archive gathers sessions, so its suite.json says only what the last one ran:
-    the results page sets apart whatever it says.
+    runs at budgets the suite no longer asks for, beside runs at the budget it does, are set
+    apart (``superseded``, ``Board.apart``).
 
     Raises:
         FileNotFoundError: no such directory.
@@ -73,9 +85,7 @@ def read_runs(path, *, transfer: bool = False, suite_cells: bool = False, unless
         raise FileNotFoundError(f"no run directory at {path}")
     suite = _suite_json(path)
     asked = SUITES.get(_name(suite, path)) if suite_cells else None
-    if asked is not None and unless_steps and suite.get("student_steps") != asked.student_steps:
-        asked = None  # a directory trained with every run at one budget (--steps) is not the suite's cells
-    board = build(students, apart=None if asked is None else superseded(asked))
+    board = build(students, apart=None if asked is None else superseded(asked, students))
     unfinished = len(board.unfinished) + (len(board.apart.unfinished) if board.apart else 0)
     if not board.entries and not (board.apart and board.apart.entries):
         raise ValueError(f"no finished student runs under {students}"

@@ -231,12 +231,12 @@ def test_a_suite_s_runs_at_a_budget_it_no_longer_asks_for_are_set_apart_not_pool
     assert f"- Archived of each suite as defined now: standard 0 of {asked:,} runs (" in short
     # the Grid10 runs recorded their time, no Cont run did: the projection says so
     assert "h on 2 cores at the rates recorded; Cont not counted: no rate recorded)." in short
-    # a directory whose finished runs are all set apart still makes a page, and says so
+    # a cell at today's budget that has not finished: the old budget's runs stay apart, the page says so
     for run in (root / "students").iterdir():
         if json.loads((run / "config.json").read_text())["steps"] == now:
-            shutil.rmtree(run)
+            (run / "result.json").unlink()
     text = write_results_page([root], tmp_path / "results.md").read_text()
-    assert "No run of the suite's cells has finished." in text and "### At budgets the suite no longer" in text
+    assert "### At budgets the suite no longer" in text and "No run finished yet; unfinished: dqn seed 0" in text
 
 
 def test_one_suite_directory_s_leaderboard_sets_them_apart_too_unless_it_ran_at_one_budget(tmp_path, capsys):
@@ -250,8 +250,11 @@ def test_one_suite_directory_s_leaderboard_sets_them_apart_too_unless_it_ran_at_
     assert "| dynamic | 3 | 0.90" in text and "| dqn | 3 | 0.30" in text
     budgets = [row["budget_transitions"] for row in csv.DictReader((root / "leaderboard.csv").open())]
     assert sorted(budgets) == sorted([str(now)] * 2 + [str(2 * now)] * 2)  # every run a row of the CSVs
-    # a directory trained with --steps (one budget for every run) is not the suite's cells: variants
-    (root / "suite.json").write_text(json.dumps({"name": "standard", "student_steps": now}))
+    # without a cell at today's budget (a directory trained with --steps, say) its runs are the
+    # rung's only ones: nothing is set apart
+    for run in (root / "students").iterdir():
+        if json.loads((run / "config.json").read_text())["steps"] == now:
+            shutil.rmtree(run)
     assert main(["leaderboard", str(root)]) == 0
     text = (root / "leaderboard.md").read_text()
-    assert "At budgets the suite" not in text and "dqn (a)" in text
+    assert "At budgets the suite" not in text and "| dqn | 3 | 0.90" in text and "(a)" not in text

@@ -412,7 +412,7 @@ class Comparison:
 
     difference: stats.Estimate  # its mean minus the baseline's, with Welch's t-interval
     improvement: stats.Estimate  # P(a run of it beats a run of the baseline), stratified bootstrap
-    verdict: str  # "ahead", "behind", "no difference of 0.2 or more [(...)]", "undecided", "too few seeds"
+    verdict: str  # "ahead[, by less than 0.2]", "behind[, ...]", "no difference of 0.2 or more [(...)]", "undecided", ...
     trivial: bool = False  # decided only because every seed of both sat at 0 (or at 1)
 
     @property
@@ -423,8 +423,10 @@ class Comparison:
 def compare(entry: Entry, baseline: Entry) -> Comparison:
     """``entry`` against ``baseline`` (same task and world) in final greedy success: *ahead*
     or *behind* where their t-intervals are apart or the probability of improvement's
-    interval excludes one half; else *no difference of 0.2 or more* where the interval of
-    the difference lies within +-``SMALLEST_DIFFERENCE``; else *undecided*."""
+    interval excludes one half (*, by less than 0.2* added where the difference's interval
+    also lies within +-``SMALLEST_DIFFERENCE``: a real but small gap); else *no difference of
+    0.2 or more* where the interval of the difference lies within +-``SMALLEST_DIFFERENCE``;
+    else *undecided*."""
     mine, theirs = entry.values["success"], baseline.values["success"]
     diff = stats.difference(mine, theirs)
     try:
@@ -452,6 +454,8 @@ def compare(entry: Entry, baseline: Entry) -> Comparison:
             return Comparison(diff, better, said, trivial=True)
     else:
         said = "undecided"
+    if said in ("ahead", "behind") and -SMALLEST_DIFFERENCE < diff.low and diff.high < SMALLEST_DIFFERENCE:
+        said += f", by less than {SMALLEST_DIFFERENCE:g}"
     return Comparison(diff, better, said)
 
 

@@ -258,7 +258,7 @@ def decided_by_regime(pairs) -> dict[str, dict[str, int]]:
                                                              "trivial"), 0))
         mine["comparisons"] += 1
         if c is not None and c.decided:
-            mine[c.verdict if c.verdict in ("ahead", "behind") else "no difference"] += 1
+            mine[c.verdict.split(",")[0] if c.verdict.startswith(("ahead", "behind")) else "no difference"] += 1
             mine["trivial"] += c.trivial
     return {regime: tally[regime] for regime in sorted(tally, key=regime_order)}
 
@@ -289,8 +289,9 @@ def comparisons_markdown(pairs) -> list[str]:
             f"Decided (ahead, behind, or no difference of {SMALLEST_DIFFERENCE:g} or more) on "
             f"{decided} of {len(rows)} comparisons, {trivial} of them only because every seed of both sat "
             "at 0 or at 1: *ahead*/*behind* where the two t-intervals are apart or the "
-            "probability's interval excludes one half; *no difference* where the difference's interval lies within "
-            f"±{SMALLEST_DIFFERENCE:g}." + (f" {by_regime}" if by_regime else ""), ""]
+            "probability's interval excludes one half (with *by less than "
+            f"{SMALLEST_DIFFERENCE:g}* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g} as well); "
+            f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}." + (f" {by_regime}" if by_regime else ""), ""]
 
 
 def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = None, level: int = 3) -> list[str]:

@@ -307,3 +307,23 @@ def test_each_learner_regime_s_share_of_decided_comparisons_is_read_apart(tmp_pa
     assert "on 2 of 2 comparisons, 1 of them only" in text
     assert text.rstrip().endswith("By learner regime, decided and not only by all-0/all-1 seeds: `one-step` 1 of 1; "
                                   "`n-step-wide` 0 of 1.")
+
+
+def test_a_decided_gap_smaller_than_the_smallest_difference_is_named_as_small(tmp_path):
+    from craftsuite.reporting.board import compare
+    from craftsuite.reporting.pages import comparisons, decided_by_regime
+
+    for seed in range(5):  # every seed of scratch at 1; the distilled student a little short on most
+        fake_run(tmp_path, "td3", seed, [(1000, 1.0)], [(950, 1.0)], task="ToolHome", world="Cont")
+        fake_run(tmp_path, "td3-dynamic", seed, [(1000, (1.0, 0.9, 0.85, 0.95, 0.9)[seed])], [(950, 1.0)],
+                 task="ToolHome", world="Cont")
+        fake_run(tmp_path, "td3", seed, [(1000, 0.1)], [(950, 1.0)], task="FirstTool", world="Cont")  # a wide gap
+        fake_run(tmp_path, "td3-dynamic", seed, [(1000, 0.9)], [(950, 1.0)], task="FirstTool", world="Cont")
+    board = build(tmp_path)
+    e = {(x.task, x.method): x for x in board}
+    small = compare(e["ToolHome", "td3-dynamic"], e["ToolHome", "td3"])
+    assert small.verdict == "behind, by less than 0.2"
+    assert -0.2 < small.difference.low and small.difference.high < 0.2 and small.improvement.high < 0.5
+    assert compare(e["FirstTool", "td3-dynamic"], e["FirstTool", "td3"]).verdict == "ahead"  # 0.8: no qualifier
+    [tally] = decided_by_regime(comparisons([board])).values()
+    assert (tally["ahead"], tally["behind"], tally["no difference"]) == (1, 1, 0)

@@ -412,7 +412,9 @@ class Comparison:
 
     difference: stats.Estimate  # its mean minus the baseline's, with Welch's t-interval
     improvement: stats.Estimate  # P(a run of it beats a run of the baseline), stratified bootstrap
-    verdict: str  # "ahead[, by less than 0.2]", "behind[, ...]", "no difference of 0.2 or more [(...)]", "undecided", ...
+    # "ahead" or "behind" (", by less than 0.2" where that too), "no difference of 0.2 or more [(...)]",
+    # "undecided", "too few seeds"
+    verdict: str
     trivial: bool = False  # decided only because every seed of both sat at 0 (or at 1)
 
     @property

@@ -4,6 +4,7 @@ archived runs rather than left to be counted from the tables."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from ..methods import scratch
@@ -49,7 +50,8 @@ def learned(board: Board, suite_name: str) -> list[Learned]:
     for world in suite.worlds:
         row = Learned(world, len(suite.rungs()), {}, {}, [])
         for spec in suite.rungs():
-            here = [e for e in board if e.task == spec.name and e.world == world and _mean(e) > -1]
+            # an entry with no finite final success (every run unfinished or unread) names nothing
+            here = [e for e in board if e.task == spec.name and e.world == world and math.isfinite(_mean(e))]
             if not here:
                 row.absent.append(spec.name)
                 continue

@@ -291,7 +291,8 @@ def comparisons_markdown(pairs) -> list[str]:
             "at 0 or at 1: *ahead*/*behind* where the two t-intervals are apart or the "
             "probability's interval excludes one half (with *by less than "
             f"{SMALLEST_DIFFERENCE:g}* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g} as well); "
-            f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}." + (f" {by_regime}" if by_regime else ""), ""]
+            f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}."
+            + (f" {by_regime}" if by_regime else ""), ""]
 
 
 def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = None, level: int = 3) -> list[str]:

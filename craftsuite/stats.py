@@ -87,6 +87,29 @@ def difference(x, y, level: float = LEVEL) -> Estimate:
     return Estimate(d, d - half, d + half)
 
 
+def seeds_to_resolve(x, y, smallest: float, level: float = LEVEL) -> int | None:
+    """The seeds a side at which Welch's interval of mean(x) - mean(y) would either exclude
+    zero or lie within +-``smallest``, if the difference and the spreads measured held: a
+    planning figure for an undecided comparison (how many seeds would decide it), not a
+    promise (a spread measured on 10 seeds is itself uncertain). None where it cannot be
+    said: fewer than ``MIN_SEEDS_FOR_INTERVAL`` values on a side, or no spread at all."""
+    from scipy import stats
+
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if min(len(x), len(y)) < MIN_SEEDS_FOR_INTERVAL or not (np.isfinite(x).all() and np.isfinite(y).all()):
+        return None
+    d, spread = abs(float(x.mean() - y.mean())), float(x.var(ddof=1) + y.var(ddof=1))
+    if spread == 0:
+        return None
+    margin = max(d, smallest - d)  # the nearer of the two ways to decide
+    n = max(MIN_SEEDS_FOR_INTERVAL, math.ceil((stats.norm.ppf(0.5 + level / 2) / margin) ** 2 * spread))
+    # the normal quantile underestimates a small n's t quantile (Welch's dof with equal n and
+    # spreads: 2n - 2): step up until the t-interval's half-width fits
+    while stats.t.ppf(0.5 + level / 2, 2 * n - 2) * math.sqrt(spread / n) >= margin:
+        n += 1
+    return n
+
+
 def iqm(values) -> float:
     """The interquartile mean: the mean of the middle 50% of ``values`` (all runs of all
     tasks, flattened), as rliable defines it (``scipy.stats.trim_mean`` cutting 25% from

@@ -85,3 +85,23 @@ def test_the_estimates_agree_with_rliable():
     theirs, bands = rly.create_performance_profile({"x": x}, taus, reps=2000)
     assert value == pytest.approx(theirs["x"])
     assert np.abs(low - bands["x"][0]).max() <= 0.1 and np.abs(high - bands["x"][1]).max() <= 0.1
+
+
+def test_seeds_to_resolve_is_where_the_welch_interval_starts_to_decide():
+    def decides(x, y) -> bool:
+        d = stats.difference(x, y)
+        return d.low > 0 or d.high < 0 or (-0.2 < d.low and d.high < 0.2)
+
+    def tile(values, k):  # k seeds with about the same mean and spread
+        return (values * (k // len(values) + 1))[:k]
+
+    # bimodal seeds, as success rates are: a gap of 0.25 (x) and of 0.05 (z, decided as no difference)
+    x, y, z = [0.0, 1.0] * 2 + [1.0], [0.0, 0.0, 1.0, 0.0] + [1.0], [0.0, 1.0, 1.0, 0.0, 0.0]
+    for a, b in ((x, y), (z, y)):
+        assert not decides(a, b)
+        n = stats.seeds_to_resolve(a, b, 0.2)
+        assert n > len(a)
+        assert decides(tile(a, int(n * 1.3)), tile(b, int(n * 1.3)))
+        assert not decides(tile(a, int(n * 0.7)), tile(b, int(n * 0.7)))
+    assert stats.seeds_to_resolve([1.0] * 5, [1.0] * 5, 0.2) is None  # no spread: nothing to extrapolate
+    assert stats.seeds_to_resolve([0.0, 1.0], [1.0, 0.0], 0.2) is None  # too few seeds to read a spread

@@ -416,6 +416,9 @@ class Comparison:
     # "undecided", "too few seeds"
     verdict: str
     trivial: bool = False  # decided only because every seed of both sat at 0 (or at 1)
+    # undecided: the seeds a side that would decide it if the difference and spreads held
+    # (``stats.seeds_to_resolve``); None where decided or not to be said
+    seeds_to_decide: int | None = None
 
     @property
     def decided(self) -> bool:
@@ -455,7 +458,8 @@ def compare(entry: Entry, baseline: Entry) -> Comparison:
             said += " (every seed of both at 0)" if mine[0] == 0 else " (every seed of both at 1)"
             return Comparison(diff, better, said, trivial=True)
     else:
-        said = "undecided"
+        return Comparison(diff, better, "undecided",
+                          seeds_to_decide=stats.seeds_to_resolve(mine, theirs, SMALLEST_DIFFERENCE))
     if said in ("ahead", "behind") and -SMALLEST_DIFFERENCE < diff.low and diff.high < SMALLEST_DIFFERENCE:
         said += f", by less than {SMALLEST_DIFFERENCE:g}"
     return Comparison(diff, better, said)

@@ -267,6 +267,13 @@ def _decided(t: dict[str, int]) -> int:
     return t["ahead"] + t["behind"] + t["no difference"]
 
 
+def _seeds_to_decide(c: Comparison, entry: Entry, base: Entry) -> str:
+    if c.seeds_to_decide is None:
+        return ""
+    now = min(len(entry.values["success"]), len(base.values["success"]))
+    return f" (at these means and spreads: about {c.seeds_to_decide} seeds a side, against {now})"
+
+
 def comparisons_markdown(pairs) -> list[str]:
     """The table of ``comparisons`` (``pairs``): the difference in final greedy success and
     the verdict of each, and how many decide it."""
@@ -277,7 +284,7 @@ def comparisons_markdown(pairs) -> list[str]:
         head = f"| {entry.task} | {entry.world_label} | {entry.regime} | `{entry.label}` − `{base.label}` "
         rows.append(head + (f"| | | {entry.budget:,} against {base.budget:,} | not compared: other budgets |"
                             if c is None else f"| {_fmt(c.difference, signed=True)} | {_fmt(c.improvement)} "
-                            f"| {entry.budget:,} | {c.verdict} |"))
+                            f"| {entry.budget:,} | {c.verdict}{_seeds_to_decide(c, entry, base)} |"))
     tally = decided_by_regime(pairs)
     decided, trivial = sum(_decided(t) for t in tally.values()), sum(t["trivial"] for t in tally.values())
     by_regime = ("By learner regime, decided and not only by all-0/all-1 seeds: " + "; ".join(
@@ -291,8 +298,9 @@ def comparisons_markdown(pairs) -> list[str]:
             "at 0 or at 1: *ahead*/*behind* where the two t-intervals are apart or the "
             "probability's interval excludes one half (with *by less than "
             f"{SMALLEST_DIFFERENCE:g}* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g} as well); "
-            f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}."
-            + (f" {by_regime}" if by_regime else ""), ""]
+            f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}. An undecided "
+            "row says how many seeds a side would decide it if its means and spreads held (a planning figure: "
+            "a spread read from 10 seeds is itself uncertain)." + (f" {by_regime}" if by_regime else ""), ""]
 
 
 def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = None, level: int = 3) -> list[str]:

@@ -277,12 +277,15 @@ def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_pa
     assert compare(e["ToolHome", "td3"], e["ToolHome", "td3-dynamic"]).verdict == "ahead"
     assert said("FirstTool").verdict == "no difference of 0.2 or more" and not said("FirstTool").trivial
     assert said("TwoToolsHome").verdict == "undecided" and not said("TwoToolsHome").decided
+    assert said("TwoToolsHome").seeds_to_decide > 5 and said("ToolHome").seeds_to_decide is None
     assert said("BlindCraftsman").verdict.endswith("(every seed of both at 0)") and said("BlindCraftsman").trivial
     assert said("DungeonQuest").verdict == "too few seeds"
     assert said("Reach").improvement.low == 0.0 and said("Reach").verdict == "undecided"
     text = "\n".join(comparisons_markdown(comparisons([board])))
     assert "Decided (ahead, behind, or no difference of 0.2 or more) on 3 of 6 comparisons, 1 of them only" in text
     assert "| ToolHome | Cont | one-step | `td3-dynamic` − `td3` | -0.80 [" in text
+    need = said("TwoToolsHome").seeds_to_decide
+    assert f"| undecided (at these means and spreads: about {need} seeds a side, against 5) |" in text
     assert "By learner regime" not in text  # one regime: the sentence above says it all
     # the best run: the highest final success, then the hardest rung, then the return
     run, entry, i = best_run(board)

@@ -344,6 +344,8 @@ def _transfer(args) -> int:
                                  ("methods", tuple(map(resolve_method, args.methods)) if args.methods else None),
                                  ("teacher_max_steps", args.teacher_steps), ("eval_every", args.eval_every))
                if v is not None}
+    if args.seeds is not None:  # every cell that many, the rungs the suite gives more seeds too
+        changes["rung_seeds"] = {}
     worlds = list(changes.get("worlds", suite.worlds))
     if args.env and CONT not in worlds:
         raise ValueError(f"--env sets the MuJoCo students' world ({CONT}); these worlds have none: {worlds}")

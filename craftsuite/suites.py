@@ -28,6 +28,9 @@ class Suite:
     worlds: tuple[str, ...] = ("Cont",)  # student worlds: "Cont" (MuJoCo), "Grid10", "Grid7"
     methods: tuple[str, ...] = ("td3",)  # each runs in the worlds its METHODS row is for
     seeds: int = 5
+    # more seeds on some rungs, by world kind and rung name ({"Grid": {"ToolHome": 20}}): where
+    # a cell is cheap enough to run to the seeds its comparisons need (experiments/twenty-seeds)
+    rung_seeds: dict = field(default_factory=dict)
     # each run's budget in transitions, by world kind and rung level (TaskSpec.level), e.g.
     # {"Cont": {"easy": 150_000, "hard": 100_000}, "Grid": {...}}: the two worlds' students
     # collect at different rates and learn at different rates per transition. A rung's own
@@ -98,6 +101,13 @@ class Suite:
                              "budget (--steps N, Suite.student_steps) or tag the task with a level the suite has")
         return self.budgets[kind][spec.level]
 
+    def seeds_for(self, spec: TaskSpec, world: str) -> int:
+        """The seeds of a rung's cells in a world."""
+        return self.rung_seeds.get(world_kind(world), {}).get(spec.name, self.seeds)
+
+    def seeds_text(self) -> str:
+        return seeds_text(self.seeds, self.rung_seeds)
+
     def n_envs(self, world: str) -> int:
         """The envs a student steps side by side in ``world`` (its collection regime)."""
         return self.td3_n_envs if world_kind(world) == CONT else self.dqn_n_envs
@@ -129,7 +139,8 @@ class Suite:
                     table = None
                     if METHODS[method].needs_table:
                         table = str((Path(teacher_root) / teachers[spec.name].run_name() / "table.npz").resolve())
-                    out += [self.student_config(spec, world, method, seed, table) for seed in range(self.seeds)]
+                    out += [self.student_config(spec, world, method, seed, table)
+                            for seed in range(self.seeds_for(spec, world))]
         if not out:
             raise ValueError(f"no method of {list(self.methods)} runs in the worlds {list(self.worlds)} "
                              f"({', '.join(f'{w}: {methods_for(w)}' for w in self.worlds)})")
@@ -156,6 +167,14 @@ class Suite:
             # counterfactual replay relabels it (crm-edges)
             automaton_state=None if self.students_see_automaton or not METHODS[method].distill
             or METHODS[method].crm else False, engine=self.engine)
+
+
+def seeds_text(seeds: int, rung_seeds: dict) -> str:
+    """``10 seeds a cell (20 on KeySwordDragon, ToolHome in Grid worlds)``: a suite's seeds (as
+    defined, or as a ``suite.json`` recorded them), as a page says them."""
+    more = "; ".join(f"{n} on {', '.join(names)} in {kind} worlds" for kind, by in rung_seeds.items()
+                     for n in sorted(set(by.values())) for names in [[r for r, m in by.items() if m == n]])
+    return f"{seeds} seed{'s' if seeds > 1 else ''} a cell" + (f" ({more})" if more else "")
 
 
 # The collection regimes measured to learn most per wall-clock second on two cores
@@ -212,9 +231,10 @@ SUITES = {s.name: s for s in (
           tasks=("Reach", "FirstTool"), worlds=("Cont",), methods=("td3", "td3-dynamic-edges"), seeds=2,
           budgets={"Cont": {"easy": 200_000, "medium": 800_000}}, archived=False, **TD3_REGIME),
     Suite("standard", "the easy, medium and middle rungs x the paper's methods and baselines, Grid10 and MuJoCo, "
-          "10 seeds, in the n-step-wide learner regime (on 2 cores many hours: run it in parts, with --worlds, "
-          "--tasks or --methods; the paper's tasks are the hard suite)",
+          "10 seeds (20 on Grid10's middle rungs), in the n-step-wide learner regime (on 2 cores many hours: run it "
+          "in parts, with --worlds, --tasks or --methods; the paper's tasks are the hard suite)",
           tags=("easy", "medium"), worlds=("Grid10", "Cont"), methods=SUITE_METHODS, seeds=10,
+          rung_seeds={"Grid": {"KeySwordDragon": 20, "ToolHome": 20, "TwoToolsHome": 20}},
           budgets={"Cont": {"easy": 250_000, "medium": 800_000, "KeySwordDragon": 100_000, "ToolHome": 250_000,
                             "TwoToolsHome": 300_000},
                    "Grid": {"easy": 30_000, "medium": 150_000, "KeySwordDragon": 10_000, "ToolHome": 15_000,

@@ -125,6 +125,9 @@ def test_transfer_flags_reach_the_suite(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(["transfer", "--suite", "standard", "--tasks", "Reach", "--worlds", "Grid10", "--methods", "dqn"]) == 0
     assert seen[-1].name == "standard" and outs[-1] == "runs/standard"
+    # --seeds N: every cell N, the rungs the suite gives more seeds too
+    assert main(["transfer", "--suite", "standard", "--tasks", "ToolHome", "--worlds", "Grid10", "--seeds", "3"]) == 0
+    assert {c.seed for c in seen[-1].student_configs(tmp_path)} == {0, 1, 2}
 
 
 def test_suites_are_well_formed(tmp_path):
@@ -170,7 +173,13 @@ def test_suites_are_well_formed(tmp_path):
     # every TD3 method of the transfer suite gets the same replay, small enough for CRM's copies
     assert {c.hyperparameters["buffer_size"] for c in transfer if c.world == "Cont"} == {200_000}
     assert {c.table is not None for c in transfer if c.method.endswith("crm-edges")} == {True}
-    assert {c.seed for c in standard} == set(range(10))
+    seeds = {}  # 10 seeds a cell, 20 on Grid10's three cheap middle rungs
+    for c in standard:
+        seeds.setdefault((c.task, c.world, c.method), set()).add(c.seed)
+    middle = {"KeySwordDragon", "ToolHome", "TwoToolsHome"}
+    assert {cell: max(s) + 1 for cell, s in seeds.items()} == {
+        cell: 20 if cell[1] == "Grid10" and cell[0] in middle else 10 for cell in seeds}
+    assert all(s == set(range(max(s) + 1)) for s in seeds.values())
     budgets, specs = SUITES["standard"].budgets, {s.name: s for s in ladder()}
     for c in standard:
         table = budgets["Cont" if c.world == "Cont" else "Grid"]

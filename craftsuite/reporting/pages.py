@@ -17,7 +17,7 @@ from ..ids import CONT, world_kind
 from ..regimes import describe
 from ..regimes import order as regime_order
 from ..runs import RunError, read_config, read_result
-from ..suites import SUITES
+from ..suites import SUITES, seeds_text
 from ..archive import size as archive_size
 from .board import (
     METRICS,
@@ -583,5 +583,5 @@ def _suite_scope(suite: dict) -> str:
         if suite.get(key):
             parts.append(f"{word} {', '.join(suite[key])}")
     if suite.get("seeds"):
-        parts.append(f"{suite['seeds']} seed{'s' if suite['seeds'] > 1 else ''}")
+        parts.append(seeds_text(suite["seeds"], suite.get("rung_seeds") or {}))
     return f" As last run: {'; '.join(parts)}." if parts else ""

@@ -74,3 +74,10 @@ def test_rates_are_transitions_over_each_population_s_time_on_cpus(tmp_path):
     # 3,000 transitions in 2 + 2 + 2 s: the resumed run's last session alone would read faster than it ran
     assert rates(build(tmp_path), "one-step") == {"Cont": 500.0}
     assert rates(build(tmp_path), "n-step-wide") == {}
+
+
+def test_a_rung_with_more_seeds_asks_for_them(tmp_path):
+    line, *rows = coverage_markdown(coverage(tmp_path, "standard"))
+    assert line.startswith("The suite as defined now (n-step-wide learner regime, 10 seeds a cell (20 on "
+                           "KeySwordDragon, ToolHome, TwoToolsHome in Grid worlds)) asks for ")
+    assert "| Grid10 | ToolHome | 0 / 140 |" in "\n".join(rows) and "| Cont | ToolHome | 0 / 70 |" in "\n".join(rows)

@@ -254,10 +254,13 @@ def test_suites_train_each_cell_as_one_population():
     from craftsuite.suite_runner import cells
     from craftsuite.suites import SUITES
 
-    configs = SUITES["standard"].student_configs("teachers")
-    jobs = cells(configs)
-    assert all(len(job) == SUITES["standard"].seeds for job in jobs)
-    assert sorted(c.seed for c in jobs[0]) == list(range(SUITES["standard"].seeds))
+    from craftsuite.task_registry import resolve_task
+
+    standard = SUITES["standard"]
+    jobs = cells(standard.student_configs("teachers"))
+    assert all(len(job) == standard.seeds_for(resolve_task(job[0].task), job[0].world) for job in jobs)
+    assert {len(job) for job in jobs} == {10, 20}  # 20 on the Grid10 middle rungs
+    assert all(sorted(c.seed for c in job) == list(range(len(job))) for job in jobs)
     assert {c.engine for s in SUITES.values() for c in s.student_configs("teachers")} == {"population"}
     sb3 = [dataclasses.replace(c, engine="sb3") for c in SUITES["paper"].student_configs("teachers")]
     assert len(cells(sb3)) == len(sb3)  # one job per SB3 run: each reused alone

@@ -102,17 +102,23 @@ def suite_projection(name: str, rates: dict, cores: int = 2) -> str:
     from craftsuite.ids import parse_id
     from craftsuite.methods import METHODS
 
+    from craftsuite.task_registry import resolve_task
+
     suite = SUITES[name]
-    members = min(rates, key=lambda m: (abs(m - suite.seeds), -m))
     configs = suite.student_configs("teachers")
-    seconds = 0.0
+    seconds, used = 0.0, set()
     for c in configs:
+        # each cell's seeds are one population: the measured size nearest them
+        seeds = suite.seeds_for(resolve_task(c.task), c.world)
+        members = min(rates, key=lambda m: (abs(m - seeds), -m))
+        used.add(members)
         kind = (parse_id(c.env_id)[1].rstrip("0123456789"), METHODS[c.method].crm)
         seconds += c.steps / rates[members].get(kind, rates[members].get((kind[0], False), float("nan")))
     total = sum(c.steps for c in configs)
     return (f"The `{name}` suite's students ({len(configs)} runs, {total:,} transitions, {suite.regime} regime) "
-            f"at these rates on {cores} cores: {seconds / cores / 3600:.1f} h ({suite.seeds} seeds a population, "
-            f"projected from the populations of {members}; from one process alone, teachers and evaluations not "
+            f"at these rates on {cores} cores: {seconds / cores / 3600:.1f} h ({suite.seeds_text()}, each cell a "
+            f"population, projected from the populations of {' and '.join(map(str, sorted(used)))}; from one "
+            "process alone, teachers and evaluations not "
             "counted; on 2 cores two grid populations kept about these rates, two MuJoCo populations about half "
             "each).")
 

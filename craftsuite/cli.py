@@ -637,7 +637,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="override the student worlds (Cont, Kinematic: TD3 methods; Grid10, Grid7: DQN methods)")
     p.add_argument("--methods", nargs="+", metavar="METHOD",
                    help=f"override the suite's methods: any of {methods}, or module:name (a row of your own)")
-    p.add_argument("--seeds", type=_positive, help="override the number of seeds")
+    p.add_argument("--seeds", type=_positive, help="override the number of seeds: every cell this many, the "
+                   "rungs the suite gives more seeds too")
     p.add_argument("--steps", type=_positive, help="one student budget for every rung (transitions)")
     p.add_argument("--teacher-steps", type=_positive, help="override the teacher's step limit")
     p.add_argument("--eval-every", type=_positive, help="override the students' evaluation interval (transitions; "

@@ -88,26 +88,47 @@ def difference(x, y, level: float = LEVEL) -> Estimate:
 
 
 def seeds_to_resolve(x, y, smallest: float, level: float = LEVEL) -> int | None:
-    """The seeds a side at which Welch's interval of mean(x) - mean(y) would either exclude
-    zero or lie within +-``smallest``, if the difference and the spreads measured held: a
-    planning figure for an undecided comparison (how many seeds would decide it), not a
-    promise (a spread measured on 10 seeds is itself uncertain). None where it cannot be
-    said: fewer than ``MIN_SEEDS_FOR_INTERVAL`` values on a side, or no spread at all."""
+    """The seeds a side at which a comparison of x against y would be decided by the results
+    page's interval rules (``reporting.board.compare``), if the difference and the spreads
+    measured held: the two t-intervals of the means apart (ahead or behind), or Welch's
+    interval of the difference within +-``smallest`` (no difference), whichever comes
+    first. A planning figure for an undecided comparison, not a promise: a spread read from a
+    handful of seeds is itself uncertain, and the probability of improvement, the page's
+    other route to *ahead* or *behind*, is not modelled (it can decide sooner). None where it
+    cannot be said: fewer than ``MIN_SEEDS_FOR_INTERVAL`` values on a side, no spread at
+    all, or no number of seeds that would decide it."""
     from scipy import stats
 
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     if min(len(x), len(y)) < MIN_SEEDS_FOR_INTERVAL or not (np.isfinite(x).all() and np.isfinite(y).all()):
         return None
-    d, spread = abs(float(x.mean() - y.mean())), float(x.var(ddof=1) + y.var(ddof=1))
-    if spread == 0:
+    d = abs(float(x.mean() - y.mean()))
+    vx, vy = float(x.var(ddof=1)), float(y.var(ddof=1))
+    if vx + vy == 0:
         return None
-    margin = max(d, smallest - d)  # the nearer of the two ways to decide
-    n = max(MIN_SEEDS_FOR_INTERVAL, math.ceil((stats.norm.ppf(0.5 + level / 2) / margin) ** 2 * spread))
-    # the normal quantile underestimates a small n's t quantile (Welch's dof with equal n and
-    # spreads: 2n - 2): step up until the t-interval's half-width fits
-    while stats.t.ppf(0.5 + level / 2, 2 * n - 2) * math.sqrt(spread / n) >= margin:
-        n += 1
-    return n
+    q = 0.5 + level / 2
+
+    def apart(n: int) -> bool:  # each mean's t-interval, n - 1 degrees of freedom
+        return stats.t.ppf(q, n - 1) * (math.sqrt(vx) + math.sqrt(vy)) / math.sqrt(n) < d
+
+    def within(n: int) -> bool:  # Welch's interval of the difference at n a side, its own degrees of freedom
+        dof = (n - 1) * (vx + vy) ** 2 / (vx**2 + vy**2)
+        return stats.t.ppf(q, dof) * math.sqrt((vx + vy) / n) < smallest - d
+
+    def first(decides) -> int | None:  # each rule's half-width shrinks with n: double, then halve
+        low, high = MIN_SEEDS_FOR_INTERVAL - 1, MIN_SEEDS_FOR_INTERVAL
+        while not decides(high):
+            if high > 1_000_000:
+                return None
+            low, high = high, high * 2
+        while high - low > 1:
+            mid = (low + high) // 2
+            low, high = (low, mid) if decides(mid) else (mid, high)
+        return high
+
+    found = [n for n in (first(apart) if d > 0 else None, first(within) if smallest > d else None)
+             if n is not None]
+    return min(found) if found else None
 
 
 def iqm(values) -> float:

@@ -169,12 +169,20 @@ class Suite:
             or METHODS[method].crm else False, engine=self.engine)
 
 
-def seeds_text(seeds: int, rung_seeds: dict) -> str:
-    """``10 seeds a cell (20 on KeySwordDragon, ToolHome in Grid worlds)``: a suite's seeds (as
-    defined, or as a ``suite.json`` recorded them), as a page says them."""
-    more = "; ".join(f"{n} on {', '.join(names)} in {kind} worlds" for kind, by in rung_seeds.items()
-                     for n in sorted(set(by.values())) for names in [[r for r, m in by.items() if m == n]])
-    return f"{seeds} seed{'s' if seeds > 1 else ''} a cell" + (f" ({more})" if more else "")
+def seeds_text(seeds: int, rung_seeds: dict, worlds=None, tasks=None) -> str:
+    """``10 seeds a cell, 20 on KeySwordDragon, ToolHome in the grid worlds``: a suite's seeds
+    (as defined, or as a ``suite.json`` recorded them), as a page says them; ``worlds`` and
+    ``tasks``, where given, limit the rungs named to those that ran."""
+    kinds = None if worlds is None else {world_kind(w) for w in worlds}
+    more = []
+    for kind, by in rung_seeds.items():
+        by = {r: n for r, n in by.items() if tasks is None or r in tasks}
+        if kinds is not None and kind not in kinds:
+            continue
+        for n in sorted(set(by.values())):
+            where = "the grid worlds" if kind == "Grid" else f"{kind} worlds"
+            more.append(f"{n} on {', '.join(r for r, m in by.items() if m == n)} in {where}")
+    return f"{seeds} seed{'s' if seeds > 1 else ''} a cell" + "".join(f", {m}" for m in more)
 
 
 # The collection regimes measured to learn most per wall-clock second on two cores

@@ -180,6 +180,16 @@ def test_suites_are_well_formed(tmp_path):
     assert {cell: max(s) + 1 for cell, s in seeds.items()} == {
         cell: 20 if cell[1] == "Grid10" and cell[0] in middle else 10 for cell in seeds}
     assert all(s == set(range(max(s) + 1)) for s in seeds.values())
+    from craftsuite.ids import world_kind
+    from craftsuite.suites import seeds_text
+
+    for each in SUITES.values():  # a misspelt world kind or rung would be silently ignored
+        kinds, names = {world_kind(w) for w in each.worlds}, {r.name for r in each.rungs()}
+        assert all(kind in kinds and set(by) <= names for kind, by in each.rung_seeds.items()), each.name
+    more = SUITES["standard"].rung_seeds
+    assert seeds_text(10, more) == "10 seeds a cell, 20 on KeySwordDragon, ToolHome, TwoToolsHome in the grid worlds"
+    assert seeds_text(10, more, worlds=["Cont"]) == seeds_text(10, {}) == "10 seeds a cell"  # only what ran
+    assert seeds_text(10, more, tasks=["ToolHome", "Reach"]) == "10 seeds a cell, 20 on ToolHome in the grid worlds"
     budgets, specs = SUITES["standard"].budgets, {s.name: s for s in ladder()}
     for c in standard:
         table = budgets["Cont" if c.world == "Cont" else "Grid"]

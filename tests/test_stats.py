@@ -87,21 +87,25 @@ def test_the_estimates_agree_with_rliable():
     assert np.abs(low - bands["x"][0]).max() <= 0.1 and np.abs(high - bands["x"][1]).max() <= 0.1
 
 
-def test_seeds_to_resolve_is_where_the_welch_interval_starts_to_decide():
-    def decides(x, y) -> bool:
-        d = stats.difference(x, y)
-        return d.low > 0 or d.high < 0 or (-0.2 < d.low and d.high < 0.2)
+def test_seeds_to_resolve_is_where_the_pages_interval_rules_start_to_decide():
+    def like(values, n):  # n seeds with exactly the mean and sample spread of ``values``
+        v = np.asarray(values, dtype=float)
+        pattern = np.linspace(-1.0, 1.0, n)
+        return v.mean() + v.std(ddof=1) * (pattern - pattern.mean()) / pattern.std(ddof=1)
 
-    def tile(values, k):  # k seeds with about the same mean and spread
-        return (values * (k // len(values) + 1))[:k]
+    def decides(x, y) -> bool:  # the page's interval rules: t-intervals apart, or the difference within +-0.2
+        a, b, d = stats.t_interval(x), stats.t_interval(y), stats.difference(x, y)
+        return a.low > b.high or b.low > a.high or (-0.2 < d.low and d.high < 0.2)
 
-    # bimodal seeds, as success rates are: a gap of 0.25 (x) and of 0.05 (z, decided as no difference)
-    x, y, z = [0.0, 1.0] * 2 + [1.0], [0.0, 0.0, 1.0, 0.0] + [1.0], [0.0, 1.0, 1.0, 0.0, 0.0]
-    for a, b in ((x, y), (z, y)):
-        assert not decides(a, b)
-        n = stats.seeds_to_resolve(a, b, 0.2)
-        assert n > len(a)
-        assert decides(tile(a, int(n * 1.3)), tile(b, int(n * 1.3)))
-        assert not decides(tile(a, int(n * 0.7)), tile(b, int(n * 0.7)))
+    cases = [([0.23, 0.87, 1, 0.85, 0.57, 0.5, 0.78, 1, 0.92, 0.56], [1, 0, 0, 0, 0, 0, 1, 0, 0, 1]),  # a gap of 0.43
+             ([0.0, 1.0, 1.0, 1.0, 0.5], [0.0, 0.0, 1.0, 0.0, 0.5]),  # 0.4, bimodal, unequal spreads
+             ([0.0, 1.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.1, 0.2]),  # 0.14: only "no difference" can decide
+             ([0.9, 1.0, 0.8, 1.0, 0.95], [0.9, 0.85, 1.0, 1.0, 0.7])]  # close and tight
+    for x, y in cases:
+        n = stats.seeds_to_resolve(x, y, 0.2)
+        assert n is not None and decides(like(x, n), like(y, n)) and not decides(like(x, n - 1), like(y, n - 1))
+    # the first case is decided by Welch's interval at 10 seeds, but not by the page's rules: more seeds it says
+    assert stats.difference(*cases[0]).low > 0 and stats.seeds_to_resolve(*cases[0], 0.2) > 10
     assert stats.seeds_to_resolve([1.0] * 5, [1.0] * 5, 0.2) is None  # no spread: nothing to extrapolate
     assert stats.seeds_to_resolve([0.0, 1.0], [1.0, 0.0], 0.2) is None  # too few seeds to read a spread
+    assert stats.seeds_to_resolve([0.0, 1.0, 1.0], [0.0, 1.0, 1.0], 0.0) is None  # no gap, no margin: never

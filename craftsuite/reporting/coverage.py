@@ -63,7 +63,7 @@ def coverage_markdown(found: Coverage | None) -> list[str]:
     if found is None:
         return []
     suite, left = found.suite, found.left
-    lines = [f"The suite as defined now ({suite.regime} learner regime, {suite.seeds_text()}) asks for "
+    lines = [f"The suite as defined now ({suite.regime} learner regime; {suite.seeds_text()}) asks for "
              f"{found.asked:,} student runs; {found.archived:,} of them are archived here"
              + (f", and {left / 1e6:,.1f}M transitions are still to train." if left else ", all of them.")
              + (f" {found.projection}" if found.projection else ""), ""]

@@ -271,6 +271,8 @@ def _seeds_to_decide(c: Comparison, entry: Entry, base: Entry) -> str:
     if c.seeds_to_decide is None:
         return ""
     now = min(len(entry.values["success"]), len(base.values["success"]))
+    if c.seeds_to_decide <= now:  # the page's clipped intervals and the bootstrap differ from the model: no figure
+        return ""
     return f" (at these means and spreads: about {c.seeds_to_decide} seeds a side, against {now})"
 
 
@@ -299,8 +301,9 @@ def comparisons_markdown(pairs) -> list[str]:
             "probability's interval excludes one half (with *by less than "
             f"{SMALLEST_DIFFERENCE:g}* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g} as well); "
             f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}. An undecided "
-            "row says how many seeds a side would decide it if its means and spreads held (a planning figure: "
-            "a spread read from 10 seeds is itself uncertain)." + (f" {by_regime}" if by_regime else ""), ""]
+            "row says how many seeds a side the interval rules would need to decide it if its means and spreads held "
+            "(a planning figure: a spread read from a handful of seeds is itself uncertain)."
+            + (f" {by_regime}" if by_regime else ""), ""]
 
 
 def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = None, level: int = 3) -> list[str]:
@@ -583,5 +586,6 @@ def _suite_scope(suite: dict) -> str:
         if suite.get(key):
             parts.append(f"{word} {', '.join(suite[key])}")
     if suite.get("seeds"):
-        parts.append(seeds_text(suite["seeds"], suite.get("rung_seeds") or {}))
+        parts.append(seeds_text(suite["seeds"], suite.get("rung_seeds") or {}, suite.get("worlds"),
+                                suite.get("tasks") if not suite.get("tags") else None))
     return f" As last run: {'; '.join(parts)}." if parts else ""

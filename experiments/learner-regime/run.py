@@ -92,7 +92,9 @@ def configs(suite: str, wave: int, ns: dict[str, int | None],
     out = []
     if suite not in WAVES[wave]:
         return out
-    for c in SUITES[suite].student_configs(Path("unused-teachers")):  # scratch methods read no table
+    # the suite's seeds a cell as this experiment read them (not the Grid10 middle rungs' 20 of twenty-seeds)
+    plain = dataclasses.replace(SUITES[suite], rung_seeds={})
+    for c in plain.student_configs(Path("unused-teachers")):  # scratch methods read no table
         if c.task in RUNGS[suite] and SCRATCH.get(c.world) == c.method:
             for name, overrides in settings_for(wave, c.world, ns[c.world], (winners or {}).get(c.world)).items():
                 out.append((name, dataclasses.replace(c, hyperparameters={**c.hyperparameters, **overrides})))

@@ -21,7 +21,7 @@ def test_archived_runs_are_counted_per_cell_and_the_rest_named(tmp_path):
     (tmp_path / "students" / "student-Reach-Cont-td3-s9-0000000000").mkdir()  # unfinished: no result.json
     lines = coverage_markdown(coverage(tmp_path, "quick"))
     left = sum(c.steps for c in configs) - sum(c.steps for c in first)
-    assert lines[0].startswith(f"The suite as defined now (one-step learner regime, {suite.seeds} seeds a cell) "
+    assert lines[0].startswith(f"The suite as defined now (one-step learner regime; {suite.seeds} seeds a cell) "
                                f"asks for {len(configs)} student runs; {len(first)} of them are archived here, "
                                f"and {left / 1e6:,.1f}M transitions are still to train.")
     reach = next(line for line in lines if "| Reach |" in line)
@@ -78,6 +78,6 @@ def test_rates_are_transitions_over_each_population_s_time_on_cpus(tmp_path):
 
 def test_a_rung_with_more_seeds_asks_for_them(tmp_path):
     line, *rows = coverage_markdown(coverage(tmp_path, "standard"))
-    assert line.startswith("The suite as defined now (n-step-wide learner regime, 10 seeds a cell (20 on "
-                           "KeySwordDragon, ToolHome, TwoToolsHome in Grid worlds)) asks for ")
+    assert line.startswith("The suite as defined now (n-step-wide learner regime; 10 seeds a cell, 20 on "
+                           "KeySwordDragon, ToolHome, TwoToolsHome in the grid worlds) asks for ")
     assert "| Grid10 | ToolHome | 0 / 140 |" in "\n".join(rows) and "| Cont | ToolHome | 0 / 70 |" in "\n".join(rows)

@@ -253,10 +253,12 @@ def decided_by_regime(pairs) -> dict[str, dict[str, int]]:
     order: the comparisons, how many say *ahead*, *behind* and *no difference*, and how many
     of those were decided only because every seed of both sat at 0 or at 1."""
     tally: dict[str, dict[str, int]] = {}
-    for entry, _, c in pairs:
-        mine = tally.setdefault(entry.regime, dict.fromkeys(("comparisons", "ahead", "behind", "no difference",
-                                                             "trivial"), 0))
+    for entry, base, c in pairs:
+        mine = tally.setdefault(entry.regime, {**dict.fromkeys(("comparisons", "ahead", "behind", "no difference",
+                                                                "trivial"), 0), "seeds to decide": []})
         mine["comparisons"] += 1
+        if c is not None and _needed(c, entry, base):
+            mine["seeds to decide"].append(_needed(c, entry, base))
         if c is not None and c.decided:
             mine[c.verdict.split(",")[0] if c.verdict.startswith(("ahead", "behind")) else "no difference"] += 1
             mine["trivial"] += c.trivial
@@ -267,13 +269,21 @@ def _decided(t: dict[str, int]) -> int:
     return t["ahead"] + t["behind"] + t["no difference"]
 
 
+def _now(entry: Entry, base: Entry) -> int:
+    return min(len(entry.values["success"]), len(base.values["success"]))
+
+
+def _needed(c: Comparison, entry: Entry, base: Entry) -> int | None:
+    """An undecided comparison's seeds a side to decide it, where more than it has (the page's
+    clipped intervals and the bootstrap differ from the model: a figure at or below today's
+    seeds is not said)."""
+    return c.seeds_to_decide if c.seeds_to_decide is not None and c.seeds_to_decide > _now(entry, base) else None
+
+
 def _seeds_to_decide(c: Comparison, entry: Entry, base: Entry) -> str:
-    if c.seeds_to_decide is None:
-        return ""
-    now = min(len(entry.values["success"]), len(base.values["success"]))
-    if c.seeds_to_decide <= now:  # the page's clipped intervals and the bootstrap differ from the model: no figure
-        return ""
-    return f" (at these means and spreads: about {c.seeds_to_decide} seeds a side, against {now})"
+    need = _needed(c, entry, base)
+    return "" if need is None else f" (at these means and spreads: about {need} seeds a side, against " \
+        f"{_now(entry, base)})"
 
 
 def comparisons_markdown(pairs) -> list[str]:
@@ -490,6 +500,14 @@ def _suite_facts(runs) -> tuple[list[Learned], Coverage] | None:
     return learned(every, runs.name), coverage(runs.path, runs.name, rates(every, SUITES[runs.name].regime))
 
 
+def _needed_range(needs: list[int]) -> str:
+    if not needs:
+        return ""
+    low, high = min(needs), max(needs)
+    return (f" (the interval rules would need about {low if low == high else f'{low}-{high}'} seeds a side "
+            "at the means and spreads measured)")
+
+
 def summary_markdown(pairs, directories, facts) -> list[str]:
     """The page's answer in three lines, from the sections below: the comparisons per
     learner regime and their verdicts, the rungs some method learned per suite and world,
@@ -503,7 +521,7 @@ def summary_markdown(pairs, directories, facts) -> list[str]:
             f"behind on {t['behind']}, no "
             f"difference of {SMALLEST_DIFFERENCE:g} or more on {t['no difference']} ({t['trivial']} of them only "
             f"because every seed of both sat at 0 or at 1), undecided on {t['comparisons'] - _decided(t)}"
-            for regime, t in tally.items()) + ".")
+            + _needed_range(t["seeds to decide"]) for regime, t in tally.items()) + ".")
     names = [runs.name for runs in directories]
     learned_parts, coverage_parts = [], []
     for runs in directories:

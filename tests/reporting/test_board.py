@@ -330,3 +330,17 @@ def test_a_decided_gap_smaller_than_the_smallest_difference_is_named_as_small(tm
     assert compare(e["FirstTool", "td3-dynamic"], e["FirstTool", "td3"]).verdict == "ahead"  # 0.8: no qualifier
     [tally] = decided_by_regime(comparisons([board])).values()
     assert (tally["ahead"], tally["behind"], tally["no difference"]) == (1, 1, 0)
+
+
+def test_the_summary_says_how_many_seeds_the_undecided_comparisons_would_need(tmp_path):
+    from craftsuite.reporting.pages import comparisons, summary_markdown
+
+    for seed, (scratch, distilled) in enumerate(zip([0.0, 1.0, 0.0, 1.0, 0.0, 0.0], [1.0, 0.0, 1.0, 1.0, 0.0, 1.0])):
+        fake_run(tmp_path, "td3", seed, [(1000, scratch)], [(950, 1.0)], task="ToolHome", world="Cont")
+        fake_run(tmp_path, "td3-dynamic", seed, [(1000, distilled)], [(950, 1.0)], task="ToolHome", world="Cont")
+    [pair] = pairs = comparisons([build(tmp_path)])
+    need = pair[2].seeds_to_decide
+    assert pair[2].verdict == "undecided" and need > 6
+    [line] = [x for x in summary_markdown(pairs, [], {}) if x.startswith("- ")]
+    assert line.endswith(f"undecided on 1 (the interval rules would need about {need} seeds a side at the means and "
+                         "spreads measured).")

@@ -253,7 +253,7 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
     page = write_results_page([tmp_path / "out"], tmp_path / "docs" / "results.md")
     text = page.read_text()
     assert "## quick:" in text and "### Reach (Cont)" in text and session["command"] in text
-    assert "As last run: rungs tagged calibration; worlds Cont; methods td3, td3-dynamic-edges; 1 seed." in text
+    assert "As last run: rungs tagged calibration; worlds Cont; methods td3, td3-dynamic-edges; 1 seed a cell." in text
     # the runs record their settings and the code that trained them
     record = json.loads((result.students[0] / "config.json").read_text())
     assert record["format"] == FORMAT and record["effective"]["hyperparameters"]["policy_kwargs"]["net_arch"] == [16]

@@ -101,7 +101,6 @@ def suite_projection(name: str, rates: dict, cores: int = 2) -> str:
     tail of the last runs left out)."""
     from craftsuite.ids import parse_id
     from craftsuite.methods import METHODS
-
     from craftsuite.task_registry import resolve_task
 
     suite = SUITES[name]

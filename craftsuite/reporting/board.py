@@ -424,6 +424,12 @@ class Comparison:
     def decided(self) -> bool:
         return self.verdict not in ("undecided", "too few seeds", "not measured")
 
+    @property
+    def side(self) -> str | None:
+        """"ahead" or "behind" (whatever the verdict adds), else None."""
+        word = self.verdict.split(",")[0]
+        return word if word in ("ahead", "behind") else None
+
 
 def compare(entry: Entry, baseline: Entry) -> Comparison:
     """``entry`` against ``baseline`` (same task and world) in final greedy success: *ahead*

@@ -257,10 +257,11 @@ def decided_by_regime(pairs) -> dict[str, dict[str, int]]:
         mine = tally.setdefault(entry.regime, {**dict.fromkeys(("comparisons", "ahead", "behind", "no difference",
                                                                 "trivial"), 0), "seeds to decide": []})
         mine["comparisons"] += 1
-        if c is not None and _needed(c, entry, base):
-            mine["seeds to decide"].append(_needed(c, entry, base))
+        need = None if c is None else _needed(c, entry, base)
+        if need is not None:
+            mine["seeds to decide"].append(need)
         if c is not None and c.decided:
-            mine[c.verdict.split(",")[0] if c.verdict.startswith(("ahead", "behind")) else "no difference"] += 1
+            mine[c.side or "no difference"] += 1
             mine["trivial"] += c.trivial
     return {regime: tally[regime] for regime in sorted(tally, key=regime_order)}
 

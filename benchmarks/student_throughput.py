@@ -1,6 +1,7 @@
 """Student throughput of the population engine: transitions and gradient updates per second per core.
 
-Usage: python benchmarks/student_throughput.py [--seconds 10] [--members 5 10] [--page PATH | --no-page]
+Usage: python benchmarks/student_throughput.py [--seconds 10] [--members 5 10] [--only TEXT] [--device cpu]
+       [--page PATH | --no-page]
 
 One process, one torch thread, Blind Craftsman: TD3 in the MuJoCo world and on the
 kinematic board, DQN on the 10x10 grid. Each row (``craftsuite.population``): the suites'
@@ -13,7 +14,7 @@ wider networks) to those settings: what the suites train now. Each row trains fo
 ``--seconds``. The reference column is each row's target. Under the table, the standard
 and hard suites' student time projected from the learner-regime rows at the suite's seeds
 per population (or the nearest population size measured). With ``--device cuda --members
-20`` it measures a GPU population.
+20`` it measures a GPU population; ``--only n-step-wide`` keeps the rows whose label holds that text.
 """
 
 from __future__ import annotations
@@ -128,8 +129,15 @@ def main():
     parser.add_argument("--members", type=int, nargs="+", default=[5, 10],
                         help="population sizes (default: 5, a suite cell's seeds, and 10)")
     parser.add_argument("--device", default="cpu", help="the population's torch device (default: cpu)")
+    parser.add_argument("--only", metavar="TEXT", help="only the rows whose label holds TEXT (e.g. n-step-wide)")
     add_page_argument(parser)
     args = parser.parse_args()
+    rows = [row for row in POPULATION_ROWS + LEARNER_ROWS if args.only is None or args.only in row[0]]
+    if not rows:
+        parser.error(f"--only {args.only!r}: no row's label holds it; the labels: "
+                     + "; ".join(row[0] for row in POPULATION_ROWS + LEARNER_ROWS))
+    if args.only is not None and not args.no_page:  # a part of the table would replace the whole section
+        parser.error("--only measures some rows, and the page's section holds them all: add --no-page")
     import torch
 
     torch.set_num_threads(1)
@@ -137,7 +145,7 @@ def main():
     report("| student | engine | transitions/s | updates/s (all members) | reference transitions/s |")
     report("|---|---|---|---|---|")
     rates = {}  # transitions/s of the learner-regime rows, by members, then (world kind, crm): the projection's
-    for label, method, env_id, n_envs, settings, env_kwargs, target in POPULATION_ROWS + LEARNER_ROWS:
+    for label, method, env_id, n_envs, settings, env_kwargs, target in rows:
         for members in args.members:
             tps, ups = measure_population(method, env_id, n_envs, settings, env_kwargs, members, args.seconds,
                                           args.device)
@@ -145,7 +153,7 @@ def main():
             if settings in (TD3_WIDE, DQN_WIDE):
                 rates.setdefault(members, {})[_kind(method, env_id)] = tps
     report("")
-    for suite in ("standard", "hard"):
+    for suite in ("standard", "hard") if rates else ():  # (the projection needs the learner-regime rows)
         report(suite_projection(suite, rates))
         report("")
     report.save(__file__, __doc__, args)

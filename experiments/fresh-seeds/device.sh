@@ -15,16 +15,18 @@ RUNS=${RUNS:-/tmp/runs/fresh-seeds}
 export PYTHONUNBUFFERED=1
 stamp=$(mktemp) && sleep 1  # the archive's files written after this are the ones to bring back
 { date -u; nproc; free -g | head -2; nvidia-smi -L 2>&1; $PY -c 'import sys, torch; print(sys.version.split()[0], torch.__version__, torch.cuda.is_available())'; } > "$OUT/device.txt" 2>&1
-start=$(date +%s)
+start=$(date +%s) log="$OUT/transfer.log"
+: > "$log"  # appended to by all (a worker outliving the limit must not write over later lines)
 timeout -k 15 "$LIMIT" $PY -m craftsuite transfer --suite standard --worlds Grid10 \
   --tasks KeySwordDragon ToolHome TwoToolsHome --methods dqn static dynamic --seeds "$SEEDS" \
-  --members "$MEMBERS" --workers "$WORKERS" --device "$DEVICE" --no-video --out "$RUNS" > "$OUT/transfer.log" 2>&1
-echo "transfer: exit $? after $(( $(date +%s) - start )) s" >> "$OUT/transfer.log"
+  --members "$MEMBERS" --workers "$WORKERS" --device "$DEVICE" --no-video --out "$RUNS" >> "$log" 2>&1
+rc=$?
 pkill -9 -f 'craftsuite|multiprocessing' 2>/dev/null; sleep 1
+echo "transfer: exit $rc after $(( $(date +%s) - start )) s" >> "$log"
 # a transfer stopped by the limit never reached its own archiving: keep what finished
-$PY -m craftsuite archive "$RUNS" --suite standard >> "$OUT/transfer.log" 2>&1
+$PY -m craftsuite archive "$RUNS" --suite standard >> "$log" 2>&1
 find results/standard -type f -newer "$stamp" -print0 | tar -czf "$OUT/standard-changes.tgz" --null -T -
-echo "archive: $(tar -tzf "$OUT/standard-changes.tgz" | grep -c 'result.json$') finished runs changed or added" >> "$OUT/transfer.log"
+echo "archive: $(tar -tzf "$OUT/standard-changes.tgz" | grep -c 'result.json$') finished runs changed or added" >> "$log"
 if [ "$BENCH" != 0 ]; then
   timeout 150 $PY benchmarks/student_throughput.py --device "$DEVICE" --members 20 80 --seconds "$BENCH" \
     --only n-step-wide --no-page > "$OUT/throughput.txt" 2>&1

@@ -21,14 +21,14 @@ timeout -k 15 "$LIMIT" $PY -m craftsuite transfer --suite standard --worlds Grid
   --tasks KeySwordDragon ToolHome TwoToolsHome --methods dqn static dynamic --seeds "$SEEDS" \
   --members "$MEMBERS" --workers "$WORKERS" --device "$DEVICE" --no-video --out "$RUNS" >> "$log" 2>&1
 rc=$?
-pkill -9 -f 'craftsuite|multiprocessing' 2>/dev/null; sleep 1
+pkill -9 -f 'craftsuite transfer --suite|multiprocessing[.](spawn|resource_tracker)' 2>/dev/null; sleep 1
 echo "transfer: exit $rc after $(( $(date +%s) - start )) s" >> "$log"
 # a transfer stopped by the limit never reached its own archiving: keep what finished
 $PY -m craftsuite archive "$RUNS" --suite standard >> "$log" 2>&1
 find results/standard -type f -newer "$stamp" -print0 | tar -czf "$OUT/standard-changes.tgz" --null -T -
 echo "archive: $(tar -tzf "$OUT/standard-changes.tgz" | grep -c 'result.json$') finished runs changed or added" >> "$log"
 if [ "$BENCH" != 0 ]; then
-  timeout 150 $PY benchmarks/student_throughput.py --device "$DEVICE" --members 20 80 --seconds "$BENCH" \
+  timeout 120 $PY benchmarks/student_throughput.py --device "$DEVICE" --members 20 80 --seconds "$BENCH" \
     --only n-step-wide --no-page > "$OUT/throughput.txt" 2>&1
   echo "throughput: exit $?" >> "$OUT/throughput.txt"
 fi

@@ -108,6 +108,26 @@ class Suite:
     def seeds_text(self) -> str:
         return seeds_text(self.seeds, self.rung_seeds)
 
+    def _check_rung_seeds(self) -> None:
+        """``rung_seeds`` names world kinds and registered rungs, with a whole number of seeds
+        each: a misspelt key would otherwise give its rung the suite's seeds, silently. (A
+        rung the suite does not run now is allowed: ``--tasks`` narrows a suite, its seeds stay.)"""
+        from .task_registry import tasks
+
+        kinds, known = (CONT, "Grid"), tasks()
+        for kind, by in self.rung_seeds.items():
+            if kind not in kinds or not isinstance(by, dict):
+                raise ValueError(f"suite {self.name!r}: rung_seeds key {kind!r} is no world kind; use "
+                                 f"{' or '.join(kinds)}, each mapping rung names to seeds, e.g. "
+                                 "{'Grid': {'ToolHome': 20}}")
+            for rung, seeds in by.items():
+                if rung not in known:
+                    raise ValueError(f"suite {self.name!r}: rung_seeds[{kind!r}] names {rung!r}, which is no "
+                                     f"registered rung; known: {', '.join(sorted(known))}")
+                if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
+                    raise ValueError(f"suite {self.name!r}: rung_seeds[{kind!r}][{rung!r}] is {seeds!r}; give a "
+                                     "whole number of seeds, 1 or more")
+
     def n_envs(self, world: str) -> int:
         """The envs a student steps side by side in ``world`` (its collection regime)."""
         return self.td3_n_envs if world_kind(world) == CONT else self.dqn_n_envs
@@ -131,6 +151,7 @@ class Suite:
         """Every student run; a distilled student reads its rung's teacher's table from
         under ``teacher_root`` (where ``suite_runner.transfer`` trains it first)."""
         check_methods(self.methods)
+        self._check_rung_seeds()
         teachers = self.teachers()
         out = []
         for spec in self.rungs():

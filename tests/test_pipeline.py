@@ -223,6 +223,15 @@ def test_suite_selection_errors_name_the_problem(tmp_path):
         dataclasses.replace(quick, worlds=("Grid10",), methods=("dqn",)).student_configs(tmp_path)
     with pytest.raises(KeyError, match="unknown method"):
         dataclasses.replace(quick, methods=("td3", "td4")).student_configs(tmp_path)
+    # more seeds on a rung: a misspelt kind or rung, or a count that is no count, is named, never ignored
+    with pytest.raises(ValueError, match="rung_seeds key 'Grid10' is no world kind; use Cont or Grid"):
+        dataclasses.replace(quick, rung_seeds={"Grid10": {"Reach": 20}}).student_configs(tmp_path)
+    with pytest.raises(ValueError, match=r"rung_seeds\['Cont'\] names 'Reech', which is no registered rung"):
+        dataclasses.replace(quick, rung_seeds={"Cont": {"Reech": 20}}).student_configs(tmp_path)
+    with pytest.raises(ValueError, match=r"rung_seeds\['Cont'\]\['Reach'\] is 2.5; give a whole number"):
+        dataclasses.replace(quick, rung_seeds={"Cont": {"Reach": 2.5}}).student_configs(tmp_path)
+    narrowed = dataclasses.replace(quick, rung_seeds={"Cont": {"KeySwordDragon": 3}})  # a rung not run: allowed
+    assert narrowed.student_configs(tmp_path) == quick.student_configs(tmp_path)
 
 
 @pytest.mark.slow  # a whole suite in a pool of spawned workers

@@ -20,6 +20,18 @@ def test_a_single_seed_reads_as_its_value_and_never_as_an_interval(tmp_path):
     assert "| 0 of 1 |" in md
 
 
+def test_a_row_lists_its_seeds_up_to_twenty_and_counts_them_beyond(tmp_path):
+    def md(seeds):
+        root = tmp_path / f"students-{seeds}"
+        for seed in range(seeds):  # per seed: 0, 1, 1, 0.5, 0, 1, 1, 0.5, ...
+            fake_run(root, "td3", seed, [(1000, (0.0, 1.0, 1.0, 0.5)[seed % 4])], [(995, 1.0)])
+        return leaderboard_markdown(build(root))
+
+    listed, counted = md(20), md(21)
+    assert "] | 0.00 1.00 1.00 0.50 0.00 1.00 1.00 0.50 " in listed and " between |" not in listed
+    assert "| td3 | 21 | 0.60 [" in counted and "] | 6 at 0.00, 10 at 1.00, 5 between | " in counted
+
+
 def test_markdown_csv_and_profile(runs, tmp_path):
     board = build(runs)
     md = write_leaderboard(board, tmp_path).read_text()

@@ -13,8 +13,9 @@ regime add the standard and hard suites' regime (``craftsuite.regimes``: n-step 
 wider networks) to those settings: what the suites train now. Each row trains for about
 ``--seconds``. The reference column is each row's target. Under the table, the standard
 and hard suites' student time projected from the learner-regime rows at the suite's seeds
-per population (or the nearest population size measured). With ``--device cuda --members
-20`` it measures a GPU population; ``--only n-step-wide`` keeps the rows whose label holds that text.
+per population (or the nearest population size measured), from a whole run on CPU only. With
+``--device cuda --members 20`` it measures a GPU population; ``--only n-step-wide`` keeps the
+rows whose label holds that text.
 """
 
 from __future__ import annotations
@@ -153,8 +154,8 @@ def main():
             if settings in (TD3_WIDE, DQN_WIDE):
                 rates.setdefault(members, {})[_kind(method, env_id)] = tps
     report("")
-    # the projection is for this project's 2 cores: it needs the learner-regime rows, measured on CPU
-    for suite in ("standard", "hard") if rates and args.device == "cpu" else ():
+    # the projection is for this project's 2 cores: it needs every learner-regime row, measured on CPU
+    for suite in ("standard", "hard") if args.only is None and args.device == "cpu" else ():
         report(suite_projection(suite, rates))
         report("")
     report.save(__file__, __doc__, args)

@@ -655,7 +655,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--members", type=_positive, help="at most this many seeds of a cell trained as one population "
                    "(default: all of them); smaller populations finish sooner and more run at once, for many cores; "
                    "the processes sharing one GPU take turns on it, so there fewer, larger populations (e.g. 80) "
-                   "make better use of it (experiments/fresh-seeds)")
+                   "should use it better (experiments/fresh-seeds)")
     p.add_argument("--ray", metavar="ADDRESS", help="run the students on Ray ('local' starts one here)")
     p.add_argument("--no-video", action="store_true", help="skip the rollout video of the best student")
     p.add_argument("--archive", metavar="DIR", help="the results archive: runs found in DIR/<suite> are not trained "

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .configs import DEFAULT_ENGINE, StudentConfig, TeacherConfig
-from .ids import CONT, KINEMATIC, world_kind
+from .ids import CONT, KINEMATIC, WORLD_KINDS, world_kind
 from .methods import METHODS, check_methods, methods_for
 from .regimes import check_regime
 from .spec import TaskSpec
@@ -114,12 +114,14 @@ class Suite:
         rung the suite does not run now is allowed: ``--tasks`` narrows a suite, its seeds stay.)"""
         from .task_registry import tasks
 
-        kinds, known = (CONT, "Grid"), tasks()
+        known = tasks()
         for kind, by in self.rung_seeds.items():
-            if kind not in kinds or not isinstance(by, dict):
+            if kind not in WORLD_KINDS:
                 raise ValueError(f"suite {self.name!r}: rung_seeds key {kind!r} is no world kind; use "
-                                 f"{' or '.join(kinds)}, each mapping rung names to seeds, e.g. "
-                                 "{'Grid': {'ToolHome': 20}}")
+                                 f"{' or '.join(WORLD_KINDS)}, e.g. {{'Grid': {{'ToolHome': 20}}}}")
+            if not isinstance(by, dict):
+                raise ValueError(f"suite {self.name!r}: rung_seeds[{kind!r}] is {by!r}; map rung names to seeds, "
+                                 f"e.g. {{{kind!r}: {{'ToolHome': 20}}}}")
             for rung, seeds in by.items():
                 if rung not in known:
                     raise ValueError(f"suite {self.name!r}: rung_seeds[{kind!r}] names {rung!r}, which is no "

@@ -224,8 +224,10 @@ def test_suite_selection_errors_name_the_problem(tmp_path):
     with pytest.raises(KeyError, match="unknown method"):
         dataclasses.replace(quick, methods=("td3", "td4")).student_configs(tmp_path)
     # more seeds on a rung: a misspelt kind or rung, or a count that is no count, is named, never ignored
-    with pytest.raises(ValueError, match="rung_seeds key 'Grid10' is no world kind; use Cont or Grid"):
+    with pytest.raises(ValueError, match="rung_seeds key 'Grid10' is no world kind; use Grid or Cont"):
         dataclasses.replace(quick, rung_seeds={"Grid10": {"Reach": 20}}).student_configs(tmp_path)
+    with pytest.raises(ValueError, match=r"rung_seeds\['Grid'\] is 20; map rung names to seeds"):
+        dataclasses.replace(quick, rung_seeds={"Grid": 20}).student_configs(tmp_path)
     with pytest.raises(ValueError, match=r"rung_seeds\['Cont'\] names 'Reech', which is no registered rung"):
         dataclasses.replace(quick, rung_seeds={"Cont": {"Reech": 20}}).student_configs(tmp_path)
     with pytest.raises(ValueError, match=r"rung_seeds\['Cont'\]\['Reach'\] is 2.5; give a whole number"):

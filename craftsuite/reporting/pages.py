@@ -92,8 +92,10 @@ def per_seed_text(values: list[float]) -> str:
     counts say what a list of 100 would, in a cell a reader can take in)."""
     if len(values) <= SEEDS_LISTED:
         return " ".join(f"{v:.2f}" for v in values)
-    low, high = sum(v == 0 for v in values), sum(v == 1 for v in values)
-    return f"{low} at 0.00, {high} at 1.00, {len(values) - low - high} between"
+    low, high, unmeasured = (sum(v == 0 for v in values), sum(v == 1 for v in values),
+                             sum(math.isnan(v) for v in values))
+    return (f"{low} at 0.00, {high} at 1.00, {len(values) - low - high - unmeasured} between"
+            + (f", {unmeasured} not measured" if unmeasured else ""))
 
 
 def task_table(rows: list[Entry]) -> list[str]:

@@ -5,7 +5,10 @@
 # $OUT: the machine (device.txt), the training log, the archive's changed files
 # (standard-changes.tgz, to unpack over results/standard here) and the throughput table.
 # Settings by environment: LIMIT (seconds of training, default 420), SEEDS (100), MEMBERS (20),
-# WORKERS (18), DEVICE (cuda), BENCH (seconds per throughput row, 5; 0 skips it).
+# WORKERS (18), DEVICE (cuda), BENCH (seconds per throughput row, 5; 0 skips it). The whole
+# script takes LIMIT plus about 3 minutes (archive, packing, the throughput rows): the device
+# command's own limit must leave that, or nothing comes back. Unfinished runs' checkpoints stay
+# on the machine (a second command on the same machine resumes them; a fresh machine does not).
 set -u
 OUT=${OUT:?set OUT to the folder the records go to}
 PY=${PY:-python3}
@@ -19,9 +22,11 @@ start=$(date +%s) log="$OUT/transfer.log"
 : > "$log"  # appended to by all (a worker outliving the limit must not write over later lines)
 timeout -k 15 "$LIMIT" $PY -m craftsuite transfer --suite standard --worlds Grid10 \
   --tasks KeySwordDragon ToolHome TwoToolsHome --methods dqn static dynamic --seeds "$SEEDS" \
-  --members "$MEMBERS" --workers "$WORKERS" --device "$DEVICE" --no-video --out "$RUNS" >> "$log" 2>&1
-rc=$?
-pkill -9 -f 'craftsuite transfer --suite|multiprocessing[.](spawn|resource_tracker)' 2>/dev/null; sleep 1
+  --members "$MEMBERS" --workers "$WORKERS" --device "$DEVICE" --no-video --out "$RUNS" >> "$log" 2>&1 &
+tpid=$!
+wait "$tpid"; rc=$?
+# timeout leads a process group of its own: the transfer and its workers, and nothing else
+kill -9 -- "-$tpid" 2>/dev/null; sleep 1
 echo "transfer: exit $rc after $(( $(date +%s) - start )) s" >> "$log"
 # a transfer stopped by the limit never reached its own archiving: keep what finished
 $PY -m craftsuite archive "$RUNS" --suite standard >> "$log" 2>&1

@@ -30,6 +30,9 @@ def test_a_row_lists_its_seeds_up_to_twenty_and_counts_them_beyond(tmp_path):
     listed, counted = md(20), md(21)
     assert "] | 0.00 1.00 1.00 0.50 0.00 1.00 1.00 0.50 " in listed and " between |" not in listed
     assert "| td3 | 21 | 0.60 [" in counted and "] | 6 at 0.00, 10 at 1.00, 5 between | " in counted
+    from craftsuite.reporting.pages import per_seed_text
+
+    assert per_seed_text([0.0] * 20 + [float("nan")]) == "20 at 0.00, 0 at 1.00, 0 between, 1 not measured"
 
 
 def test_markdown_csv_and_profile(runs, tmp_path):

@@ -190,6 +190,11 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
     return "\n".join(lines)
 
 
+def _share(x: float) -> str:
+    """A share of episodes, where a handful among thousands must not read as none."""
+    return "0%" if x == 0 else "<1%" if x < 0.005 else f"{x:.0%}"
+
+
 def obstacles_markdown(rows: list[Entry]) -> list[str]:
     """Where no method of one task's table learned it (mean final greedy success below
     ``THRESHOLD`` for every row), what each method's training episodes reached
@@ -227,9 +232,11 @@ def obstacles_markdown(rows: list[Entry]) -> list[str]:
                                                           f" (after {', '.join(after or [])})")
             furthest = (f"state {f.state}{where}"
                         + f", {f.distance} edge{'s' if f.distance != 1 else ''} from acceptance "
-                        f"({f.share:.0%} of episodes)")
-            reached = ", ".join(f"{p} {share:.0%}" for p, share in progress.seen_share.items())
-        lines.append(f"| {e.label} | {len(e.seeds)} | {per_100k:.1f} | {furthest} | {reached} |")
+                        f"({_share(f.share)} of episodes)")
+            reached = ", ".join(f"{p} {_share(share)}" for p, share in progress.seen_share.items())
+        # the counts too: 2 completions in 47,000 episodes round to 0.0 per 100k, as none would
+        counts = f" ({progress.completed:,} of {progress.episodes:,} episodes)" if progress is not None else ""
+        lines.append(f"| {e.label} | {len(e.seeds)} | {per_100k:.1f}{counts} | {furthest} | {reached} |")
     return ["", intro + "; of the automaton states the episodes visited, the one fewest edges from acceptance (of "
             "those as close, the one furthest from the start) and the share of episodes that visited it; the share "
             "of episodes in which each proposition held at "

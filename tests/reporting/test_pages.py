@@ -158,9 +158,13 @@ def test_a_task_no_method_learned_says_where_its_episodes_stopped(tmp_path):
     rows = list(build(root))
     text = "\n".join(obstacles_markdown(rows))
     assert "| method | seeds | completed per 100k | furthest automaton state | propositions reached |" in text
-    assert "| td3 | 3 | 0.0 | state 0 (the initial)," in text and "wood 100%" in text and "home 0%" in text
-    assert "| td3-dynamic | 3 | 0.0 | state 1 (after wood), 1 edge from acceptance" in text
+    assert "| td3 | 3 | 0.0 (0 of 6 episodes) | state 0 (the initial)," in text
+    assert "wood 100%" in text and "home 0%" in text
+    assert "| td3-dynamic | 3 | 0.0 (0 of 6 episodes) | state 1 (after wood), 1 edge from acceptance" in text
     assert "(50% of episodes)" in text  # td3-dynamic: one episode of two moved on
+    from craftsuite.reporting.pages import _share
+
+    assert (_share(0.0), _share(2 / 47_000), _share(0.5)) == ("0%", "<1%", "50%")  # a few is not none
     # a task some method learned needs no such table
     learned = fake_run(tmp_path / "other", "td3", 0, [(1000, 1.0)], [(995, 1.0, 1)])
     assert obstacles_markdown(list(build(learned.parent))) == []

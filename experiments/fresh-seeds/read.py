@@ -15,7 +15,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from craftsuite.reporting.board import build, compare, distilled_against_scratch
+from craftsuite.reporting.board import build, compare, finite_mean
 from craftsuite.suites import SUITES
 
 RUNGS = ("KeySwordDragon", "ToolHome", "TwoToolsHome")
@@ -49,6 +49,9 @@ def main():
     if set(budget) != set(RUNGS):
         sys.exit(f"the standard suite has no Grid10 budget for {sorted(set(RUNGS) - set(budget))}: "
                  "this reading is of its middle rungs")
+    if not (args.archive / "students").is_dir():
+        sys.exit(f"{args.archive / 'students'}: no such directory; give --archive the suite's archive, "
+                 "e.g. results/standard")
     pooled = build(args.archive / "students").of_regime(REGIME)
     fresh = build(args.archive / "students", apart=lambda c: not first <= c["seed"] <= last).of_regime(REGIME)
     fresh_cells, wanted = cells(fresh, budget), set(range(first, last + 1))
@@ -68,18 +71,13 @@ def main():
     print("|---|---|---|---|---|---|")
     for rung in RUNGS:
         for method in METHODS[1:]:
-            row = []
-            for found in (fresh_cells, pooled_cells):
-                entry, base = found.get((rung, method)), found.get((rung, "dqn"))
-                if entry is None or base is None or (entry, base) not in distilled_against_scratch([entry, base]):
-                    row.append(None)
-                else:
-                    row.append((entry, base))
-            if None in row:
+            # (the distilled method against scratch, as the page's distilled_against_scratch pairs them)
+            row = [(found.get((rung, method)), found.get((rung, "dqn"))) for found in (fresh_cells, pooled_cells)]
+            if None in (side for pair in row for side in pair):
                 print(f"| {rung} | `{method}` | no comparison: a side has no runs at the suite's budget | | | |")
                 continue
             (f, fb), (p, pb) = row
-            mean = [sum(b.values["success"]) / len(b.values["success"]) for b in (fb, pb)]
+            mean = [finite_mean(b.values["success"]) for b in (fb, pb)]
             print(f"| {rung} | `{f.label}` | {len(f.seeds)}+{len(fb.seeds)} / {len(p.seeds)}+{len(pb.seeds)} "
                   f"| {mean[0]:.2f} / {mean[1]:.2f} | {reading(f, fb)} | {reading(p, pb)} |")
 

@@ -1,72 +1,84 @@
 #!/usr/bin/env bash
-# One part of the campaign on a machine with a GPU and 16 cores, within a fixed wall time:
-# a suite's MuJoCo cells as populations on the GPU (SUITE, default standard: the middle rungs
-# first, then the easy rungs if the time left can finish them; SUITE=hard: the paper's tasks,
-# RUNGS picking which). Cells that finish are archived into results/$SUITE there and packed,
-# one archive per rung, with the log (the machine, the GPU's load, each run's time) and the
-# archive's provenance, into $OUT.
-# Usage, from the project root: [SUITE=hard RUNGS="--tasks BlindCraftsman" EXTRA="--members 2"]
-#   bash experiments/suite-campaign/device.sh COMMIT SECONDS
+# One part of the campaign on a machine with a GPU and 16 cores, within a fixed wall time.
+# Each PART is one `craftsuite transfer` of a suite's cells, written SUITE:WORKERS:DEVICE:ARGS
+# (DEVICE cuda for populations on the GPU, cpu for populations on cores); the parts run at
+# once, each stopped at the deadline. Cells that finish are archived into results/<suite>
+# there and packed, one archive per suite and rung, with the log (the machine, the GPU's load,
+# each run's time) and the archives' provenance, into $OUT.
+# Usage, from the project root:
+#   bash experiments/suite-campaign/device.sh COMMIT SECONDS \
+#     'hard:14:cpu:--worlds Grid10 --tasks BlindCraftsman --methods dqn static --members 5' \
+#     'standard:2:cuda:--worlds Grid10 --tasks Reach --members 10'
+# Sizing (parts 1-2): a GPU process drives about 2.9k TD3 transitions/s, and about 15 of them
+# fill the GPU; a CPU process about 800/s. A population that cannot finish by the deadline is
+# lost with the machine (its checkpoints stay there).
 set -u
-commit=$1
-seconds=$2
-suite=${SUITE:-standard}
-case $suite in standard|hard) ;; *) echo "SUITE must be standard or hard, got $suite" >&2; exit 2 ;; esac
-if [ "$suite" != standard ] && [ -z "${RUNGS:-}" ]; then
-  # every hard cell at once would be 350M transitions: a part names the rungs (and methods) it can finish
-  echo "SUITE=$suite needs RUNGS, e.g. RUNGS=\"--tasks BlindCraftsman --methods td3 td3-dynamic\"" >&2; exit 2
+if [ $# -lt 3 ]; then
+  echo "usage: device.sh COMMIT SECONDS SUITE:WORKERS:DEVICE:ARGS..." >&2; exit 2
 fi
+commit=$1 seconds=$2
+shift 2
+for part in "$@"; do  # refused before anything starts, so a typo costs no device time
+  IFS=: read -r suite workers device args <<< "$part"
+  case $suite in standard|hard) ;; *) echo "part '$part': SUITE must be standard or hard" >&2; exit 2 ;; esac
+  case $device in cpu|cuda) ;; *) echo "part '$part': DEVICE must be cpu or cuda" >&2; exit 2 ;; esac
+  [[ $workers =~ ^[0-9]+$ ]] || { echo "part '$part': WORKERS must be a whole number" >&2; exit 2; }
+  [[ $args == *--worlds* ]] || { echo "part '$part': ARGS must name --worlds (every cell at once would not finish)" >&2; exit 2; }
+done
 out=${OUT:-/tmp/out}
 mkdir -p "$out"
 export PYTHONPATH=${PYTHONPATH:-}:$PWD MUJOCO_GL=disable PYTHONUNBUFFERED=1 CRAFTSUITE_COMMIT=$commit \
   OMP_NUM_THREADS=1 MKL_NUM_THREADS=1
 py=${PYTHON:-python3}
-device=${DEVICE:-cuda}
 end=$(( $(date +%s) + seconds ))
-{ echo "cores: $(nproc --all)"; free -g | head -2; nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv 2>&1; } \
-  >> "$out/campaign.log"
+log="$out/campaign.log"
+{ echo "cores: $(nproc --all)"; free -g | head -2; nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv 2>&1; } >> "$log"
 # the GPU's load while the cells train, every 30 s
 ( while sleep 30; do echo "gpu $(date -u +%H:%M:%S) $(nvidia-smi --query-gpu=utilization.gpu,memory.used \
-  --format=csv,noheader 2>&1)"; done >> "$out/campaign.log" ) &
+  --format=csv,noheader 2>&1)"; done >> "$log" ) &
 sampler=$!
-mkdir -p "results/$suite/students"
-ls "results/$suite/students" > /tmp/before.txt
+stamp=$(mktemp) && sleep 1  # the archive's files written after this are the ones to bring back
 
-run_part() {  # run_part NAME WORKERS ARGS...: one transfer, stopped at the deadline
-  local name=$1 workers=$2; shift 2
-  local left=$(( end - $(date +%s) ))
-  echo "== $name: $left s left, $(date -u +%H:%M:%S)" | tee -a "$out/campaign.log"
-  local start=$(date +%s)
-  timeout "$left" "$py" -m craftsuite transfer --suite "$suite" --worlds Cont "$@" --workers "$workers" \
-    --device "$device" --no-video --archive results --out "/tmp/runs/$name" ${EXTRA:-} >> "$out/campaign.log" 2>&1
-  echo "== $name: rc $?, $(( $(date +%s) - start )) s" | tee -a "$out/campaign.log"
-}
-
-# RUNGS and WORKERS pick another first part (e.g. RUNGS="--tasks KeySwordDragon" WORKERS=6); about
-# 15 population processes fill an H100 (parts 1-2), more only queue for it
-if [ "$suite" = standard ]; then
-  run_part middle "${WORKERS:-15}" ${RUNGS:---tags middle}
-  # the easy rungs' cells take 2.5M transitions each: only where the time left can hold them
-  if [ $(( end - $(date +%s) )) -gt 300 ]; then run_part easy 14 --tags easy; fi
-else
-  run_part "$suite" "${WORKERS:-15}" $RUNGS
-fi
+n=0
+for part in "$@"; do
+  IFS=: read -r suite workers device args <<< "$part"
+  n=$(( n + 1 ))
+  mkdir -p "results/$suite/students"
+  (
+    start=$(date +%s)
+    echo "== part $n ($part): $(( end - start )) s left, $(date -u +%H:%M:%S)" >> "$log"
+    visible=$([ "$device" = cpu ] && echo "" || echo "${CUDA_VISIBLE_DEVICES-0}")
+    # timeout leads a process group of its own: the transfer and its workers, and nothing else
+    CUDA_VISIBLE_DEVICES=$visible timeout -k 15 $(( end - start )) "$py" -m craftsuite transfer --suite "$suite" \
+      $args --workers "$workers" --device "$device" --no-video --archive results --out "/tmp/runs/part$n" \
+      >> "$out/part$n.log" 2>&1
+    echo "== part $n: rc $?, $(( $(date +%s) - start )) s" >> "$log"
+  ) &
+done
+wait $(jobs -p | grep -v "^$sampler$")
+kill "$sampler" 2>/dev/null
 
 # what finished goes into the archive there (unfinished runs are named and skipped)
-for d in /tmp/runs/*/; do "$py" -m craftsuite archive "$d" --suite "$suite" >> "$out/campaign.log" 2>&1; done
-ls "results/$suite/students" | sort > /tmp/after.txt
-comm -13 <(sort /tmp/before.txt) /tmp/after.txt | sed "s|^|results/$suite/students/|" > /tmp/new.txt
-echo "$(wc -l < /tmp/new.txt) new runs archived" | tee -a "$out/campaign.log"
-kill $sampler
-# one archive per rung (a file that comes back holds at most 16 MiB)
-cp "results/$suite/provenance.json" "$out/provenance.json"
-for task in $(sed 's|.*/student-\([A-Za-z]*\)-.*|\1|' /tmp/new.txt | sort -u); do
-  grep "/student-$task-" /tmp/new.txt | tar -czf "$out/$suite-$task.tgz" -T -
+n=0
+for part in "$@"; do
+  IFS=: read -r suite _ _ _ <<< "$part"
+  n=$(( n + 1 ))
+  "$py" -m craftsuite archive "/tmp/runs/part$n" --suite "$suite" >> "$log" 2>&1
+done
+find results/*/students -name result.json -newer "$stamp" | xargs -r -n1 dirname | sort > /tmp/new.txt
+echo "$(wc -l < /tmp/new.txt) runs archived" | tee -a "$log"
+# one archive per suite and rung (a file that comes back holds at most 16 MiB)
+for suite in $(cut -d/ -f2 /tmp/new.txt | sort -u); do
+  cp "results/$suite/provenance.json" "$out/$suite-provenance.json"
+  for task in $(grep "^results/$suite/" /tmp/new.txt | sed 's|.*/student-\([A-Za-z]*\)-.*|\1|' | sort -u); do
+    grep "^results/$suite/students/student-$task-" /tmp/new.txt | tar -czf "$out/$suite-$task.tgz" -T -
+  done
 done
 # each run's transitions and seconds, for the part's measured time
-"$py" - >> "$out/campaign.log" <<'PY'
+"$py" - >> "$log" <<'PY'
 import json, pathlib
 for line in open("/tmp/new.txt"):
     r = json.loads((pathlib.Path(line.strip()) / "result.json").read_text())
-    print(line.strip().split("/")[-1], r.get("steps"), r.get("seconds_this_session"), r.get("seconds_share"))
+    print(line.strip().split("/")[-1], r.get("steps"), r.get("members"), r.get("device"), r.get("seconds_this_session"))
 PY
+tail -3 "$log"

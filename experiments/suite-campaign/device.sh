@@ -2,9 +2,8 @@
 # One part of the campaign on a machine with a GPU and 16 cores, within a fixed wall time.
 # Each PART is one `craftsuite transfer` of a suite's cells, written SUITE:WORKERS:DEVICE:ARGS
 # (DEVICE cuda for populations on the GPU, cpu for populations on cores); the parts run at
-# once, each stopped at the deadline. Cells that finish are archived into results/<suite>
-# there and packed, one archive per suite and rung, with the log (the machine, the GPU's load,
-# each run's time) and the archives' provenance, into $OUT.
+# once, each stopped at the deadline. Each part's finished runs are packed (records and
+# provenance, partN.tgz) with the logs (the machine, the GPU's load, each run's time) into $OUT.
 # Usage, from the project root:
 #   bash experiments/suite-campaign/device.sh COMMIT SECONDS \
 #     'hard:14:cpu:--worlds Grid10 --tasks BlindCraftsman --methods dqn static --members 5' \
@@ -37,7 +36,8 @@ log="$out/campaign.log"
 ( while sleep 30; do echo "gpu $(date -u +%H:%M:%S) $(nvidia-smi --query-gpu=utilization.gpu,memory.used \
   --format=csv,noheader 2>&1)"; done >> "$log" ) &
 sampler=$!
-stamp=$(mktemp) && sleep 1  # the archive's files written after this are the ones to bring back
+# a directory of this call's own: a second call on the same machine must not resume or re-archive the first's
+runs=$(mktemp -d /tmp/runs.XXXX)
 
 n=0
 for part in "$@"; do
@@ -50,7 +50,7 @@ for part in "$@"; do
     visible=$([ "$device" = cpu ] && echo "" || echo "${CUDA_VISIBLE_DEVICES-0}")
     # timeout leads a process group of its own: the transfer and its workers, and nothing else
     CUDA_VISIBLE_DEVICES=$visible timeout -k 15 $(( end - start )) "$py" -m craftsuite transfer --suite "$suite" \
-      $args --workers "$workers" --device "$device" --no-video --archive results --out "/tmp/runs/part$n" \
+      $args --workers "$workers" --device "$device" --no-video --archive results --out "$runs/part$n" \
       >> "$out/part$n.log" 2>&1
     echo "== part $n: rc $?, $(( $(date +%s) - start )) s" >> "$log"
   ) &
@@ -58,27 +58,23 @@ done
 wait $(jobs -p | grep -v "^$sampler$")
 kill "$sampler" 2>/dev/null
 
-# what finished goes into the archive there (unfinished runs are named and skipped)
+# each part's finished runs, their records only (no model, checkpoint or log of the learner),
+# with the part's provenance, one archive per part (a file that comes back holds at most 16 MiB):
+# here, `tar -xzf partN.tgz -C DIR && craftsuite archive DIR/partN --suite SUITE` keeps them
 n=0
 for part in "$@"; do
-  IFS=: read -r suite _ _ _ <<< "$part"
   n=$(( n + 1 ))
-  "$py" -m craftsuite archive "/tmp/runs/part$n" --suite "$suite" >> "$log" 2>&1
+  ( cd "$runs" && find "part$n/students" -name result.json | xargs -r -n1 dirname > "part$n.finished"
+    tar -czf "$out/part$n.tgz" "part$n/provenance.json" "part$n/suite.json" \
+      $(sed 's|$|/config.json|; p; s|config.json$|result.json|; p; s|result.json$|evals.csv|' "part$n.finished") \
+      $(for d in $(cat "part$n.finished"); do ls "$d"/episodes.csv* 2>/dev/null; done) )
+  echo "part $n: $(wc -l < "$runs/part$n.finished") finished runs packed" | tee -a "$log"
 done
-find results/*/students -name result.json -newer "$stamp" | xargs -r -n1 dirname | sort > /tmp/new.txt
-echo "$(wc -l < /tmp/new.txt) runs archived" | tee -a "$log"
-# one archive per suite and rung (a file that comes back holds at most 16 MiB)
-for suite in $(cut -d/ -f2 /tmp/new.txt | sort -u); do
-  cp "results/$suite/provenance.json" "$out/$suite-provenance.json"
-  for task in $(grep "^results/$suite/" /tmp/new.txt | sed 's|.*/student-\([A-Za-z]*\)-.*|\1|' | sort -u); do
-    grep "^results/$suite/students/student-$task-" /tmp/new.txt | tar -czf "$out/$suite-$task.tgz" -T -
-  done
-done
-# each run's transitions and seconds, for the part's measured time
-"$py" - >> "$log" <<'PY'
-import json, pathlib
-for line in open("/tmp/new.txt"):
-    r = json.loads((pathlib.Path(line.strip()) / "result.json").read_text())
-    print(line.strip().split("/")[-1], r.get("steps"), r.get("members"), r.get("device"), r.get("seconds_this_session"))
+# each finished run's transitions, population and seconds, for the part's measured time
+"$py" - "$runs" >> "$log" <<'PY'
+import json, pathlib, sys
+for result in sorted(pathlib.Path(sys.argv[1]).glob("part*/students/*/result.json")):
+    r = json.loads(result.read_text())
+    print(result.parent.name, r.get("steps"), r.get("members"), r.get("device"), r.get("seconds_this_session"))
 PY
 tail -3 "$log"

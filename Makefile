@@ -39,7 +39,7 @@ docs: $(STAMP)
 	$(PY) -m craftsuite leaderboard results/paper --reproduction docs/reproduction.md
 
 # Each benchmark prints its figures beside their targets and rewrites its own section of
-# docs/performance.md (about 15 minutes on 2 cores; run it on an idle machine)
+# docs/performance.md (about 25 minutes on 2 cores; run it on an idle machine)
 bench: $(STAMP)
 	$(PY) benchmarks/automata.py --flloat-timeout 30
 	$(PY) benchmarks/grid_steps.py --steps 100000
@@ -50,6 +50,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/engine_equivalence.py
 	$(PY) benchmarks/teachers.py --quick
 	$(PY) benchmarks/interval_coverage.py
+	$(PY) benchmarks/verdict_error.py
 	$(PY) benchmarks/code_size.py
 
 clean:

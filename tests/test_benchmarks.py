@@ -83,7 +83,8 @@ def test_every_benchmark_has_a_section_and_a_line_in_make_bench(page_module):
 TINY = {"automata": ["--tasks", "Reach", "--flloat-timeout", "5"], "code_size": ["--reference", "HEAD"],
         "cont_steps": ["--steps", "100", "--no-render"],
         "crm_memory": ["--steps", "300"], "engine_equivalence": [], "grid_steps": ["--steps", "200"],
-        "interval_coverage": ["--trials", "20"], "student_throughput": ["--seconds", "0.2", "--members", "2"],
+        "interval_coverage": ["--trials", "20"], "verdict_error": ["--trials", "4"],
+        "student_throughput": ["--seconds", "0.2", "--members", "2"],
         "teachers": ["--tasks", "Reach", "--max-steps", "300"],
         "vector_envs": ["--envs", "2", "--steps", "20"]}
 

@@ -1,0 +1,119 @@
+"""How often does the results page call a gap that is not there, and find one that is?
+
+Usage: python benchmarks/verdict_error.py [--trials N] [--page PATH | --no-page]
+
+Each trial draws both sides' per-seed final greedy success from one distribution and reads
+them with the page's own comparison (``craftsuite.reporting.board.compare``). A seed's
+success is the share of 20 greedy episodes that succeed (the suites evaluate 20): in the
+bimodal cases a seed learns with probability q and then succeeds in each episode with
+probability 0.95, else 0.02; in the unimodal case each episode succeeds with probability
+0.5. Where both sides share a distribution, any *ahead* or *behind* is false: its rate is
+the rule's error, against a reference of 5% for a 95% rule (standard error
+sqrt(0.05 * 0.95 / N)). Beside it: each route alone (the two t-intervals apart; the
+probability of improvement's bootstrap interval excluding one half) and the stricter rule
+(the intervals apart, or the probability's route **and** Welch's interval of the difference
+excluding 0). Then power: how often each rule says *ahead* when the distilled side learns
+with q 0.2 higher.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+import numpy as np
+
+from craftsuite import stats
+from craftsuite.reporting import board
+from _page import Report, add_page_argument  # benchmarks/ is on sys.path as a script
+
+EPISODES = 20  # greedy evaluation episodes per seed, as the suites run them
+LEARNED, UNLEARNED = 0.95, 0.02  # an episode's success probability on a seed that learned / did not
+SEEDS = (5, 10, 20, 100)
+NULLS = (("bimodal, q = 0.2", 0.2), ("bimodal, q = 0.5", 0.5), ("bimodal, q = 0.8", 0.8), ("unimodal, p = 0.5", None))
+GAPS = ((0.3, 0.5), (0.5, 0.7))  # (scratch's q, the distilled side's q)
+
+
+def draw(rng, n: int, q: float | None) -> list[float]:
+    """n seeds' final greedy success: bimodal with learning probability q, or unimodal (q None)."""
+    p = np.full(n, 0.5) if q is None else np.where(rng.random(n) < q, LEARNED, UNLEARNED)
+    return list(rng.binomial(EPISODES, p) / EPISODES)
+
+
+def entry(values: list[float]) -> board.Entry:
+    return board.Entry(task="T", world="Grid10", method="m", seeds=list(range(len(values))),
+                       values={m: values for m in board.METRICS}, reached=stats.reached([]))
+
+
+def routes(mine: list[float], theirs: list[float]) -> dict[str, str | None]:
+    """The side ("ahead", "behind" or None) each rule gives: the page's, each of its two
+    routes alone, and the stricter rule."""
+    a, b = entry(mine), entry(theirs)
+    comparison = board.compare(a, b)
+    apart = board.verdict(a, b, "success")
+    apart = apart if apart in ("ahead", "behind") else None
+    p, diff = comparison.improvement, comparison.difference
+    probability = None
+    if min(len(mine), len(theirs)) >= 5 and p.has_interval and not math.isnan(p.low):
+        probability = "ahead" if p.low > 0.5 else "behind" if p.high < 0.5 else None
+    welch = None
+    if diff.has_interval:
+        welch = "ahead" if diff.low > 0 else "behind" if diff.high < 0 else None
+    strict = apart or (probability if probability and probability == welch else None)
+    return {"page": comparison.side, "apart": apart, "probability": probability, "strict": strict}
+
+
+RULES = ("page", "apart", "probability", "strict")
+
+
+def rates(rng, n: int, q_mine, q_theirs, trials: int, side: str | None) -> dict[str, float]:
+    """Per rule, the share of trials giving ``side`` (None: either side)."""
+    hits = dict.fromkeys(RULES, 0)
+    for _ in range(trials):
+        said = routes(draw(rng, n, q_mine), draw(rng, n, q_theirs))
+        for rule in RULES:
+            hits[rule] += said[rule] is not None and (side is None or said[rule] == side)
+    return {rule: hits[rule] / trials for rule in RULES}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--trials", type=int, default=1_000, help="trials per setting (a quarter at 100 seeds)")
+    add_page_argument(parser)
+    args = parser.parse_args()
+    rng = np.random.default_rng(0)
+    report = Report()
+
+    def trials(n: int) -> int:
+        return max(1, args.trials // 4) if n >= 100 else args.trials
+
+    report(f"False *ahead*/*behind* under no difference, share of trials (reference: 0.05; standard error "
+           f"{math.sqrt(0.05 * 0.95 / args.trials):.3f} at {args.trials:,} trials, "
+           f"{math.sqrt(0.05 * 0.95 / trials(100)):.3f} at 100 seeds):")
+    report()
+    report("| outcomes per seed | seeds a side | the page's rule | t-intervals apart | probability's interval | "
+           "stricter rule |")
+    report("|---|---|---|---|---|---|")
+    worst = 0.0
+    for name, q in NULLS:
+        for n in SEEDS:
+            r = rates(rng, n, q, q, trials(n), None)
+            worst = max(worst, r["page"])
+            report(f"| {name} | {n} | {r['page']:.3f} | {r['apart']:.3f} | {r['probability']:.3f} | "
+                   f"{r['strict']:.3f} |")
+    report()
+    report(f"The page's rule errs at most {worst:.3f} of the time here (reference 0.05).")
+    report()
+    report("Power: *ahead* where the distilled side's seeds learn with q 0.2 higher, share of trials:")
+    report()
+    report("| scratch's q → distilled's q | seeds a side | the page's rule | stricter rule |")
+    report("|---|---|---|---|")
+    for q_theirs, q_mine in GAPS:
+        for n in SEEDS:
+            r = rates(rng, n, q_mine, q_theirs, trials(n), "ahead")
+            report(f"| {q_theirs} → {q_mine} | {n} | {r['page']:.3f} | {r['strict']:.3f} |")
+    report.save(__file__, __doc__, args)
+
+
+if __name__ == "__main__":
+    main()

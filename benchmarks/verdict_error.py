@@ -9,11 +9,11 @@ bimodal cases a seed learns with probability q and then succeeds in each episode
 probability 0.95, else 0.02; in the unimodal case each episode succeeds with probability
 0.5. Where both sides share a distribution, any *ahead* or *behind* is false: its rate is
 the rule's error, against a reference of 5% for a 95% rule (standard error
-sqrt(0.05 * 0.95 / N)). Beside it: each route alone (the two t-intervals apart; the
-probability of improvement's bootstrap interval excluding one half) and the stricter rule
-(the intervals apart, or the probability's route **and** Welch's interval of the difference
-excluding 0). Then power: how often each rule says *ahead* when the distilled side learns
-with q 0.2 higher.
+sqrt(0.05 * 0.95 / N)). The page's rule: the two t-intervals apart, or the probability of
+improvement's bootstrap interval excluding one half **and** Welch's interval of the
+difference excluding 0. Beside it: each route alone, and the rule the page had before
+(either route alone decides). Then power: how often each rule says *ahead* when the
+distilled side learns with q 0.2 higher.
 """
 
 from __future__ import annotations
@@ -47,23 +47,19 @@ def entry(values: list[float]) -> board.Entry:
 
 def routes(mine: list[float], theirs: list[float]) -> dict[str, str | None]:
     """The side ("ahead", "behind" or None) each rule gives: the page's, each of its two
-    routes alone, and the stricter rule."""
+    routes alone, and either route alone (the page's rule before)."""
     a, b = entry(mine), entry(theirs)
     comparison = board.compare(a, b)
     apart = board.verdict(a, b, "success")
     apart = apart if apart in ("ahead", "behind") else None
-    p, diff = comparison.improvement, comparison.difference
+    p = comparison.improvement
     probability = None
     if min(len(mine), len(theirs)) >= 5 and p.has_interval and not math.isnan(p.low):
         probability = "ahead" if p.low > 0.5 else "behind" if p.high < 0.5 else None
-    welch = None
-    if diff.has_interval:
-        welch = "ahead" if diff.low > 0 else "behind" if diff.high < 0 else None
-    strict = apart or (probability if probability and probability == welch else None)
-    return {"page": comparison.side, "apart": apart, "probability": probability, "strict": strict}
+    return {"page": comparison.side, "apart": apart, "probability": probability, "either": apart or probability}
 
 
-RULES = ("page", "apart", "probability", "strict")
+RULES = ("page", "apart", "probability", "either")
 
 
 def rates(rng, n: int, q_mine, q_theirs, trials: int, side: str | None) -> dict[str, float]:
@@ -92,26 +88,27 @@ def main() -> None:
            f"{math.sqrt(0.05 * 0.95 / trials(100)):.3f} at 100 seeds):")
     report()
     report("| outcomes per seed | seeds a side | the page's rule | t-intervals apart | probability's interval | "
-           "stricter rule |")
+           "either alone (before) |")
     report("|---|---|---|---|---|---|")
-    worst = 0.0
+    worst = before = 0.0
     for name, q in NULLS:
         for n in SEEDS:
             r = rates(rng, n, q, q, trials(n), None)
-            worst = max(worst, r["page"])
+            worst, before = max(worst, r["page"]), max(before, r["either"])
             report(f"| {name} | {n} | {r['page']:.3f} | {r['apart']:.3f} | {r['probability']:.3f} | "
-                   f"{r['strict']:.3f} |")
+                   f"{r['either']:.3f} |")
     report()
-    report(f"The page's rule errs at most {worst:.3f} of the time here (reference 0.05).")
+    report(f"The page's rule errs at most {worst:.3f} of the time here, the rule before at most {before:.3f} "
+           "(reference 0.05).")
     report()
     report("Power: *ahead* where the distilled side's seeds learn with q 0.2 higher, share of trials:")
     report()
-    report("| scratch's q → distilled's q | seeds a side | the page's rule | stricter rule |")
+    report("| scratch's q → distilled's q | seeds a side | the page's rule | either alone (before) |")
     report("|---|---|---|---|")
     for q_theirs, q_mine in GAPS:
         for n in SEEDS:
             r = rates(rng, n, q_mine, q_theirs, trials(n), "ahead")
-            report(f"| {q_theirs} → {q_mine} | {n} | {r['page']:.3f} | {r['strict']:.3f} |")
+            report(f"| {q_theirs} → {q_mine} | {n} | {r['page']:.3f} | {r['either']:.3f} |")
     report.save(__file__, __doc__, args)
 
 

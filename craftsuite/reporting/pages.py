@@ -328,8 +328,9 @@ def comparisons_markdown(pairs) -> list[str]:
             "|---|---|---|---|---|---|---|---|", *rows, "",
             f"Decided (ahead, behind, or no difference of {SMALLEST_DIFFERENCE:g} or more) on "
             f"{decided} of {len(rows)} comparisons, {trivial} of them only because every seed of both sat "
-            "at 0 or at 1: *ahead*/*behind* where the two t-intervals are apart or the "
-            "probability's interval excludes one half (with *by less than "
+            "at 0 or at 1: *ahead*/*behind* where the two t-intervals are apart, or where the "
+            "probability's interval excludes one half and the difference's excludes 0 (the probability's interval "
+            "alone errs up to twice its 5% at 5-10 seeds a side: docs/performance.md) (with *by less than "
             f"{SMALLEST_DIFFERENCE:g}* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g} as well); "
             f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}. An undecided "
             "row says how many seeds a side the interval rules would need to decide it if its means and spreads held "

@@ -312,6 +312,21 @@ def test_each_learner_regime_s_share_of_decided_comparisons_is_read_apart(tmp_pa
                                   "`n-step-wide` 0 of 1.")
 
 
+def test_the_probability_of_improvement_alone_does_not_decide(tmp_path):
+    # every seed of scratch at 1, two of the distilled student's at 0: the probability's interval
+    # lies below one half, but Welch's interval of the difference includes 0
+    from craftsuite.reporting.board import compare
+
+    distilled = (1.0, 1.0, 1.0, 0.75, 1.0, 1.0, 0.0, 1.0, 1.0, 0.0)
+    for seed in range(10):
+        fake_run(tmp_path, "dqn", seed, [(1000, 1.0)], [(950, 1.0)], task="ToolHome", world="Grid10")
+        fake_run(tmp_path, "dynamic", seed, [(1000, distilled[seed])], [(950, 1.0)], task="ToolHome", world="Grid10")
+    e = {x.method: x for x in build(tmp_path)}
+    said = compare(e["dynamic"], e["dqn"])
+    assert said.improvement.high < 0.5 and said.difference.low < 0 < said.difference.high
+    assert said.verdict == "undecided" and said.seeds_to_decide > 10
+
+
 def test_a_decided_gap_smaller_than_the_smallest_difference_is_named_as_small(tmp_path):
     from craftsuite.reporting.board import compare
     from craftsuite.reporting.pages import comparisons, decided_by_regime

@@ -54,7 +54,7 @@ def routes(mine: list[float], theirs: list[float]) -> dict[str, str | None]:
     apart = apart if apart in ("ahead", "behind") else None
     p = comparison.improvement
     probability = None
-    if min(len(mine), len(theirs)) >= 5 and p.has_interval and not math.isnan(p.low):
+    if min(len(mine), len(theirs)) >= 5 and p.has_interval:
         probability = "ahead" if p.low > 0.5 else "behind" if p.high < 0.5 else None
     return {"page": comparison.side, "apart": apart, "probability": probability, "either": apart or probability}
 

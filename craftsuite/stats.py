@@ -93,8 +93,9 @@ def seeds_to_resolve(x, y, smallest: float, level: float = LEVEL) -> int | None:
     measured held: the two t-intervals of the means apart (ahead or behind), or Welch's
     interval of the difference within +-``smallest`` (no difference), whichever comes
     first. A planning figure for an undecided comparison, not a promise: a spread read from a
-    handful of seeds is itself uncertain, and the probability of improvement, the page's
-    other route to *ahead* or *behind*, is not modelled (it can decide sooner). None where it
+    handful of seeds is itself uncertain, and the page's other route to *ahead* or *behind*
+    (the probability of improvement's interval excluding one half while Welch's interval
+    excludes 0 on the same side) is not modelled (it can decide sooner). None where it
     cannot be said: fewer than ``MIN_SEEDS_FOR_INTERVAL`` values on a side, no spread at
     all, or no number of seeds that would decide it."""
     from scipy import stats

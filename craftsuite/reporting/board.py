@@ -435,10 +435,10 @@ def compare(entry: Entry, baseline: Entry) -> Comparison:
     """``entry`` against ``baseline`` (same task and world) in final greedy success: *ahead*
     or *behind* where their t-intervals are apart, or where the probability of improvement's
     interval excludes one half and Welch's interval of the difference excludes 0 on the same
-    side (*, by less than 0.2* added where the difference's interval
-    also lies within +-``SMALLEST_DIFFERENCE``: a real but small gap); else *no difference of
-    0.2 or more* where the interval of the difference lies within +-``SMALLEST_DIFFERENCE``;
-    else *undecided*."""
+    side (*, by less than 0.2* added where the difference's interval also lies within
+    +-``SMALLEST_DIFFERENCE``: a real but small gap); else *no difference of 0.2 or more*
+    where the interval of the difference lies within +-``SMALLEST_DIFFERENCE``; else
+    *undecided*."""
     mine, theirs = entry.values["success"], baseline.values["success"]
     diff = stats.difference(mine, theirs)
     try:

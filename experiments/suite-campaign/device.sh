@@ -8,9 +8,11 @@
 #   bash experiments/suite-campaign/device.sh COMMIT SECONDS \
 #     'hard:14:cpu:--worlds Grid10 --tasks BlindCraftsman --methods dqn static --members 5' \
 #     'standard:2:cuda:--worlds Grid10 --tasks Reach --members 10'
-# Sizing (parts 1-2): a GPU process drives about 2.9k TD3 transitions/s, and about 15 of them
-# fill the GPU; a CPU process about 800/s. A population that cannot finish by the deadline is
-# lost with the machine (its checkpoints stay there).
+# Sizing: a GPU process drives about 2.9k TD3 transitions/s with a population of 10, and about
+# 15 of them fill the GPU (parts 1-2); a DQN population of 10 on the GPU about 1.7k/s, and a
+# CPU process with a DQN population of 5 about 600/s when every core is busy (part 12). A
+# population that cannot finish by the deadline is lost with the machine (its checkpoints, a
+# replay buffer each, are far over what a file that comes back may hold).
 set -u
 if [ $# -lt 3 ]; then
   echo "usage: device.sh COMMIT SECONDS SUITE:WORKERS:DEVICE:ARGS..." >&2; exit 2

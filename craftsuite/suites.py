@@ -278,7 +278,7 @@ SUITES = {s.name: s for s in (
           tags=("hard",), worlds=("Grid10", "Cont"), methods=SUITE_METHODS, seeds=10,
           budgets={"Cont": {"hard": 1_000_000},
                    "Grid": {"hard": 1_000_000, "DungeonQuest": 50_000, "BlindCraftsman": 50_000,
-                            "BlindCraftsmanObstacles": 50_000}},
+                            "BlindCraftsmanObstacles": 50_000, "GoldMine": 100_000}},
           regime="n-step-wide", **TD3_REGIME, **DQN_REGIME),
     Suite("paper", "the paper's protocol as the authors' code ran it: the paper's methods and baselines on its tasks "
           "in the grid, MuJoCo and kinematic worlds, 20 seeds, 2M steps of 10 envs (20M transitions) per run",

@@ -52,10 +52,7 @@ def routes(mine: list[float], theirs: list[float]) -> dict[str, str | None]:
     comparison = board.compare(a, b)
     apart = board.verdict(a, b, "success")
     apart = apart if apart in ("ahead", "behind") else None
-    p = comparison.improvement
-    probability = None
-    if min(len(mine), len(theirs)) >= 5 and p.has_interval:
-        probability = "ahead" if p.low > 0.5 else "behind" if p.high < 0.5 else None
+    probability = board.probability_side(comparison.improvement, len(mine), len(theirs))
     return {"page": comparison.side, "apart": apart, "probability": probability, "either": apart or probability}
 
 
@@ -77,6 +74,8 @@ def main() -> None:
     parser.add_argument("--trials", type=int, default=1_000, help="trials per setting (a quarter at 100 seeds)")
     add_page_argument(parser)
     args = parser.parse_args()
+    if args.trials < 1:
+        parser.error(f"--trials must be at least 1, got {args.trials}")
     rng = np.random.default_rng(0)
     report = Report()
 

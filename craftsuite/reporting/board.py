@@ -431,6 +431,16 @@ class Comparison:
         return word if word in ("ahead", "behind") else None
 
 
+def probability_side(improvement: stats.Estimate, n: int, m: int) -> str | None:
+    """"ahead" or "behind" where the probability of improvement's interval excludes one half,
+    from ``n`` and ``m`` runs; else None. The bootstrap interval reads [1, 1] for any complete
+    separation, 3 seeds a side too: it counts only from 5 seeds a side (there, an exact
+    Mann-Whitney p = 0.008)."""
+    if min(n, m) < 5 or not improvement.has_interval:
+        return None
+    return "ahead" if improvement.low > 0.5 else "behind" if improvement.high < 0.5 else None
+
+
 def compare(entry: Entry, baseline: Entry) -> Comparison:
     """``entry`` against ``baseline`` (same task and world) in final greedy success: *ahead*
     or *behind* where their t-intervals are apart, or where the probability of improvement's
@@ -446,9 +456,6 @@ def compare(entry: Entry, baseline: Entry) -> Comparison:
     except ValueError:  # fewer than 2 runs on a side
         better = stats.Estimate(math.nan)
     apart = verdict(entry, baseline, "success")
-    # the probability's bootstrap interval reads [1, 1] for any complete separation, 3 seeds
-    # a side too: it decides only from 5 seeds a side (there, an exact Mann-Whitney p = 0.008)
-    enough = min(len(mine), len(theirs)) >= 5 and better.has_interval
     if math.isnan(diff.value):
         said = "not measured"
     elif not (diff.has_interval and better.has_interval):
@@ -457,9 +464,9 @@ def compare(entry: Entry, baseline: Entry) -> Comparison:
         said = apart
     # the probability's route alone errs up to twice its nominal 5% at 5-10 seeds a side
     # (benchmarks/verdict_error.py): it decides only where Welch's interval agrees
-    elif enough and better.low > 0.5 and diff.low > 0:
+    elif probability_side(better, len(mine), len(theirs)) == "ahead" and diff.low > 0:
         said = "ahead"
-    elif enough and better.high < 0.5 and diff.high < 0:
+    elif probability_side(better, len(mine), len(theirs)) == "behind" and diff.high < 0:
         said = "behind"
     elif -SMALLEST_DIFFERENCE < diff.low and diff.high < SMALLEST_DIFFERENCE:
         said = f"no difference of {SMALLEST_DIFFERENCE:g} or more"

@@ -60,23 +60,26 @@ done
 wait $(jobs -p | grep -v "^$sampler$")
 kill "$sampler" 2>/dev/null
 
-# each part's finished runs, their records only (no model, checkpoint or log of the learner),
-# with the part's provenance, one archive per part (a file that comes back holds at most 16 MiB):
-# here, `tar -xzf partN.tgz -C DIR && craftsuite archive DIR/partN --suite SUITE` keeps them
-n=0
-for part in "$@"; do
-  n=$(( n + 1 ))
-  ( cd "$runs" && find "part$n/students" -name result.json | xargs -r -n1 dirname > "part$n.finished"
-    tar -czf "$out/part$n.tgz" "part$n/provenance.json" "part$n/suite.json" \
-      $(sed 's|$|/config.json|; p; s|config.json$|result.json|; p; s|result.json$|evals.csv|' "part$n.finished") \
-      $(for d in $(cat "part$n.finished"); do ls "$d"/episodes.csv* 2>/dev/null; done) )
-  echo "part $n: $(wc -l < "$runs/part$n.finished") finished runs packed" | tee -a "$log"
-done
-# each finished run's transitions, population and seconds, for the part's measured time
+# each part's finished runs, their records only (the archive's own list: no model, checkpoint
+# or learner's log), with the part's provenance, one archive per part (a file that comes back
+# holds at most 16 MiB): here, `tar -xzf partN.tgz -C DIR && craftsuite archive DIR/partN
+# --suite SUITE` keeps them. Beside it in the log, each finished run's transitions, population
+# and seconds, for the part's measured time.
 "$py" - "$runs" >> "$log" <<'PY'
 import json, pathlib, sys
-for result in sorted(pathlib.Path(sys.argv[1]).glob("part*/students/*/result.json")):
-    r = json.loads(result.read_text())
-    print(result.parent.name, r.get("steps"), r.get("members"), r.get("device"), r.get("seconds_this_session"))
+from craftsuite.archive import COMPRESSED, RECORDS
+runs = pathlib.Path(sys.argv[1])
+for part in sorted(p for p in runs.iterdir() if p.is_dir()):
+    finished = sorted(r.parent for r in part.glob("students/*/result.json"))
+    names = [*RECORDS, *COMPRESSED, *(f"{c}.gz" for c in COMPRESSED)]
+    files = [part / "provenance.json", part / "suite.json"] + [d / n for d in finished for n in names if (d / n).is_file()]
+    (runs / f"{part.name}.files").write_text("".join(f"{f.relative_to(runs)}\n" for f in files if f.is_file()))
+    print(f"{part.name}: {len(finished)} finished runs packed")
+    for d in finished:
+        r = json.loads((d / "result.json").read_text())
+        print(d.name, r.get("steps"), r.get("members"), r.get("device"), r.get("seconds_this_session"))
 PY
+for files in "$runs"/part*.files; do
+  tar -czf "$out/$(basename "$files" .files).tgz" -C "$runs" -T "$files"
+done
 tail -3 "$log"

@@ -536,21 +536,31 @@ def aggregates(entries) -> list[Aggregate]:
         left_out = []
         if regime != SELF_REPORTED and any(e.self_reported for e in entries if e.world_label == label):
             left_out.append("self-reported runs: compared with these per rung, not aggregated with them")
-        # a method at another budget on a task than the task's scratch runs is another benchmark
-        budgets = {e.task: e.budget for e in mine if e.method == scratch(world) and not e.variant}
-        apart = sorted({e.method for e in mine if not e.variant and budgets.get(e.task, e.budget) != e.budget})
-        if apart:
-            left_out.append(f"{', '.join(apart)}: another budget than the scratch runs' on some task")
-            mine = [e for e in mine if e.method not in apart]
-        variants = sorted({e.method for e in mine if e.variant})
-        if variants:
-            left_out.append(f"{', '.join(variants)}: runs of more than one setting")
-        methods = sorted({e.method for e in mine} - set(variants))
-        twice = sorted({(e.task, e.method) for e in mine if e.method in methods
-                        and sum((f.task, f.method) == (e.task, e.method) for f in mine if not f.variant) > 1})
-        if twice:  # one cell run into two directories at other budgets, say: neither is pooled
-            left_out.append("; ".join(f"{m} on {t}: runs in more than one directory" for t, m in twice))
-            methods = [m for m in methods if m not in {m for _, m in twice}]
+        # A cell that does not read as one (another budget than the task's scratch runs: another
+        # benchmark; runs of more than one setting; one cell in two directories) leaves the
+        # aggregate. Where it is the baseline's, the task goes (the probability of improvement
+        # needs the baseline on every task); elsewhere the method goes and the others keep the task.
+        scratch_method = scratch(world)
+        budgets = {e.task: e.budget for e in mine if e.method == scratch_method and not e.variant}
+        one = [e for e in mine if not e.variant]
+        unreadable = {}
+        for e in mine:
+            if e.variant:
+                unreadable.setdefault((e.task, e.method), "runs of more than one setting")
+            elif sum((f.task, f.method) == (e.task, e.method) for f in one) > 1:
+                unreadable.setdefault((e.task, e.method), "runs in more than one directory")
+            elif budgets.get(e.task, e.budget) != e.budget:
+                unreadable.setdefault((e.task, e.method), "another budget than the scratch runs'")
+        for (task, method), why in sorted(unreadable.items()):
+            if method == scratch_method:
+                left_out.append(f"task {task}: the baseline {method} there has {why}")
+                mine = [e for e in mine if e.task != task]
+        dropped = {}
+        for (task, method), why in sorted(unreadable.items()):
+            if method != scratch_method and any(e.method == method for e in mine):
+                dropped.setdefault(method, f"{method}: {why} on {task}")
+        left_out += [dropped[m] for m in sorted(dropped)]
+        methods = sorted({e.method for e in mine} - set(dropped))
         cells = {(e.task, e.method): e for e in mine if e.method in methods}
         tasks = sorted({e.task for e in mine}, key=rung_order)
         blank = sum(len(e.seeds) - len(finite(e, m)) for e in cells.values() for m in AGGREGATED[:1])
@@ -570,7 +580,6 @@ def aggregates(entries) -> list[Aggregate]:
                 left_out.append(f"task {t}: run by {', '.join(ran) or 'no aggregated method'} only")
         if not common:
             methods = []
-        scratch_method = scratch(world)
         baseline = scratch_method if scratch_method in methods else None
         if scratch_method and not baseline and any(e.method == scratch_method for e in mine):
             left_out.append(f"the baseline {scratch_method} is not aggregated: no probability of improvement")

@@ -130,7 +130,8 @@ def test_runs_of_one_method_that_differ_beyond_the_seed_are_flagged_and_not_pool
     assert entries["td3 (a)"].differs == {"steps": 1000} and entries["td3 (b)"].differs == {"steps": 2000}
     md = leaderboard_markdown(Board(list(entries.values())))
     assert "are not pooled" in md and "- *td3 (b): steps = 2000*" in md
-    assert "td3: runs of more than one setting" in md  # nor aggregated
+    # nor aggregated: the baseline's cell there is not one, so the task leaves the aggregate
+    assert "task BlindCraftsman: the baseline td3 there has runs of more than one setting" in md
     with open(write_leaderboard(Board(list(entries.values())), tmp_path).with_suffix(".csv")) as f:
         assert {(r["method"], r["variant"]): r["differs_in"] for r in csv.DictReader(f)} == {
             ("td3", "a"): "steps", ("td3", "b"): "steps", ("td3-dynamic", ""): ""}
@@ -141,6 +142,33 @@ def test_a_task_only_the_baseline_ran_with_one_seed_does_not_drop_the_baseline(r
     [agg] = aggregates(list(build(runs)))
     assert agg.baseline == "td3" and set(agg.improvement) == {"td3-dynamic"}
     assert agg.tasks == ["BlindCraftsman"] and "task Reach: run by td3 only" in agg.left_out
+
+
+def test_the_baseline_in_two_settings_on_one_task_drops_that_task_not_the_baseline(tmp_path):
+    root = tmp_path / "students"
+    for task in ("Reach", "BlindCraftsman"):
+        for seed in range(3):
+            fake_run(root, "td3", seed, [(1000, 0.5)], [(995, 0.0)], task=task)
+            fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)], task=task)
+    for seed in range(3):  # candidates at another budget on a third task: td3 there is two cells
+        fake_run(root, "td3", seed, [(1000, 0.0)], [(995, 0.0)], task="DungeonQuest")
+        fake_run(root, "td3", seed + 3, [(2000, 0.0)], [(1995, 0.0)], task="DungeonQuest", budget=2_000)
+    [agg] = aggregates(list(build(root)))
+    assert agg.baseline == "td3" and agg.tasks == ["Reach", "BlindCraftsman"]
+    assert agg.improvement["td3-dynamic"]["success"].value == 1.0
+    assert "task DungeonQuest: the baseline td3 there has runs of more than one setting" in agg.left_out
+
+
+def test_another_method_in_two_settings_leaves_the_aggregate_and_the_others_keep_the_task(tmp_path):
+    root = tmp_path / "students"
+    for seed in range(3):
+        fake_run(root, "td3", seed, [(1000, 0.5)], [(995, 0.0)])
+        fake_run(root, "td3-static", seed, [(1000, 0.5)], [(995, 0.0)])
+        fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)])
+        fake_run(root, "td3-dynamic", seed + 3, [(2000, 1.0)], [(1995, 0.0)], budget=2_000)
+    [agg] = aggregates(list(build(root)))
+    assert agg.tasks == ["BlindCraftsman"] and set(agg.improvement) == {"td3-static"}
+    assert "td3-dynamic: runs of more than one setting on BlindCraftsman" in agg.left_out
 
 
 def test_a_run_without_evaluations_is_no_estimate_and_is_left_out_of_the_aggregate_by_name(runs):

@@ -495,6 +495,16 @@ def distilled_against_scratch(rows: list[Entry], self_reported: bool = False) ->
 
 
 @dataclass
+class Pairwise:
+    """A method against the baseline on every task both ran with 2 runs or more each (more
+    tasks, where other methods ran fewer, than the aggregate's common ones)."""
+
+    tasks: list[str]
+    runs: tuple[int, int]  # the method's runs and the baseline's on those tasks
+    improvement: dict[str, stats.Estimate]  # metric -> P(method > baseline)
+
+
+@dataclass
 class Aggregate:
     """One world's methods across its tasks."""
 
@@ -508,6 +518,8 @@ class Aggregate:
     scores: dict[str, list[np.ndarray]]  # method -> final success per task (for profiles)
     runs: dict[str, int]  # method -> runs aggregated
     left_out: list[str]  # what was not aggregated, and why
+    # method -> its comparison with the baseline on every task both ran, beyond ``tasks``
+    against_baseline: dict[str, Pairwise] = field(default_factory=dict)
 
     @property
     def world_label(self) -> str:
@@ -563,6 +575,7 @@ def aggregates(entries) -> list[Aggregate]:
         methods = sorted({e.method for e in mine} - set(dropped))
         cells = {(e.task, e.method): e for e in mine if e.method in methods}
         tasks = sorted({e.task for e in mine}, key=rung_order)
+        pairwise = _against_baseline(cells, tasks, methods, scratch_method, finite)
         blank = sum(len(e.seeds) - len(finite(e, m)) for e in cells.values() for m in AGGREGATED[:1])
         if blank:
             left_out.append(f"{blank} run{'s' if blank > 1 else ''} without an evaluation")
@@ -591,5 +604,29 @@ def aggregates(entries) -> list[Aggregate]:
             improvement={m: {metric: stats.probability_of_improvement(per_task[m][metric], per_task[baseline][metric])
                              for metric in AGGREGATED} for m in methods if baseline and m != baseline},
             scores={m: per_task[m]["success"] for m in methods},
-            runs={m: sum(len(x) for x in per_task[m]["success"]) for m in methods}, left_out=left_out))
+            runs={m: sum(len(x) for x in per_task[m]["success"]) for m in methods}, left_out=left_out,
+            against_baseline=pairwise))
+    return out
+
+
+def _against_baseline(cells: dict, tasks: list[str], methods: list[str], baseline: str | None,
+                      finite) -> dict[str, Pairwise]:
+    """Each method against ``baseline`` on every task both ran with 2 finite runs or more
+    of each metric: the probability of improvement on those tasks alone."""
+    if baseline not in methods:
+        return {}
+    out = {}
+    for m in methods:
+        if m == baseline:
+            continue
+        shared = [t for t in tasks if all((t, x) in cells and len(finite(cells[(t, x)], metric)) >= 2
+                                          for x in (m, baseline) for metric in AGGREGATED)]
+        if shared:
+            def runs(x):
+                return [finite(cells[(t, x)], "success") for t in shared]
+
+            out[m] = Pairwise(shared, (sum(map(len, runs(m))), sum(map(len, runs(baseline)))), {
+                metric: stats.probability_of_improvement([finite(cells[(t, m)], metric) for t in shared],
+                                                         [finite(cells[(t, baseline)], metric) for t in shared])
+                for metric in AGGREGATED})
     return out

@@ -346,7 +346,8 @@ def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = 
         base = agg.baseline
         if not agg.iqm:
             lines += [f"{h} {agg.label}", "",
-                      "Nothing to aggregate: " + "; ".join(agg.left_out or ["no method"]) + ".", ""]
+                      "Nothing to aggregate: " + "; ".join(agg.left_out or ["no method"]) + ".", "",
+                      *_against_baseline_markdown(agg)]
             continue
         lines += [f"{h} {agg.label}: {len(agg.tasks)} task{'s' if len(agg.tasks) > 1 else ''} "
                   f"({', '.join(agg.tasks)})", "",
@@ -363,10 +364,30 @@ def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = 
                             ("(the baseline) | |" if m == base else "| |")))
         if agg.left_out:
             lines += ["", "Not in this aggregate: " + "; ".join(agg.left_out) + "."]
+        if any(len(pair.tasks) > len(agg.tasks) for pair in agg.against_baseline.values()):
+            lines += ["", *_against_baseline_markdown(agg)[:-1]]
         if images and agg.label in images:
             lines += ["", f"![performance profile, {agg.label}]({images[agg.label].as_posix()})"]
         lines.append("")
     return lines
+
+
+def _against_baseline_markdown(agg: Aggregate) -> list[str]:
+    """Each method against the baseline on every task both ran: more tasks than the table
+    of the tasks every method ran, where some method ran fewer."""
+    if not agg.against_baseline:
+        return []
+    base = agg.baseline
+    lines = [f"Each method against `{base}` on every task both ran (each row its own tasks, so rows are not "
+             "compared with each other; the probability as above):", "",
+             f"| method | tasks | runs (method / {base}) | P(improves on {base}): success | P(improves): AUC |",
+             "|---|---|---|---|---|"]
+    order = sorted(agg.against_baseline, key=lambda m: (-len(agg.against_baseline[m].tasks), m))
+    for m in order:
+        pair = agg.against_baseline[m]
+        lines.append(f"| {m} | {len(pair.tasks)} ({', '.join(pair.tasks)}) | {pair.runs[0]} / {pair.runs[1]} | "
+                     f"{_fmt(pair.improvement['success'])} | {_fmt(pair.improvement['auc'])} |")
+    return lines + [""]
 
 
 def leaderboard_csv(board: Board) -> str:

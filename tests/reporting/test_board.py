@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from craftsuite.reporting.board import Board, aggregates, build, run_metrics, verdict
-from craftsuite.reporting.pages import leaderboard_markdown, write_leaderboard
+from craftsuite.reporting.pages import aggregates_markdown, leaderboard_markdown, write_leaderboard
 
 from .fakes import fake_run
 
@@ -387,3 +387,29 @@ def test_the_summary_says_how_many_seeds_the_undecided_comparisons_would_need(tm
     [line] = [x for x in summary_markdown(pairs, [], {}) if x.startswith("- ")]
     assert line.endswith(f"undecided on 1 (the interval rules would need about {need} seeds a side at the means and "
                          "spreads measured).")
+
+
+def test_a_method_that_ran_more_tasks_than_the_others_is_compared_with_the_baseline_on_all_of_them(tmp_path):
+    root = tmp_path / "students"
+    for seed in range(3):
+        for task in ("Reach", "BlindCraftsman"):
+            fake_run(root, "td3", seed, [(1000, 0.0)], [(995, 0.0)], task=task)
+            fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)], task=task)
+        fake_run(root, "td3-static", seed, [(1000, 0.0)], [(995, 0.0)], task="Reach")  # one task only
+    [agg] = aggregates(list(build(root)))
+    assert agg.tasks == ["Reach"]  # the tasks every method ran
+    pair = agg.against_baseline["td3-dynamic"]
+    assert pair.tasks == ["Reach", "BlindCraftsman"] and pair.runs == (6, 6)
+    assert pair.improvement["success"].value == 1.0  # beats every td3 run on both tasks
+    assert agg.against_baseline["td3-static"].tasks == ["Reach"]
+    md = "\n".join(aggregates_markdown([agg]))
+    assert "| td3-dynamic | 2 (Reach, BlindCraftsman) | 6 / 6 | 1.00" in md
+
+
+def test_no_second_table_where_every_method_ran_every_task(tmp_path):
+    root = tmp_path / "students"
+    for seed in range(3):
+        fake_run(root, "td3", seed, [(1000, 0.0)], [(995, 0.0)])
+        fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)])
+    [agg] = aggregates(list(build(root)))
+    assert "on every task both ran" not in "\n".join(aggregates_markdown([agg]))

@@ -471,14 +471,14 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
     directories = [read_runs(d, suite_cells=True) for d in run_dirs]
     pairs = comparisons([runs.board for runs in directories])
     facts = {runs.path: _suite_facts(runs) for runs in directories}
-    lines += summary_markdown(pairs, directories, facts)
+    ladder = aggregates([e for runs in directories for e in runs.board])
+    lines += summary_markdown(pairs, directories, facts, ladder)
     compared = comparisons_markdown(pairs)
     if compared:
         lines += ["## Distilled against scratch", "",
                   "Each distilled method against its algorithm from scratch on each rung, in final greedy success "
                   "(the rows come from the leaderboards below).", "", *compared]
     if len(directories) > 1:
-        ladder = aggregates([e for runs in directories for e in runs.board])
         if any(agg.iqm for agg in ladder):
             lines += ["## Across the ladder", "", "Every directory below together, per world and learner regime "
                       "(the sections below aggregate each directory alone):", "", *aggregates_markdown(ladder)]
@@ -552,11 +552,12 @@ def _needed_range(needs: list[int]) -> str:
             "at the means and spreads measured)")
 
 
-def summary_markdown(pairs, directories, facts) -> list[str]:
-    """The page's answer in three lines, from the sections below: the comparisons per
-    learner regime and their verdicts, the rungs some method learned per suite and world,
-    and how much of each suite is archived and still to train (``facts``: ``_suite_facts``
-    per directory)."""
+def summary_markdown(pairs, directories, facts, ladder: list[Aggregate] = ()) -> list[str]:
+    """The page's answer in a few lines, from the sections below: the comparisons per
+    learner regime and their verdicts, each distilled method's probability of beating
+    scratch across the tasks both ran (``ladder``: the aggregates of every directory
+    together), the rungs some method learned per suite and world, and how much of each suite
+    is archived and still to train (``facts``: ``_suite_facts`` per directory)."""
     lines = []
     tally = decided_by_regime(pairs)
     if tally:
@@ -566,6 +567,7 @@ def summary_markdown(pairs, directories, facts) -> list[str]:
             f"difference of {SMALLEST_DIFFERENCE:g} or more on {t['no difference']} ({t['trivial']} of them only "
             f"because every seed of both sat at 0 or at 1), undecided on {t['comparisons'] - _decided(t)}"
             + _needed_range(t["seeds to decide"]) for regime, t in tally.items()) + ".")
+    lines += _distilled_across_the_ladder(ladder)
     names = [runs.name for runs in directories]
     learned_parts, coverage_parts = [], []
     for runs in directories:
@@ -588,6 +590,25 @@ def summary_markdown(pairs, directories, facts) -> list[str]:
                      + "; ".join(learned_parts) + ".")
         lines.append("- Archived of each suite as defined now: " + "; ".join(coverage_parts) + ".")
     return ["## In short", "", *lines, ""] if lines else []
+
+
+def _distilled_across_the_ladder(ladder: list[Aggregate]) -> list[str]:
+    """Per world and learner regime, each distilled method's probability of beating scratch
+    in final greedy success, over every task both ran (``Aggregate.against_baseline``)."""
+    from ..methods import METHODS
+
+    rows = []
+    for agg in ladder:
+        mine = {m: p for m, p in agg.against_baseline.items() if m in METHODS and METHODS[m].distill}
+        if mine:
+            rows.append(f"  - {agg.label}: " + ", ".join(
+                f"`{m}` {_fmt(p.improvement['success'])} ({len(p.tasks)} task{'s' if len(p.tasks) > 1 else ''})"
+                for m, p in sorted(mine.items(), key=lambda kv: (-len(kv[1].tasks), kv[0]))))
+    if not rows:
+        return []
+    return ["- Distilled against scratch across the ladder: the probability that a distilled run's final greedy "
+            "success beats a scratch run's on the same task, averaged over every task both ran (0.5: no "
+            "difference; 95% stratified bootstrap; *Across the ladder* below):", *rows]
 
 
 def superseded_markdown(board: Board | None, level: int = 3) -> list[str]:

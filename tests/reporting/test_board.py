@@ -413,3 +413,18 @@ def test_no_second_table_where_every_method_ran_every_task(tmp_path):
         fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)])
     [agg] = aggregates(list(build(root)))
     assert "on every task both ran" not in "\n".join(aggregates_markdown([agg]))
+
+
+def test_the_summary_gives_each_distilled_method_against_scratch_across_the_tasks_both_ran(tmp_path):
+    from craftsuite.reporting.pages import summary_markdown
+
+    root = tmp_path / "students"
+    for seed in range(3):
+        for task in ("Reach", "BlindCraftsman"):
+            fake_run(root, "td3", seed, [(1000, 0.0)], [(995, 0.0)], task=task)
+            fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)], task=task)
+        fake_run(root, "product-td3", seed, [(1000, 1.0)], [(995, 0.0)], task="Reach")  # not distilled: not named
+    lines = summary_markdown([], [], {}, aggregates(list(build(root))))
+    assert lines[2].startswith("- Distilled against scratch across the ladder")
+    assert lines[3] == "  - Cont, one-step regime: `td3-dynamic` 1.00 [1.00, 1.00] (2 tasks)"
+    assert "product-td3" not in "\n".join(lines)

@@ -256,6 +256,12 @@ def scratch(world: str) -> str | None:
     return _scratch_of(world_kind(world))
 
 
+def is_distilled(method: str) -> bool:
+    """Whether a method's student learns with a distilled target (the methods the results
+    compare with their world's algorithm from scratch)."""
+    return method in METHODS and bool(METHODS[method].distill)
+
+
 def _scratch_of(kind: str) -> str | None:
     return next((n for n, m in METHODS.items() if m.world == kind and not (m.product or m.distill or m.crm)), None)
 

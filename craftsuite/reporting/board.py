@@ -485,21 +485,24 @@ def distilled_against_scratch(rows: list[Entry], self_reported: bool = False) ->
     """For one task, world and regime: each distilled student (a method with a distilled
     target), and with ``self_reported`` each self-reported method, beside its world's
     algorithm from scratch; none where scratch did not run or ran in variants."""
-    from ..methods import METHODS, scratch
+    from ..methods import is_distilled, scratch
 
     base = [e for e in rows if e.method == scratch(e.world) and not e.self_reported]
     if len(base) != 1:
         return []
-    return [(e, base[0]) for e in rows if (e.method in METHODS and METHODS[e.method].distill and not e.self_reported)
+    return [(e, base[0]) for e in rows if (is_distilled(e.method) and not e.self_reported)
             or (self_reported and e.self_reported)]
 
 
 @dataclass
 class Pairwise:
-    """A method against the baseline on every task both ran with 2 runs or more each (more
-    tasks, where other methods ran fewer, than the aggregate's common ones)."""
+    """A method against the world's baseline on every task both ran with 2 runs or more of
+    each metric: more tasks than the aggregate's common ones where other methods ran fewer. A
+    method short of runs on some common task (left out of the aggregate) is still here, on
+    the tasks where it has them."""
 
     tasks: list[str]
+    baseline: str  # the world's algorithm from scratch (the aggregate's own may be None: not on every task)
     runs: tuple[int, int]  # the method's runs and the baseline's on those tasks
     improvement: dict[str, stats.Estimate]  # metric -> P(method > baseline)
 
@@ -548,30 +551,23 @@ def aggregates(entries) -> list[Aggregate]:
         left_out = []
         if regime != SELF_REPORTED and any(e.self_reported for e in entries if e.world_label == label):
             left_out.append("self-reported runs: compared with these per rung, not aggregated with them")
-        # A cell that does not read as one (another budget than the task's scratch runs: another
-        # benchmark; runs of more than one setting; one cell in two directories) leaves the
+        # A cell that does not read as one (runs of more than one setting; one cell in two
+        # directories; another budget than the task's scratch runs: another benchmark) leaves the
         # aggregate. Where it is the baseline's, the task goes (the probability of improvement
-        # needs the baseline on every task); elsewhere the method goes and the others keep the task.
+        # needs the baseline on every task), unless that would take every task the baseline ran;
+        # elsewhere the method goes and the others keep the task.
         scratch_method = scratch(world)
-        budgets = {e.task: e.budget for e in mine if e.method == scratch_method and not e.variant}
-        one = [e for e in mine if not e.variant]
-        unreadable = {}
-        for e in mine:
-            if e.variant:
-                unreadable.setdefault((e.task, e.method), "runs of more than one setting")
-            elif sum((f.task, f.method) == (e.task, e.method) for f in one) > 1:
-                unreadable.setdefault((e.task, e.method), "runs in more than one directory")
-            elif budgets.get(e.task, e.budget) != e.budget:
-                unreadable.setdefault((e.task, e.method), "another budget than the scratch runs'")
-        for (task, method), why in sorted(unreadable.items()):
-            if method == scratch_method:
-                left_out.append(f"task {task}: the baseline {method} there has {why}")
-                mine = [e for e in mine if e.task != task]
-        dropped = {}
-        for (task, method), why in sorted(unreadable.items()):
-            if method != scratch_method and any(e.method == method for e in mine):
-                dropped.setdefault(method, f"{method}: {why} on {task}")
-        left_out += [dropped[m] for m in sorted(dropped)]
+        unreadable = _unreadable_cells(mine, scratch_method)
+        bad_base = {t for (t, m) in unreadable if m == scratch_method}
+        if bad_base and bad_base != {e.task for e in mine if e.method == scratch_method}:
+            left_out += [f"task {t}: the baseline {scratch_method} there has {unreadable[t, scratch_method]}"
+                         for t in sorted(bad_base, key=rung_order)]
+            mine = [e for e in mine if e.task not in bad_base]
+        dropped: dict[str, list[str]] = {}
+        for (task, method), why in sorted(unreadable.items(), key=lambda kv: (rung_order(kv[0][0]), kv[0][1])):
+            if any((e.task, e.method) == (task, method) for e in mine):
+                dropped.setdefault(method, []).append(f"{why} on {task}")
+        left_out += [f"{m}: {'; '.join(dropped[m])}" for m in sorted(dropped)]
         methods = sorted({e.method for e in mine} - set(dropped))
         cells = {(e.task, e.method): e for e in mine if e.method in methods}
         tasks = sorted({e.task for e in mine}, key=rung_order)
@@ -595,18 +591,45 @@ def aggregates(entries) -> list[Aggregate]:
             methods = []
         baseline = scratch_method if scratch_method in methods else None
         if scratch_method and not baseline and any(e.method == scratch_method for e in mine):
-            left_out.append(f"the baseline {scratch_method} is not aggregated: no probability of improvement")
+            left_out.append(f"the baseline {scratch_method} is not aggregated: no probability of improvement here"
+                            + ("; each method against it on the tasks both ran below" if pairwise else ""))
         per_task = {m: {metric: [finite(cells[(t, m)], metric) for t in common] for metric in AGGREGATED}
                     for m in methods}
         out.append(Aggregate(
             world=world, world_kwargs=world_kwargs, regime=regime, tasks=common, baseline=baseline,
             iqm={m: {metric: stats.aggregate_iqm(per_task[m][metric]) for metric in AGGREGATED} for m in methods},
-            improvement={m: {metric: stats.probability_of_improvement(per_task[m][metric], per_task[baseline][metric])
-                             for metric in AGGREGATED} for m in methods if baseline and m != baseline},
+            improvement={m: _improvement(cells, common, m, baseline, finite) for m in methods
+                         if baseline and m != baseline},
             scores={m: per_task[m]["success"] for m in methods},
             runs={m: sum(len(x) for x in per_task[m]["success"]) for m in methods}, left_out=left_out,
             against_baseline=pairwise))
     return out
+
+
+def _unreadable_cells(entries, baseline: str | None) -> dict[tuple[str, str], str]:
+    """The (task, method) cells of ``entries`` that do not read as one cell, each with why."""
+    one = [e for e in entries if not e.variant]
+    count: dict[tuple[str, str], int] = {}
+    for e in one:
+        count[e.task, e.method] = count.get((e.task, e.method), 0) + 1
+    budgets = {e.task: e.budget for e in one if e.method == baseline and count[e.task, e.method] == 1}
+    out = {}
+    for e in entries:
+        if e.variant:
+            out.setdefault((e.task, e.method), "runs of more than one setting")
+        elif count[e.task, e.method] > 1:
+            out.setdefault((e.task, e.method), "runs in more than one directory")
+        elif budgets.get(e.task, e.budget) != e.budget:
+            out.setdefault((e.task, e.method), "another budget than the scratch runs'")
+    return out
+
+
+def _improvement(cells: dict, tasks: list[str], method: str, baseline: str, finite) -> dict[str, stats.Estimate]:
+    """P(a run of ``method`` beats a run of ``baseline`` on the same task), per aggregated
+    metric, averaged over ``tasks``."""
+    return {metric: stats.probability_of_improvement([finite(cells[(t, method)], metric) for t in tasks],
+                                                     [finite(cells[(t, baseline)], metric) for t in tasks])
+            for metric in AGGREGATED}
 
 
 def _against_baseline(cells: dict, tasks: list[str], methods: list[str], baseline: str | None,
@@ -622,11 +645,6 @@ def _against_baseline(cells: dict, tasks: list[str], methods: list[str], baselin
         shared = [t for t in tasks if all((t, x) in cells and len(finite(cells[(t, x)], metric)) >= 2
                                           for x in (m, baseline) for metric in AGGREGATED)]
         if shared:
-            def runs(x):
-                return [finite(cells[(t, x)], "success") for t in shared]
-
-            out[m] = Pairwise(shared, (sum(map(len, runs(m))), sum(map(len, runs(baseline)))), {
-                metric: stats.probability_of_improvement([finite(cells[(t, m)], metric) for t in shared],
-                                                         [finite(cells[(t, baseline)], metric) for t in shared])
-                for metric in AGGREGATED})
+            runs = tuple(sum(len(finite(cells[(t, x)], "success")) for t in shared) for x in (m, baseline))
+            out[m] = Pairwise(shared, baseline, runs, _improvement(cells, shared, m, baseline, finite))
     return out

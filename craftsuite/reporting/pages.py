@@ -364,8 +364,9 @@ def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = 
                             ("(the baseline) | |" if m == base else "| |")))
         if agg.left_out:
             lines += ["", "Not in this aggregate: " + "; ".join(agg.left_out) + "."]
-        if any(len(pair.tasks) > len(agg.tasks) for pair in agg.against_baseline.values()):
-            lines += ["", *_against_baseline_markdown(agg)[:-1]]
+        beyond = _against_baseline_markdown(agg)
+        if beyond:
+            lines += ["", *beyond[:-1]]
         if images and agg.label in images:
             lines += ["", f"![performance profile, {agg.label}]({images[agg.label].as_posix()})"]
         lines.append("")
@@ -373,18 +374,23 @@ def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = 
 
 
 def _against_baseline_markdown(agg: Aggregate) -> list[str]:
-    """Each method against the baseline on every task both ran: more tasks than the table
-    of the tasks every method ran, where some method ran fewer."""
-    if not agg.against_baseline:
+    """Each method against the baseline on every task both ran, where that is more tasks
+    than the aggregate's table (every method, where there is no table)."""
+    rows = {m: pair for m, pair in agg.against_baseline.items() if not agg.iqm or len(pair.tasks) > len(agg.tasks)}
+    if not rows:
         return []
-    base = agg.baseline
-    lines = [f"Each method against `{base}` on every task both ran (each row its own tasks, so rows are not "
-             "compared with each other; the probability as above):", "",
+    base = next(iter(rows.values())).baseline
+    lines = [f"Each method that ran more tasks than the table's against `{base}` on every task both ran: the "
+             f"probability that a run of the method beats a run of `{base}` on the same task (ties count half), "
+             "averaged over those tasks, with its 95% stratified-bootstrap interval (each row its own tasks: rows "
+             "are not compared with each other):" if agg.iqm else
+             f"Each method against `{base}` on every task both ran: the probability that a run of the method beats "
+             f"a run of `{base}` on the same task (ties count half), averaged over those tasks, with its 95% "
+             "stratified-bootstrap interval (each row its own tasks: rows are not compared with each other):", "",
              f"| method | tasks | runs (method / {base}) | P(improves on {base}): success | P(improves): AUC |",
              "|---|---|---|---|---|"]
-    order = sorted(agg.against_baseline, key=lambda m: (-len(agg.against_baseline[m].tasks), m))
-    for m in order:
-        pair = agg.against_baseline[m]
+    for m in sorted(rows, key=lambda m: (-len(rows[m].tasks), m)):
+        pair = rows[m]
         lines.append(f"| {m} | {len(pair.tasks)} ({', '.join(pair.tasks)}) | {pair.runs[0]} / {pair.runs[1]} | "
                      f"{_fmt(pair.improvement['success'])} | {_fmt(pair.improvement['auc'])} |")
     return lines + [""]
@@ -595,11 +601,11 @@ def summary_markdown(pairs, directories, facts, ladder: list[Aggregate] = ()) ->
 def _distilled_across_the_ladder(ladder: list[Aggregate]) -> list[str]:
     """Per world and learner regime, each distilled method's probability of beating scratch
     in final greedy success, over every task both ran (``Aggregate.against_baseline``)."""
-    from ..methods import METHODS
+    from ..methods import is_distilled
 
     rows = []
     for agg in ladder:
-        mine = {m: p for m, p in agg.against_baseline.items() if m in METHODS and METHODS[m].distill}
+        mine = {m: p for m, p in agg.against_baseline.items() if is_distilled(m)}
         if mine:
             rows.append(f"  - {agg.label}: " + ", ".join(
                 f"`{m}` {_fmt(p.improvement['success'])} ({len(p.tasks)} task{'s' if len(p.tasks) > 1 else ''})"
@@ -607,8 +613,9 @@ def _distilled_across_the_ladder(ladder: list[Aggregate]) -> list[str]:
     if not rows:
         return []
     return ["- Distilled against scratch across the ladder: the probability that a distilled run's final greedy "
-            "success beats a scratch run's on the same task, averaged over every task both ran (0.5: no "
-            "difference; 95% stratified bootstrap; *Across the ladder* below):", *rows]
+            "success beats a scratch run's on the same task (ties count half, so a task where both sit at 0 or at 1 "
+            "pulls it toward 0.5), averaged over every task both ran, with its 95% stratified-bootstrap interval:",
+            *rows]
 
 
 def superseded_markdown(board: Board | None, level: int = 3) -> list[str]:

@@ -130,8 +130,8 @@ def test_runs_of_one_method_that_differ_beyond_the_seed_are_flagged_and_not_pool
     assert entries["td3 (a)"].differs == {"steps": 1000} and entries["td3 (b)"].differs == {"steps": 2000}
     md = leaderboard_markdown(Board(list(entries.values())))
     assert "are not pooled" in md and "- *td3 (b): steps = 2000*" in md
-    # nor aggregated: the baseline's cell there is not one, so the task leaves the aggregate
-    assert "task BlindCraftsman: the baseline td3 there has runs of more than one setting" in md
+    # nor aggregated: the baseline is two cells on its only task, so it leaves (the task stays for the others)
+    assert "td3: runs of more than one setting on BlindCraftsman" in md
     with open(write_leaderboard(Board(list(entries.values())), tmp_path).with_suffix(".csv")) as f:
         assert {(r["method"], r["variant"]): r["differs_in"] for r in csv.DictReader(f)} == {
             ("td3", "a"): "steps", ("td3", "b"): "steps", ("td3-dynamic", ""): ""}
@@ -169,6 +169,49 @@ def test_another_method_in_two_settings_leaves_the_aggregate_and_the_others_keep
     [agg] = aggregates(list(build(root)))
     assert agg.tasks == ["BlindCraftsman"] and set(agg.improvement) == {"td3-static"}
     assert "td3-dynamic: runs of more than one setting on BlindCraftsman" in agg.left_out
+
+
+def test_a_method_whose_odd_cell_sat_on_a_task_the_baseline_took_away_stays(tmp_path):
+    root = tmp_path / "students"
+    for seed in range(3):
+        for task in ("Reach", "BlindCraftsman"):
+            fake_run(root, "td3", seed, [(1000, 0.5)], [(995, 0.0)], task=task)
+            fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)], task=task)
+        for method in ("td3", "td3-dynamic"):  # both ran budget candidates on a third task
+            fake_run(root, method, seed, [(1000, 0.0)], [(995, 0.0)], task="DungeonQuest")
+            fake_run(root, method, seed + 3, [(2000, 0.0)], [(1995, 0.0)], task="DungeonQuest", budget=2_000)
+    [agg] = aggregates(list(build(root)))
+    assert agg.tasks == ["Reach", "BlindCraftsman"] and set(agg.improvement) == {"td3-dynamic"}
+    assert not any(line.startswith("td3-dynamic:") for line in agg.left_out)
+
+
+def test_a_baseline_two_cells_on_every_task_it_ran_leaves_and_the_others_keep_their_tasks(tmp_path):
+    root = tmp_path / "students"
+    for seed in range(3):
+        for task in ("Reach", "BlindCraftsman"):
+            fake_run(root, "td3", seed, [(1000, 0.5)], [(995, 0.0)], task=task)
+            fake_run(root, "td3", seed + 3, [(2000, 0.5)], [(1995, 0.0)], task=task, budget=2_000)
+            fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)], task=task)
+            fake_run(root, "td3-static", seed, [(1000, 0.0)], [(995, 0.0)], task=task)
+    [agg] = aggregates(list(build(root)))
+    assert agg.tasks == ["Reach", "BlindCraftsman"] and agg.baseline is None
+    assert set(agg.iqm) == {"td3-dynamic", "td3-static"} and not agg.against_baseline
+    assert ("td3: runs of more than one setting on Reach; runs of more than one setting on BlindCraftsman"
+            in agg.left_out)
+
+
+def test_where_no_task_has_every_method_each_still_meets_the_baseline_on_its_own_tasks(tmp_path):
+    root = tmp_path / "students"
+    for seed in range(3):
+        for task in ("Reach", "BlindCraftsman"):
+            fake_run(root, "td3", seed, [(1000, 0.0)], [(995, 0.0)], task=task)
+        fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)], task="Reach")
+        fake_run(root, "td3-static", seed, [(1000, 1.0)], [(995, 0.0)], task="BlindCraftsman")
+    [agg] = aggregates(list(build(root)))
+    assert not agg.iqm and agg.against_baseline["td3-dynamic"].tasks == ["Reach"]
+    md = "\n".join(aggregates_markdown([agg]))
+    assert "Nothing to aggregate" in md and "each method against it on the tasks both ran below" in md
+    assert "| td3-static | 1 (BlindCraftsman) | 3 / 3 | 1.00" in md and "None" not in md
 
 
 def test_a_run_without_evaluations_is_no_estimate_and_is_left_out_of_the_aggregate_by_name(runs):

@@ -19,8 +19,10 @@ A run directory holds
   written at each evaluation, and ``checkpoint-old/``, the one before, kept until the next
   is complete so that a damaged newest checkpoint can be resumed from the one before (the
   resume keeps the damaged one aside as ``checkpoint-unloadable/``); ``RunDir`` rotates
-  them. A student's are removed when it finishes (its final model is ``model.zip``), a
-  teacher's older one;
+  them. A student's are removed when it finishes (its final model is ``model.zip``: the
+  agent after its last step's gradient updates, which run after the last evaluation as
+  SB3's callbacks run before its ``train()``, so its greedy success on that evaluation's
+  seeds may differ from the one ``evals.csv`` records), a teacher's older one;
 * ``tb/``: TensorBoard logs (on resume, what the killed run logged after its checkpoint is
   purged, as from the CSV logs);
 * ``result.json``: written last; its presence means the run is finished and reusable. It

@@ -380,12 +380,9 @@ def _against_baseline_markdown(agg: Aggregate) -> list[str]:
     if not rows:
         return []
     base = next(iter(rows.values())).baseline
-    lines = [f"Each method that ran more tasks than the table's against `{base}` on every task both ran: the "
-             f"probability that a run of the method beats a run of `{base}` on the same task (ties count half), "
-             "averaged over those tasks, with its 95% stratified-bootstrap interval (each row its own tasks: rows "
-             "are not compared with each other):" if agg.iqm else
-             f"Each method against `{base}` on every task both ran: the probability that a run of the method beats "
-             f"a run of `{base}` on the same task (ties count half), averaged over those tasks, with its 95% "
+    which = "Each method that ran more tasks than the table's" if agg.iqm else "Each method"
+    lines = [f"{which} against `{base}` on every task both ran: the probability that a run of the method beats a "
+             f"run of `{base}` on the same task (ties count half), averaged over those tasks, with its 95% "
              "stratified-bootstrap interval (each row its own tasks: rows are not compared with each other):", "",
              f"| method | tasks | runs (method / {base}) | P(improves on {base}): success | P(improves): AUC |",
              "|---|---|---|---|---|"]

@@ -12,6 +12,14 @@ from craftsuite.reporting.pages import aggregates_markdown, leaderboard_markdown
 from .fakes import fake_run
 
 
+def two_tasks(root, scratch: float, distilled: float, seeds=range(3)):
+    """``td3`` and ``td3-dynamic`` on Reach and Blind Craftsman, every seed at these final successes."""
+    for seed in seeds:
+        for task in ("Reach", "BlindCraftsman"):
+            fake_run(root, "td3", seed, [(1000, scratch)], [(995, 0.0)], task=task)
+            fake_run(root, "td3-dynamic", seed, [(1000, distilled)], [(995, 0.0)], task=task)
+
+
 def test_run_metrics_known_answers(runs):
     m = run_metrics(runs / "student-BlindCraftsman-Cont-td3-dynamic-s0")
     assert m["success"] == 1.0
@@ -146,10 +154,7 @@ def test_a_task_only_the_baseline_ran_with_one_seed_does_not_drop_the_baseline(r
 
 def test_the_baseline_in_two_settings_on_one_task_drops_that_task_not_the_baseline(tmp_path):
     root = tmp_path / "students"
-    for task in ("Reach", "BlindCraftsman"):
-        for seed in range(3):
-            fake_run(root, "td3", seed, [(1000, 0.5)], [(995, 0.0)], task=task)
-            fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)], task=task)
+    two_tasks(root, 0.5, 1.0)
     for seed in range(3):  # candidates at another budget on a third task: td3 there is two cells
         fake_run(root, "td3", seed, [(1000, 0.0)], [(995, 0.0)], task="DungeonQuest")
         fake_run(root, "td3", seed + 3, [(2000, 0.0)], [(1995, 0.0)], task="DungeonQuest", budget=2_000)
@@ -173,10 +178,8 @@ def test_another_method_in_two_settings_leaves_the_aggregate_and_the_others_keep
 
 def test_a_method_whose_odd_cell_sat_on_a_task_the_baseline_took_away_stays(tmp_path):
     root = tmp_path / "students"
+    two_tasks(root, 0.5, 1.0)
     for seed in range(3):
-        for task in ("Reach", "BlindCraftsman"):
-            fake_run(root, "td3", seed, [(1000, 0.5)], [(995, 0.0)], task=task)
-            fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)], task=task)
         for method in ("td3", "td3-dynamic"):  # both ran budget candidates on a third task
             fake_run(root, method, seed, [(1000, 0.0)], [(995, 0.0)], task="DungeonQuest")
             fake_run(root, method, seed + 3, [(2000, 0.0)], [(1995, 0.0)], task="DungeonQuest", budget=2_000)
@@ -434,10 +437,8 @@ def test_the_summary_says_how_many_seeds_the_undecided_comparisons_would_need(tm
 
 def test_a_method_that_ran_more_tasks_than_the_others_is_compared_with_the_baseline_on_all_of_them(tmp_path):
     root = tmp_path / "students"
+    two_tasks(root, 0.0, 1.0)
     for seed in range(3):
-        for task in ("Reach", "BlindCraftsman"):
-            fake_run(root, "td3", seed, [(1000, 0.0)], [(995, 0.0)], task=task)
-            fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)], task=task)
         fake_run(root, "td3-static", seed, [(1000, 0.0)], [(995, 0.0)], task="Reach")  # one task only
     [agg] = aggregates(list(build(root)))
     assert agg.tasks == ["Reach"]  # the tasks every method ran
@@ -462,10 +463,8 @@ def test_the_summary_gives_each_distilled_method_against_scratch_across_the_task
     from craftsuite.reporting.pages import summary_markdown
 
     root = tmp_path / "students"
+    two_tasks(root, 0.0, 1.0)
     for seed in range(3):
-        for task in ("Reach", "BlindCraftsman"):
-            fake_run(root, "td3", seed, [(1000, 0.0)], [(995, 0.0)], task=task)
-            fake_run(root, "td3-dynamic", seed, [(1000, 1.0)], [(995, 0.0)], task=task)
         fake_run(root, "product-td3", seed, [(1000, 1.0)], [(995, 0.0)], task="Reach")  # not distilled: not named
     lines = summary_markdown([], [], {}, aggregates(list(build(root))))
     assert lines[2].startswith("- Distilled against scratch across the ladder")

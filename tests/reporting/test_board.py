@@ -470,3 +470,13 @@ def test_the_summary_gives_each_distilled_method_against_scratch_across_the_task
     assert lines[2].startswith("- Distilled against scratch across the ladder")
     assert lines[3] == "  - Cont, one-step regime: `td3-dynamic` 1.00 [1.00, 1.00] (2 tasks)"
     assert "product-td3" not in "\n".join(lines)
+
+
+def test_a_baseline_in_two_directories_drops_its_task_and_names_no_other_method(tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    two_tasks(a, 0.0, 1.0)
+    for seed in range(3):  # the baseline's Reach again, at another budget, in a second directory
+        fake_run(b, "td3", seed, [(2000, 0.0)], [(1995, 0.0)], task="Reach", budget=2_000)
+    [agg] = aggregates([*build(a), *build(b)])
+    assert agg.baseline == "td3" and agg.tasks == ["BlindCraftsman"] and set(agg.improvement) == {"td3-dynamic"}
+    assert agg.left_out == ["task Reach: the baseline td3 there has runs in more than one directory"]

@@ -81,7 +81,7 @@ def evaluate(policy, env: str, *, suite: str = "standard", step: int | None = No
         raise ValueError(f"step must be a non-negative integer (the evaluation's transitions), got {step!r}")
     kwargs = config.env_kwargs
     if product is None:
-        product = _sees_automaton(policy, config.env_id, kwargs)
+        product = sees_automaton(policy, config.env_id, kwargs)
     played = play(lambda space: _batched(policy, space), config.env_id, kwargs, product, n, eval_seed(step))
     return Evaluation(float(np.mean([e.success for e in played])), float(np.mean([e.total_reward for e in played])),
                       float(np.mean([e.length for e in played])), tuple(played), config.env_id, kwargs, step)
@@ -102,7 +102,7 @@ def play(policy_for, env_id: str, env_kwargs: dict, product: bool, episodes: int
             env.close()
 
 
-def _sees_automaton(policy, env_id: str, kwargs: dict) -> bool:
+def sees_automaton(policy, env_id: str, kwargs: dict) -> bool:
     """Whether a policy that declares its observation space (an SB3 model) was trained
     with the automaton state in its observations."""
     space = getattr(policy, "observation_space", None)

@@ -18,7 +18,6 @@ the run's recorded success beside it.
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 from pathlib import Path
 
@@ -28,8 +27,9 @@ import numpy as np
 import craftsuite  # noqa: F401  (registers the ids)
 from craftsuite.agents.factory import load_agent
 from craftsuite.episodes import rollout
-from craftsuite.evaluation import protocol
-from craftsuite.runs import eval_seed
+from craftsuite.evaluation import protocol, sees_automaton
+from craftsuite.ids import env_id as id_of
+from craftsuite.runs import eval_seed, read_config, read_csv
 
 
 def state_of(env) -> tuple:
@@ -74,9 +74,8 @@ def replay(model, env_id: str, kwargs: dict, product: bool, n: int, seed: int, e
 
 
 def last_evaluation(run: Path) -> tuple[int, float]:
-    with open(run / "evals.csv") as f:
-        rows = list(csv.DictReader(f))
-    return int(rows[-1]["step"]), float(rows[-1]["success"])
+    last = read_csv(run / "evals.csv", ("step", "success"), required=True)[-1]
+    return int(last["step"]), float(last["success"])
 
 
 def main() -> None:
@@ -94,15 +93,13 @@ def main() -> None:
         raise SystemExit(f"no student run with a model.zip under {args.students}: give a transfer's students/")
     out = []
     for run in runs:
-        config = json.loads((run / "config.json").read_text())
-        env_id = f"CraftSuite/{config['task']}-{config['world']}-v0"
+        config = read_config(run)
+        env_id = id_of(config["task"], config["world"])
         suite_config, _ = protocol(env_id, args.suite)
         kwargs, n = suite_config.env_kwargs, suite_config.eval_episodes
         step, recorded = last_evaluation(run)
         model = load_agent(run / "model.zip")
-        plain = gym.make(env_id, product=False, **kwargs)
-        product = tuple(model.observation_space.shape) != tuple(plain.observation_space.shape)
-        plain.close()
+        product = sees_automaton(model, env_id, kwargs)
         greedy = replay(model, env_id, kwargs, product, n, eval_seed(step))
         success = float(np.mean([e["success"] for e in greedy]))
         if abs(success - recorded) > 1e-9 and not args.own_success:

@@ -1,0 +1,62 @@
+"""The cells this campaign read more than once before deciding how many seeds to give them,
+re-read with the error shared out over their looks.
+
+    python experiments/suite-campaign/looks.py
+
+A cell that gets more seeds because a first reading was undecided has had two chances to
+decide, so an interval at 95% on its final sample claims more than it has. Bonferroni over the
+looks (each at 1 - 0.05/k for k looks) keeps the whole sequence's error at 5% whatever rule
+chose the next seed count. Prints, per distilled-against-scratch comparison of those cells,
+Welch's interval of the difference in final greedy success at 95% and at the shared level,
+and whether the page's verdict on the difference still stands there.
+"""
+
+from __future__ import annotations
+
+from craftsuite import stats
+from craftsuite.reporting.board import build
+
+REGIME = "n-step-wide"
+SMALLEST = 0.2  # the page's "no difference of 0.2 or more"
+# (suite, task, world, scratch, distilled methods): the seed counts read, in order (this
+# folder's README, the parts that gave each cell more seeds)
+LOOKS = {
+    ("hard", "BlindCraftsman", "Grid10", "dqn", ("dynamic", "static")): (10, 20),
+    ("hard", "GoldMine", "Grid10", "dqn", ("dynamic", "static")): (10, 20),
+    ("standard", "TwoToolsHome", "Grid10", "dqn", ("dynamic", "static")): (20, 100, 150),
+    ("standard", "ToolHome", "Cont", "td3", ("td3-dynamic",)): (3, 10),
+}
+
+
+def reading(d: stats.Estimate) -> str:
+    """What the difference's interval alone says (the page's rule on the difference)."""
+    if d.low > 0:
+        return "ahead"
+    if d.high < 0:
+        return "behind"
+    if -SMALLEST < d.low and d.high < SMALLEST:
+        return "no difference of 0.2 or more"
+    return "undecided"
+
+
+def main() -> None:
+    boards = {}
+    for (suite, task, world, scratch, methods), seeds in LOOKS.items():
+        board = boards.setdefault(suite, build(f"results/{suite}/students"))
+        # the suite's own cell: of a method's settings on the task, the one with the most seeds
+        cell = {}
+        for e in sorted(board.entries, key=lambda e: len(e.seeds)):
+            if e.task == task and e.world.startswith(world) and e.regime == REGIME:
+                cell[e.method] = e
+        level = 1 - (1 - stats.LEVEL) / len(seeds)
+        for method in methods:
+            x, y = cell[method].values["success"], cell[scratch].values["success"]
+            plain, shared = stats.difference(x, y), stats.difference(x, y, level=level)
+            print(f"{task} ({world}) {method} - {scratch}, {len(x)}/{len(y)} seeds, looks at "
+                  f"{', '.join(map(str, seeds))}: {plain.value:+.2f} [{plain.low:+.2f}, {plain.high:+.2f}] "
+                  f"({reading(plain)}); at {level:.1%}: [{shared.low:+.2f}, {shared.high:+.2f}] "
+                  f"({reading(shared)})")
+
+
+if __name__ == "__main__":
+    main()

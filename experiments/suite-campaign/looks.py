@@ -15,10 +15,9 @@ says (the page's *ahead*/*behind* also has other routes: this checks the differe
 from __future__ import annotations
 
 from craftsuite import stats
-from craftsuite.reporting.board import build
+from craftsuite.reporting.board import SMALLEST_DIFFERENCE, build
 
 REGIME = "n-step-wide"
-SMALLEST = 0.2  # the page's "no difference of 0.2 or more"
 # (suite, task, world, scratch, distilled methods): the seed counts read, in order (this
 # folder's README, the parts that gave each cell more seeds, and experiments/twenty-seeds and
 # experiments/fresh-seeds for the Grid10 middle rungs)
@@ -38,8 +37,8 @@ def reading(d: stats.Estimate) -> str:
         return "ahead"
     if d.high < 0:
         return "behind"
-    if -SMALLEST < d.low and d.high < SMALLEST:
-        return "no difference of 0.2 or more"
+    if -SMALLEST_DIFFERENCE < d.low and d.high < SMALLEST_DIFFERENCE:
+        return f"no difference of {SMALLEST_DIFFERENCE:g} or more"
     return "undecided"
 
 
@@ -54,6 +53,10 @@ def main() -> None:
                 cell[e.method] = e
         level = 1 - (1 - stats.LEVEL) / len(seeds)
         for method in methods:
+            missing = [m for m in (method, scratch) if m not in cell]
+            if missing:
+                raise SystemExit(f"{task} ({world}): no {REGIME} runs of {', '.join(missing)} under "
+                                 f"results/{suite}/students; run this from the project's root")
             x, y = cell[method].values["success"], cell[scratch].values["success"]
             if not (len(x) == len(y) == seeds[-1] and cell[method].budget == cell[scratch].budget):
                 raise SystemExit(f"{task} ({world}): {method} has {len(x)} seeds at {cell[method].budget:,}, "

@@ -406,9 +406,14 @@ def _transfer_target(entry: Entry, baseline: Entry) -> str:
 SMALLEST_DIFFERENCE = 0.2
 
 
+# the metrics a method is compared with its baseline in, each with the words a page reads it by:
+# final greedy success (where a run ends) and AUC (how soon and how steadily it got there)
+COMPARED = {"success": "final greedy success", "auc": "AUC"}
+
+
 @dataclass(frozen=True)
 class Comparison:
-    """A method against a baseline on one task and world, in final greedy success."""
+    """A method against a baseline on one task and world, in one of ``COMPARED``."""
 
     difference: stats.Estimate  # its mean minus the baseline's, with Welch's t-interval
     improvement: stats.Estimate  # P(a run of it beats a run of the baseline), stratified bootstrap
@@ -441,21 +446,24 @@ def probability_side(improvement: stats.Estimate, n: int, m: int) -> str | None:
     return "ahead" if improvement.low > 0.5 else "behind" if improvement.high < 0.5 else None
 
 
-def compare(entry: Entry, baseline: Entry) -> Comparison:
-    """``entry`` against ``baseline`` (same task and world) in final greedy success: *ahead*
-    or *behind* where their t-intervals are apart, or where the probability of improvement's
-    interval excludes one half and Welch's interval of the difference excludes 0 on the same
-    side (*, by less than 0.2* added where the difference's interval also lies within
-    +-``SMALLEST_DIFFERENCE``: a real but small gap); else *no difference of 0.2 or more*
-    where the interval of the difference lies within +-``SMALLEST_DIFFERENCE``; else
-    *undecided*."""
-    mine, theirs = entry.values["success"], baseline.values["success"]
+def compare(entry: Entry, baseline: Entry, metric: str = "success") -> Comparison:
+    """``entry`` against ``baseline`` (same task and world) in ``metric`` (one of
+    ``COMPARED``; both lie in [0, 1]): *ahead* or *behind* where their t-intervals are apart,
+    or where the probability of improvement's interval excludes one half and Welch's interval
+    of the difference excludes 0 on the same side (*, by less than 0.2* added where the
+    difference's interval also lies within +-``SMALLEST_DIFFERENCE``: a real but small gap);
+    else *no difference of 0.2 or more* where the interval of the difference lies within
+    +-``SMALLEST_DIFFERENCE``; else *undecided*. One rule and one smallest difference for
+    every metric, so that no threshold is chosen after the figures are seen."""
+    if metric not in COMPARED:
+        raise ValueError(f"no comparison in {metric!r}: compare in one of {sorted(COMPARED)}")
+    mine, theirs = entry.values[metric], baseline.values[metric]
     diff = stats.difference(mine, theirs)
     try:
         better = stats.probability_of_improvement([mine], [theirs])
     except ValueError:  # fewer than 2 runs on a side
         better = stats.Estimate(math.nan)
-    apart = verdict(entry, baseline, "success")
+    apart = verdict(entry, baseline, metric)
     if math.isnan(diff.value):
         said = "not measured"
     elif not (diff.has_interval and better.has_interval):

@@ -253,18 +253,28 @@ def _comparison_text(entry: Entry, baseline: Entry) -> str:
             f"**{c.verdict}**")
 
 
-def comparisons(boards: list[Board]) -> list[tuple[Entry, Entry, Comparison | None]]:
+def comparisons(boards: list[Board], metric: str = "success") -> list[tuple[Entry, Entry, Comparison | None]]:
     """Every distilled method against its algorithm from scratch, rung by rung, across
-    ``boards`` (easiest rung first): each pair with its verdict (``board.compare``), None
-    where the two ran at other budgets (never set side by side as one comparison)."""
-    out = []
-    for board in boards:
-        entries = list(board)
-        for task, world, regime in sorted({(e.task, e.world_label, e.regime) for e in entries},
-                                          key=lambda k: (rung_order(k[0]), k[1], k[2])):
-            here = [e for e in entries if (e.task, e.world_label, e.regime) == (task, world, regime)]
-            out += [(entry, base, compare(entry, base) if entry.budget == base.budget else None)
-                    for entry, base in distilled_against_scratch(here)]
+    ``boards`` (easiest rung first): each pair with its verdict in ``metric``
+    (``board.compare``), None where the two ran at other budgets (never set side by side as
+    one comparison)."""
+    return in_metric([(entry, base, None) for board in boards for entry, base in _pairs(board)], metric)
+
+
+def in_metric(pairs, metric: str) -> list[tuple[Entry, Entry, Comparison | None]]:
+    """``pairs`` (``comparisons``) read again in ``metric``: the same rows, each with its
+    verdict in that metric (None where the two ran at other budgets)."""
+    return [(entry, base, compare(entry, base, metric) if entry.budget == base.budget else None)
+            for entry, base, _ in pairs]
+
+
+def _pairs(board: Board) -> list[tuple[Entry, Entry]]:
+    """A board's distilled methods, each with its algorithm from scratch, easiest rung first."""
+    out, entries = [], list(board)
+    for task, world, regime in sorted({(e.task, e.world_label, e.regime) for e in entries},
+                                      key=lambda k: (rung_order(k[0]), k[1], k[2])):
+        here = [e for e in entries if (e.task, e.world_label, e.regime) == (task, world, regime)]
+        out += distilled_against_scratch(here)
     return out
 
 
@@ -308,27 +318,24 @@ def _seeds_to_decide(c: Comparison, entry: Entry, base: Entry) -> str:
 
 
 def comparisons_markdown(pairs) -> list[str]:
-    """The table of ``comparisons`` (``pairs``): the difference in final greedy success and
-    the verdict of each, and how many decide it."""
+    """The table of ``comparisons`` (``pairs``, in final greedy success): the difference and
+    verdict of each in final greedy success and in AUC, and how many decide it in each."""
     if not pairs:
         return []
-    rows = []
-    for entry, base, c in pairs:
+    rows, auc = [], in_metric(pairs, "auc")
+    for (entry, base, c), (_, _, in_auc) in zip(pairs, auc):
         head = f"| {entry.task} | {entry.world_label} | {entry.regime} | `{entry.label}` − `{base.label}` "
-        rows.append(head + (f"| | | {entry.budget:,} against {base.budget:,} | not compared: other budgets |"
+        rows.append(head + (f"| | | {entry.budget:,} against {base.budget:,} | not compared: other budgets | | |"
                             if c is None else f"| {_fmt(c.difference, signed=True)} | {_fmt(c.improvement)} "
-                            f"| {entry.budget:,} | {c.verdict}{_seeds_to_decide(c, entry, base)} |"))
-    tally = decided_by_regime(pairs)
-    decided, trivial = sum(_decided(t) for t in tally.values()), sum(t["trivial"] for t in tally.values())
-    by_regime = ("By learner regime, decided and not only by all-0/all-1 seeds: " + "; ".join(
-        f"`{regime}` {_decided(t) - t['trivial']} of {t['comparisons']}" for regime, t in tally.items())
-        + "." if len(tally) > 1 else "")
+                            f"| {entry.budget:,} | {c.verdict}{_seeds_to_decide(c, entry, base)} "
+                            f"| {_fmt(in_auc.difference, signed=True)} "
+                            f"| {in_auc.verdict}{_seeds_to_decide(in_auc, entry, base)} |"))
     return ["| rung | world | learner regime | distilled − scratch | difference in success [95% Welch t] "
-            "| P(distilled > scratch) [95% bootstrap] | transitions per run | verdict |",
-            "|---|---|---|---|---|---|---|---|", *rows, "",
-            f"Decided (ahead, behind, or no difference of {SMALLEST_DIFFERENCE:g} or more) on "
-            f"{decided} of {len(rows)} comparisons, {trivial} of them only because every seed of both sat "
-            "at 0 or at 1: *ahead*/*behind* where the two t-intervals are apart, or where the "
+            "| P(distilled > scratch) [95% bootstrap] | transitions per run | verdict "
+            "| difference in AUC [95% Welch t] | verdict in AUC |",
+            "|---|---|---|---|---|---|---|---|---|---|", *rows, "",
+            f"Decided in final greedy success (ahead, behind, or no difference of {SMALLEST_DIFFERENCE:g} or more) "
+            f"{_tally_text(pairs)}: *ahead*/*behind* where the two t-intervals are apart, or where the "
             "probability's interval excludes one half and the difference's excludes 0 on the same side (the "
             "probability's interval alone errs up to twice its 5% at 5-10 seeds a side: docs/performance.md; "
             f"*by less than {SMALLEST_DIFFERENCE:g}* added where the difference's interval lies within "
@@ -336,7 +343,26 @@ def comparisons_markdown(pairs) -> list[str]:
             f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}. An undecided "
             "row says how many seeds a side the interval rules would need to decide it if its means and spreads held "
             "(a planning figure: a spread read from a handful of seeds is itself uncertain)."
-            + (f" {by_regime}" if by_regime else ""), ""]
+            + _by_regime_text(pairs), "",
+            "Decided in AUC (the mean greedy success over the evaluations during training: how soon and how steadily "
+            "a run learned, where final success says only where it ended), by the same rules and the same smallest "
+            f"difference, {_tally_text(auc)}." + _by_regime_text(auc), ""]
+
+
+def _tally_text(pairs) -> str:
+    """How many of ``pairs`` are decided, and how many of those only by all-0/all-1 seeds."""
+    tally = decided_by_regime(pairs).values()
+    return (f"on {sum(_decided(t) for t in tally)} of {len(pairs)} comparisons, {sum(t['trivial'] for t in tally)} "
+            "of them only because every seed of both sat at 0 or at 1")
+
+
+def _by_regime_text(pairs) -> str:
+    """Where ``pairs`` span several learner regimes, each regime's share decided other than
+    by all-0/all-1 seeds, as a sentence (else nothing: the count before it says it all)."""
+    tally = decided_by_regime(pairs)
+    return (" By learner regime, decided and not only by all-0/all-1 seeds: " + "; ".join(
+        f"`{regime}` {_decided(t) - t['trivial']} of {t['comparisons']}" for regime, t in tally.items()) + "."
+        if len(tally) > 1 else "")
 
 
 def aggregates_markdown(aggs: list[Aggregate], images: dict[str, Path] | None = None, level: int = 3) -> list[str]:
@@ -562,14 +588,10 @@ def summary_markdown(pairs, directories, facts, ladder: list[Aggregate] = ()) ->
     together), the rungs some method learned per suite and world, and how much of each suite
     is archived and still to train (``facts``: ``_suite_facts`` per directory)."""
     lines = []
-    tally = decided_by_regime(pairs)
-    if tally:
-        lines.append("- Distilled against scratch, final greedy success: " + "; ".join(
-            f"`{regime}` {t['comparisons']} comparison{'s' if t['comparisons'] > 1 else ''}: ahead on {t['ahead']}, "
-            f"behind on {t['behind']}, no "
-            f"difference of {SMALLEST_DIFFERENCE:g} or more on {t['no difference']} ({t['trivial']} of them only "
-            f"because every seed of both sat at 0 or at 1), undecided on {t['comparisons'] - _decided(t)}"
-            + _needed_range(t["seeds to decide"]) for regime, t in tally.items()) + ".")
+    if pairs:
+        lines.append("- Distilled against scratch, final greedy success: " + _verdicts_text(pairs) + ".")
+        lines.append("- Distilled against scratch, AUC (how soon a run learned; same rules): "
+                     + _verdicts_text(in_metric(pairs, "auc")) + ".")
     lines += _distilled_across_the_ladder(ladder)
     names = [runs.name for runs in directories]
     learned_parts, coverage_parts = [], []
@@ -593,6 +615,17 @@ def summary_markdown(pairs, directories, facts, ladder: list[Aggregate] = ()) ->
                      + "; ".join(learned_parts) + ".")
         lines.append("- Archived of each suite as defined now: " + "; ".join(coverage_parts) + ".")
     return ["## In short", "", *lines, ""] if lines else []
+
+
+def _verdicts_text(pairs) -> str:
+    """Per learner regime, how many of ``pairs`` say each verdict, and what the undecided
+    ones would need."""
+    return "; ".join(
+        f"`{regime}` {t['comparisons']} comparison{'s' if t['comparisons'] > 1 else ''}: ahead on {t['ahead']}, "
+        f"behind on {t['behind']}, no difference of {SMALLEST_DIFFERENCE:g} or more on {t['no difference']} "
+        f"({t['trivial']} of them only because every seed of both sat at 0 or at 1), undecided on "
+        f"{t['comparisons'] - _decided(t)}" + _needed_range(t["seeds to decide"])
+        for regime, t in decided_by_regime(pairs).items())
 
 
 def _distilled_across_the_ladder(ladder: list[Aggregate]) -> list[str]:

@@ -356,7 +356,8 @@ def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_pa
     assert said("DungeonQuest").verdict == "too few seeds"
     assert said("Reach").improvement.low == 0.0 and said("Reach").verdict == "undecided"
     text = "\n".join(comparisons_markdown(comparisons([board])))
-    assert "Decided (ahead, behind, or no difference of 0.2 or more) on 3 of 6 comparisons, 1 of them only" in text
+    assert ("Decided in final greedy success (ahead, behind, or no difference of 0.2 or more) on 3 of 6 comparisons, "
+            "1 of them only") in text
     assert "| ToolHome | Cont | one-step | `td3-dynamic` − `td3` | -0.80 [" in text
     need = said("TwoToolsHome").seeds_to_decide
     assert f"| undecided (at these means and spreads: about {need} seeds a side, against 5) |" in text
@@ -382,8 +383,37 @@ def test_each_learner_regime_s_share_of_decided_comparisons_is_read_apart(tmp_pa
     assert "| ToolHome | Cont | n-step-wide | `td3-dynamic` − `td3` | +0.00 [+0.00, +0.00] |" in text
     # both decided; the n-step-wide one only because every seed of both sat at 1
     assert "on 2 of 2 comparisons, 1 of them only" in text
-    assert text.rstrip().endswith("By learner regime, decided and not only by all-0/all-1 seeds: `one-step` 1 of 1; "
-                                  "`n-step-wide` 0 of 1.")
+    success, auc = [x for x in text.split("\n") if x.startswith("Decided")]
+    assert success.endswith("By learner regime, decided and not only by all-0/all-1 seeds: `one-step` 1 of 1; "
+                            "`n-step-wide` 0 of 1.")
+    assert auc.startswith("Decided in AUC") and auc.endswith("`one-step` 1 of 1; `n-step-wide` 0 of 1.")
+
+
+def test_a_comparison_trivial_in_final_success_can_be_decided_in_auc(tmp_path):
+    # every seed of both ends at 1, but the distilled student gets there an evaluation sooner:
+    # final success cannot tell them apart, AUC (the mean over the evaluations) can
+    from craftsuite.reporting.board import compare
+    from craftsuite.reporting.pages import comparisons, comparisons_markdown, summary_markdown
+
+    for seed in range(5):
+        late = 0.1 * seed / 4  # a little spread, so that the intervals have width
+        fake_run(tmp_path, "td3", seed, [(250, 0.0), (500, late), (750, 1.0), (1000, 1.0)], [(950, 1.0)],
+                 task="ToolHome")
+        fake_run(tmp_path, "td3-dynamic", seed, [(250, late), (500, 1.0), (750, 1.0), (1000, 1.0)], [(950, 1.0)],
+                 task="ToolHome")
+    e = {x.method: x for x in build(tmp_path)}
+    in_success, in_auc = compare(e["td3-dynamic"], e["td3"]), compare(e["td3-dynamic"], e["td3"], "auc")
+    assert in_success.trivial and in_success.verdict.endswith("(every seed of both at 1)")
+    assert in_auc.verdict == "ahead" and not in_auc.trivial and in_auc.difference.low > 0.2
+    pairs = comparisons([build(tmp_path)])
+    [row] = [x for x in comparisons_markdown(pairs) if x.startswith("| ToolHome")]
+    assert row.endswith(f"| no difference of 0.2 or more (every seed of both at 1) | {in_auc.difference.value:+.2f} "
+                        f"[{in_auc.difference.low:+.2f}, {in_auc.difference.high:+.2f}] | ahead |")
+    success_line, auc_line = [x for x in summary_markdown(pairs, [], {}) if x.startswith("- Distilled")]
+    assert "ahead on 0" in success_line and "(1 of them only" in success_line
+    assert auc_line.startswith("- Distilled against scratch, AUC") and "ahead on 1" in auc_line
+    with pytest.raises(ValueError, match="compare in one of"):
+        compare(e["td3-dynamic"], e["td3"], "return")
 
 
 def test_the_probability_of_improvement_alone_does_not_decide(tmp_path):
@@ -430,7 +460,8 @@ def test_the_summary_says_how_many_seeds_the_undecided_comparisons_would_need(tm
     [pair] = pairs = comparisons([build(tmp_path)])
     need = pair[2].seeds_to_decide
     assert pair[2].verdict == "undecided" and need > 6
-    [line] = [x for x in summary_markdown(pairs, [], {}) if x.startswith("- ")]
+    line, in_auc = [x for x in summary_markdown(pairs, [], {}) if x.startswith("- ")]
+    assert in_auc.startswith("- Distilled against scratch, AUC")  # one evaluation a run: AUC reads as success
     assert line.endswith(f"undecided on 1 (the interval rules would need about {need} seeds a side at the means and "
                          "spreads measured).")
 

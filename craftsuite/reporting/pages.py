@@ -159,7 +159,9 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
         if pairs:
             lines += ["", "Against scratch, final greedy success (the difference of the means with Welch's "
                       "95% t-interval; the probability that a run beats a scratch run, with its bootstrap interval): "
-                      + "; ".join(_comparison_text(e, base) for e, base in pairs) + "."]
+                      + "; ".join(_comparison_text(e, base) for e, base in pairs) + ".", "",
+                      "Against scratch, AUC (how soon a run learned; the same rules): "
+                      + "; ".join(_comparison_text(e, base, "auc") for e, base in pairs) + "."]
         lines += obstacles_markdown(rows)
         notes = [f"*{e.label}: " + "; ".join(f"{k} = {json.dumps(v)}" for k, v in e.differs.items()) + "*"
                  for e in rows if e.variant]
@@ -245,10 +247,10 @@ def obstacles_markdown(rows: list[Entry]) -> list[str]:
             "|---|---|---|---|---|", *lines, *unread]
 
 
-def _comparison_text(entry: Entry, baseline: Entry) -> str:
+def _comparison_text(entry: Entry, baseline: Entry, metric: str = "success") -> str:
     if entry.budget != baseline.budget:  # never set side by side as if they were one comparison
         return f"`{entry.label}` not compared: {entry.budget:,} transitions against {baseline.budget:,}"
-    c = compare(entry, baseline)
+    c = compare(entry, baseline, metric)
     return (f"`{entry.label}` {_fmt(c.difference, signed=True)}, P(> `{baseline.label}`) {_fmt(c.improvement)}: "
             f"**{c.verdict}**")
 

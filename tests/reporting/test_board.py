@@ -393,7 +393,7 @@ def test_a_comparison_trivial_in_final_success_can_be_decided_in_auc(tmp_path):
     # every seed of both ends at 1, but the distilled student gets there an evaluation sooner:
     # final success cannot tell them apart, AUC (the mean over the evaluations) can
     from craftsuite.reporting.board import compare
-    from craftsuite.reporting.pages import comparisons, comparisons_markdown, summary_markdown
+    from craftsuite.reporting.pages import comparisons, comparisons_markdown, leaderboard_markdown, summary_markdown
 
     for seed in range(5):
         late = 0.1 * seed / 4  # a little spread, so that the intervals have width
@@ -414,6 +414,10 @@ def test_a_comparison_trivial_in_final_success_can_be_decided_in_auc(tmp_path):
     assert auc_line.startswith("- Distilled against scratch, AUC") and "ahead on 1" in auc_line
     with pytest.raises(ValueError, match="compare in one of"):
         compare(e["td3-dynamic"], e["td3"], "return")
+    # the rung's own section says both readings (a leaderboard of one directory has no table of them)
+    board_text = leaderboard_markdown(build(tmp_path)).split("\n")
+    [in_auc_text] = [x for x in board_text if x.startswith("Against scratch, AUC")]
+    assert in_auc_text.endswith(": **ahead**.") and "`td3-dynamic` +" in in_auc_text
 
 
 def test_the_probability_of_improvement_alone_does_not_decide(tmp_path):

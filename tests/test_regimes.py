@@ -80,5 +80,5 @@ def test_two_regimes_runs_are_two_leaderboards_never_variants(tmp_path):
     assert "## Learner regime `one-step`" in md and "## Learner regime `n-step`" in md
     assert "#### Cont, n-step regime" in md  # each regime's aggregate apart
     table = "\n".join(comparisons_markdown(comparisons([board])))
-    assert "| BlindCraftsman | Cont | one-step | `td3-dynamic` − `td3` | +1.00" in table
-    assert "| BlindCraftsman | Cont | n-step | `td3-dynamic` − `td3` | -1.00" in table
+    assert "| BlindCraftsman | Cont | one-step | `td3-dynamic` − `td3` | 1,000 | +1.00" in table
+    assert "| BlindCraftsman | Cont | n-step | `td3-dynamic` − `td3` | 1,000 | -1.00" in table

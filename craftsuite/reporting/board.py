@@ -401,14 +401,18 @@ def _transfer_target(entry: Entry, baseline: Entry) -> str:
     return f"not met ({figures})"
 
 
-# the smallest difference in final greedy success a comparison must be able to see: where
-# the interval of the difference lies within +-this, the two are said not to differ by it
+# the smallest difference a comparison must be able to see, in final greedy success and in
+# AUC alike: where the interval of the difference lies within +-this, the two are said not to
+# differ by it
 SMALLEST_DIFFERENCE = 0.2
 
 
-# the metrics a method is compared with its baseline in, each with the words a page reads it by:
-# final greedy success (where a run ends) and AUC (how soon and how steadily it got there)
+# the metrics a method is compared with its baseline in, each with the words a page reads it
+# by: final greedy success (where a run ends) and AUC (how soon and how steadily it got there)
 COMPARED = {"success": "final greedy success", "auc": "AUC"}
+# where every value of both sides is 0 (or 1), what that says of the runs beyond "every
+# seed of both at 0", by metric: an AUC of 0 (or 1) is success 0 (or 1) at every evaluation
+ALL_SAME = {"success": "", "auc": " at every evaluation"}
 
 
 @dataclass(frozen=True)
@@ -479,7 +483,7 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success") -> Compariso
     elif -SMALLEST_DIFFERENCE < diff.low and diff.high < SMALLEST_DIFFERENCE:
         said = f"no difference of {SMALLEST_DIFFERENCE:g} or more"
         if {*mine, *theirs} in ({0.0}, {1.0}):  # said plainly: no comparison tells methods apart there
-            said += " (every seed of both at 0)" if mine[0] == 0 else " (every seed of both at 1)"
+            said += f" (every seed of both at {mine[0]:g}{ALL_SAME[metric]})"
             return Comparison(diff, better, said, trivial=True)
     else:
         return Comparison(diff, better, "undecided",

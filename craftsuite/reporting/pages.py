@@ -24,6 +24,8 @@ from .board import (
     THRESHOLD,
     SELF_REPORTED,
     SMALLEST_DIFFERENCE,
+    ALL_SAME,
+    COMPARED,
     Aggregate,
     Board,
     Comparison,
@@ -157,10 +159,10 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
                       "as never): " + "; ".join(f"`{e.label}` {verdict(e, base, 'steps_to_80')}"
                                                  for e, base in same) + "."]
         if pairs:
-            lines += ["", "Against scratch, final greedy success (the difference of the means with Welch's "
+            lines += ["", f"Against scratch, {COMPARED['success']} (the difference of the means with Welch's "
                       "95% t-interval; the probability that a run beats a scratch run, with its bootstrap interval): "
                       + "; ".join(_comparison_text(e, base) for e, base in pairs) + ".", "",
-                      "Against scratch, AUC (how soon a run learned; the same rules): "
+                      f"Against scratch, {COMPARED['auc']} (how soon a run learned; the same rules): "
                       + "; ".join(_comparison_text(e, base, "auc") for e, base in pairs) + "."]
         lines += obstacles_markdown(rows)
         notes = [f"*{e.label}: " + "; ".join(f"{k} = {json.dumps(v)}" for k, v in e.differs.items()) + "*"
@@ -255,19 +257,20 @@ def _comparison_text(entry: Entry, baseline: Entry, metric: str = "success") -> 
             f"**{c.verdict}**")
 
 
-def comparisons(boards: list[Board], metric: str = "success") -> list[tuple[Entry, Entry, Comparison | None]]:
+def comparisons(boards: list[Board]) -> list[tuple[Entry, Entry, Comparison | None]]:
     """Every distilled method against its algorithm from scratch, rung by rung, across
-    ``boards`` (easiest rung first): each pair with its verdict in ``metric``
+    ``boards`` (easiest rung first): each pair with its verdict in final greedy success
     (``board.compare``), None where the two ran at other budgets (never set side by side as
-    one comparison)."""
-    return in_metric([(entry, base, None) for board in boards for entry, base in _pairs(board)], metric)
+    one comparison). ``in_metric`` reads the same pairs in AUC."""
+    return in_metric([pair for board in boards for pair in _pairs(board)], "success")
 
 
 def in_metric(pairs, metric: str) -> list[tuple[Entry, Entry, Comparison | None]]:
-    """``pairs`` (``comparisons``) read again in ``metric``: the same rows, each with its
-    verdict in that metric (None where the two ran at other budgets)."""
+    """``pairs`` (each starting with a method's entry and its baseline's, as ``comparisons``
+    gives them) with their verdicts in ``metric``, one of ``board.COMPARED``: None where the
+    two ran at other budgets."""
     return [(entry, base, compare(entry, base, metric) if entry.budget == base.budget else None)
-            for entry, base, _ in pairs]
+            for entry, base, *_ in pairs]
 
 
 def _pairs(board: Board) -> list[tuple[Entry, Entry]]:
@@ -319,23 +322,23 @@ def _seeds_to_decide(c: Comparison, entry: Entry, base: Entry) -> str:
         f"{_now(entry, base)})"
 
 
-def comparisons_markdown(pairs) -> list[str]:
-    """The table of ``comparisons`` (``pairs``, in final greedy success): the difference and
-    verdict of each in final greedy success and in AUC, and how many decide it in each."""
+def comparisons_markdown(pairs, auc=None) -> list[str]:
+    """The table of ``comparisons`` (``pairs``) and of the same pairs in AUC (``auc``:
+    ``in_metric(pairs, "auc")``, read here if not given): the difference, probability and
+    verdict of each in final greedy success and in AUC, and how many each decides."""
     if not pairs:
         return []
-    rows, auc = [], in_metric(pairs, "auc")
+    auc = in_metric(pairs, "auc") if auc is None else auc
+    rows = []
     for (entry, base, c), (_, _, in_auc) in zip(pairs, auc):
         head = f"| {entry.task} | {entry.world_label} | {entry.regime} | `{entry.label}` − `{base.label}` "
-        rows.append(head + (f"| | | {entry.budget:,} against {base.budget:,} | not compared: other budgets | | |"
-                            if c is None else f"| {_fmt(c.difference, signed=True)} | {_fmt(c.improvement)} "
-                            f"| {entry.budget:,} | {c.verdict}{_seeds_to_decide(c, entry, base)} "
-                            f"| {_fmt(in_auc.difference, signed=True)} "
-                            f"| {in_auc.verdict}{_seeds_to_decide(in_auc, entry, base)} |"))
-    return ["| rung | world | learner regime | distilled − scratch | difference in success [95% Welch t] "
-            "| P(distilled > scratch) [95% bootstrap] | transitions per run | verdict "
-            "| difference in AUC [95% Welch t] | verdict in AUC |",
-            "|---|---|---|---|---|---|---|---|---|---|", *rows, "",
+        rows.append(head + (f"| | | {entry.budget:,} against {base.budget:,} | not compared: other budgets | | | |"
+                            if c is None else f"| {entry.budget:,} | {_cells(c, entry, base)} | "
+                            f"{_cells(in_auc, entry, base)} |"))
+    return ["| rung | world | learner regime | distilled − scratch | transitions per run "
+            "| difference in success [95% Welch t] | P(distilled > scratch) [95% bootstrap] | verdict "
+            "| difference in AUC [95% Welch t] | P(distilled > scratch) in AUC | verdict in AUC |",
+            "|---|---|---|---|---|---|---|---|---|---|---|", *rows, "",
             f"Decided in final greedy success (ahead, behind, or no difference of {SMALLEST_DIFFERENCE:g} or more) "
             f"{_tally_text(pairs)}: *ahead*/*behind* where the two t-intervals are apart, or where the "
             "probability's interval excludes one half and the difference's excludes 0 on the same side (the "
@@ -348,14 +351,23 @@ def comparisons_markdown(pairs) -> list[str]:
             + _by_regime_text(pairs), "",
             "Decided in AUC (the mean greedy success over the evaluations during training: how soon and how steadily "
             "a run learned, where final success says only where it ended), by the same rules and the same smallest "
-            f"difference, {_tally_text(auc)}." + _by_regime_text(auc), ""]
+            f"difference, {_tally_text(auc, 'auc')}. A gap of {SMALLEST_DIFFERENCE:g} in AUC is a large one (a run "
+            f"at 1 for a further {SMALLEST_DIFFERENCE:.0%} of its evaluations, or a level {SMALLEST_DIFFERENCE:g} "
+            "higher throughout), so an AUC *no difference* rules out only a gap that large." + _by_regime_text(auc), ""]
 
 
-def _tally_text(pairs) -> str:
-    """How many of ``pairs`` are decided, and how many of those only by all-0/all-1 seeds."""
+def _cells(c: Comparison, entry: Entry, base: Entry) -> str:
+    """A comparison's difference, probability and verdict, as three cells of a table row."""
+    return (f"{_fmt(c.difference, signed=True)} | {_fmt(c.improvement)} | "
+            f"{c.verdict}{_seeds_to_decide(c, entry, base)}")
+
+
+def _tally_text(pairs, metric: str = "success") -> str:
+    """How many of ``pairs`` (read in ``metric``) are decided, and how many of those only
+    because every value of both sides was 0 (or 1)."""
     tally = decided_by_regime(pairs).values()
     return (f"on {sum(_decided(t) for t in tally)} of {len(pairs)} comparisons, {sum(t['trivial'] for t in tally)} "
-            "of them only because every seed of both sat at 0 or at 1")
+            f"of them only because every seed of both sat at 0 or at 1{ALL_SAME[metric]}")
 
 
 def _by_regime_text(pairs) -> str:
@@ -501,14 +513,15 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
     # every directory read before anything is written
     directories = [read_runs(d, suite_cells=True) for d in run_dirs]
     pairs = comparisons([runs.board for runs in directories])
+    auc = in_metric(pairs, "auc")
     facts = {runs.path: _suite_facts(runs) for runs in directories}
     ladder = aggregates([e for runs in directories for e in runs.board])
-    lines += summary_markdown(pairs, directories, facts, ladder)
-    compared = comparisons_markdown(pairs)
+    lines += summary_markdown(pairs, directories, facts, ladder, auc)
+    compared = comparisons_markdown(pairs, auc)
     if compared:
         lines += ["## Distilled against scratch", "",
                   "Each distilled method against its algorithm from scratch on each rung, in final greedy success "
-                  "(the rows come from the leaderboards below).", "", *compared]
+                  "and in AUC (the rows come from the leaderboards below).", "", *compared]
     if len(directories) > 1:
         if any(agg.iqm for agg in ladder):
             lines += ["## Across the ladder", "", "Every directory below together, per world and learner regime "
@@ -583,17 +596,19 @@ def _needed_range(needs: list[int]) -> str:
             "at the means and spreads measured)")
 
 
-def summary_markdown(pairs, directories, facts, ladder: list[Aggregate] = ()) -> list[str]:
+def summary_markdown(pairs, directories, facts, ladder: list[Aggregate] = (), auc=None) -> list[str]:
     """The page's answer in a few lines, from the sections below: the comparisons per
-    learner regime and their verdicts, each distilled method's probability of beating
+    learner regime and their verdicts in final greedy success and in AUC (``auc``: the same
+    pairs, ``in_metric(pairs, "auc")``, read here if not given), each distilled method's probability of beating
     scratch across the tasks both ran (``ladder``: the aggregates of every directory
     together), the rungs some method learned per suite and world, and how much of each suite
     is archived and still to train (``facts``: ``_suite_facts`` per directory)."""
     lines = []
     if pairs:
-        lines.append("- Distilled against scratch, final greedy success: " + _verdicts_text(pairs) + ".")
-        lines.append("- Distilled against scratch, AUC (how soon a run learned; same rules): "
-                     + _verdicts_text(in_metric(pairs, "auc")) + ".")
+        auc = in_metric(pairs, "auc") if auc is None else auc
+        lines.append(f"- Distilled against scratch, {COMPARED['success']}: {_verdicts_text(pairs)}.")
+        lines.append(f"- Distilled against scratch, {COMPARED['auc']} (how soon a run learned; the same rules): "
+                     f"{_verdicts_text(auc, 'auc')}.")
     lines += _distilled_across_the_ladder(ladder)
     names = [runs.name for runs in directories]
     learned_parts, coverage_parts = [], []
@@ -619,13 +634,13 @@ def summary_markdown(pairs, directories, facts, ladder: list[Aggregate] = ()) ->
     return ["## In short", "", *lines, ""] if lines else []
 
 
-def _verdicts_text(pairs) -> str:
-    """Per learner regime, how many of ``pairs`` say each verdict, and what the undecided
-    ones would need."""
+def _verdicts_text(pairs, metric: str = "success") -> str:
+    """Per learner regime, how many of ``pairs`` (read in ``metric``) say each verdict, and
+    what the undecided ones would need."""
     return "; ".join(
         f"`{regime}` {t['comparisons']} comparison{'s' if t['comparisons'] > 1 else ''}: ahead on {t['ahead']}, "
         f"behind on {t['behind']}, no difference of {SMALLEST_DIFFERENCE:g} or more on {t['no difference']} "
-        f"({t['trivial']} of them only because every seed of both sat at 0 or at 1), undecided on "
+        f"({t['trivial']} of them only because every seed of both sat at 0 or at 1{ALL_SAME[metric]}), undecided on "
         f"{t['comparisons'] - _decided(t)}" + _needed_range(t["seeds to decide"])
         for regime, t in decided_by_regime(pairs).items())
 

@@ -358,7 +358,7 @@ def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_pa
     text = "\n".join(comparisons_markdown(comparisons([board])))
     assert ("Decided in final greedy success (ahead, behind, or no difference of 0.2 or more) on 3 of 6 comparisons, "
             "1 of them only") in text
-    assert "| ToolHome | Cont | one-step | `td3-dynamic` − `td3` | -0.80 [" in text
+    assert "| ToolHome | Cont | one-step | `td3-dynamic` − `td3` | 1,000 | -0.80 [" in text
     need = said("TwoToolsHome").seeds_to_decide
     assert f"| undecided (at these means and spreads: about {need} seeds a side, against 5) |" in text
     assert "By learner regime" not in text  # one regime: the sentence above says it all
@@ -380,13 +380,25 @@ def test_each_learner_regime_s_share_of_decided_comparisons_is_read_apart(tmp_pa
         fake_run(tmp_path, "td3", seed, [(1000, 1.0)], [(950, 1.0)], task="ToolHome", hyperparameters=wide)
         fake_run(tmp_path, "td3-dynamic", seed, [(1000, 1.0)], [(950, 1.0)], task="ToolHome", hyperparameters=wide)
     text = "\n".join(comparisons_markdown(comparisons([build(tmp_path)])))
-    assert "| ToolHome | Cont | n-step-wide | `td3-dynamic` − `td3` | +0.00 [+0.00, +0.00] |" in text
+    assert "| ToolHome | Cont | n-step-wide | `td3-dynamic` − `td3` | 1,000 | +0.00 [+0.00, +0.00] |" in text
     # both decided; the n-step-wide one only because every seed of both sat at 1
     assert "on 2 of 2 comparisons, 1 of them only" in text
     success, auc = [x for x in text.split("\n") if x.startswith("Decided")]
     assert success.endswith("By learner regime, decided and not only by all-0/all-1 seeds: `one-step` 1 of 1; "
                             "`n-step-wide` 0 of 1.")
     assert auc.startswith("Decided in AUC") and auc.endswith("`one-step` 1 of 1; `n-step-wide` 0 of 1.")
+
+
+def test_a_comparison_at_two_budgets_is_a_row_of_the_table_s_width_and_is_not_counted(tmp_path):
+    from craftsuite.reporting.pages import comparisons, comparisons_markdown
+
+    for seed in range(5):
+        fake_run(tmp_path, "td3", seed, [(1000, 1.0)], [(950, 1.0)], task="ToolHome")
+        fake_run(tmp_path, "td3-dynamic", seed, [(2000, 1.0)], [(1950, 1.0)], task="ToolHome", budget=2000)
+    lines = comparisons_markdown(comparisons([build(tmp_path)]))
+    header, rule, row = lines[:3]
+    assert "not compared: other budgets" in row and row.count("|") == header.count("|") == rule.count("|")
+    assert "on 0 of 1 comparisons" in lines[4]
 
 
 def test_a_comparison_trivial_in_final_success_can_be_decided_in_auc(tmp_path):
@@ -408,16 +420,24 @@ def test_a_comparison_trivial_in_final_success_can_be_decided_in_auc(tmp_path):
     pairs = comparisons([build(tmp_path)])
     [row] = [x for x in comparisons_markdown(pairs) if x.startswith("| ToolHome")]
     assert row.endswith(f"| no difference of 0.2 or more (every seed of both at 1) | {in_auc.difference.value:+.2f} "
-                        f"[{in_auc.difference.low:+.2f}, {in_auc.difference.high:+.2f}] | ahead |")
+                        f"[{in_auc.difference.low:+.2f}, {in_auc.difference.high:+.2f}] | 1.00 [1.00, 1.00] | ahead |")
     success_line, auc_line = [x for x in summary_markdown(pairs, [], {}) if x.startswith("- Distilled")]
     assert "ahead on 0" in success_line and "(1 of them only" in success_line
     assert auc_line.startswith("- Distilled against scratch, AUC") and "ahead on 1" in auc_line
     with pytest.raises(ValueError, match="compare in one of"):
         compare(e["td3-dynamic"], e["td3"], "return")
+    for seed in range(5):  # nobody ever succeeds: trivial in both, and AUC's wording says it held throughout
+        fake_run(tmp_path, "td3", seed, [(500, 0.0), (1000, 0.0)], [(950, 0.0)], task="Reach")
+        fake_run(tmp_path, "td3-dynamic", seed, [(500, 0.0), (1000, 0.0)], [(950, 0.0)], task="Reach")
+    e = {(x.task, x.method): x for x in build(tmp_path)}
+    never = compare(e["Reach", "td3-dynamic"], e["Reach", "td3"], "auc")
+    assert never.trivial
+    assert never.verdict == "no difference of 0.2 or more (every seed of both at 0 at every evaluation)"
     # the rung's own section says both readings (a leaderboard of one directory has no table of them)
     board_text = leaderboard_markdown(build(tmp_path)).split("\n")
-    [in_auc_text] = [x for x in board_text if x.startswith("Against scratch, AUC")]
-    assert in_auc_text.endswith(": **ahead**.") and "`td3-dynamic` +" in in_auc_text
+    reach, toolhome = [x for x in board_text if x.startswith("Against scratch, AUC")]  # easiest rung first
+    assert toolhome.endswith(": **ahead**.") and "`td3-dynamic` +" in toolhome
+    assert reach.endswith("(every seed of both at 0 at every evaluation)**.")
 
 
 def test_the_probability_of_improvement_alone_does_not_decide(tmp_path):

@@ -647,7 +647,7 @@ def _verdicts_text(pairs, metric: str = "success") -> str:
 
 def _distilled_across_the_ladder(ladder: list[Aggregate]) -> list[str]:
     """Per world and learner regime, each distilled method's probability of beating scratch
-    in final greedy success, over every task both ran (``Aggregate.against_baseline``)."""
+    in final greedy success and in AUC, over every task both ran (``Aggregate.against_baseline``)."""
     from ..methods import is_distilled
 
     rows = []
@@ -655,13 +655,15 @@ def _distilled_across_the_ladder(ladder: list[Aggregate]) -> list[str]:
         mine = {m: p for m, p in agg.against_baseline.items() if is_distilled(m)}
         if mine:
             rows.append(f"  - {agg.label}: " + ", ".join(
-                f"`{m}` {_fmt(p.improvement['success'])} ({len(p.tasks)} task{'s' if len(p.tasks) > 1 else ''})"
+                f"`{m}` {_fmt(p.improvement['success'])}, in AUC {_fmt(p.improvement['auc'])} "
+                f"({len(p.tasks)} task{'s' if len(p.tasks) > 1 else ''})"
                 for m, p in sorted(mine.items(), key=lambda kv: (-len(kv[1].tasks), kv[0]))))
     if not rows:
         return []
     return ["- Distilled against scratch across the ladder: the probability that a distilled run's final greedy "
             "success beats a scratch run's on the same task (ties count half, so a task where both sit at 0 or at 1 "
-            "pulls it toward 0.5), averaged over every task both ran, with its 95% stratified-bootstrap interval:",
+            "pulls it toward 0.5), averaged over every task both ran, with its 95% stratified-bootstrap interval; "
+            "then the same in AUC (how soon a run learned; ties are rarer there):",
             *rows]
 
 

@@ -523,7 +523,7 @@ def test_the_summary_gives_each_distilled_method_against_scratch_across_the_task
         fake_run(root, "product-td3", seed, [(1000, 1.0)], [(995, 0.0)], task="Reach")  # not distilled: not named
     lines = summary_markdown([], [], {}, aggregates(list(build(root))))
     assert lines[2].startswith("- Distilled against scratch across the ladder")
-    assert lines[3] == "  - Cont, one-step regime: `td3-dynamic` 1.00 [1.00, 1.00] (2 tasks)"
+    assert lines[3] == "  - Cont, one-step regime: `td3-dynamic` 1.00 [1.00, 1.00], in AUC 1.00 [1.00, 1.00] (2 tasks)"
     assert "product-td3" not in "\n".join(lines)
 
 

@@ -27,7 +27,9 @@ LOOKS = {
     ("standard", "KeySwordDragon", "Grid10", "dqn", ("dynamic", "static")): (10, 20, 100),
     ("standard", "ToolHome", "Grid10", "dqn", ("dynamic", "static")): (10, 20, 100),
     ("standard", "TwoToolsHome", "Grid10", "dqn", ("dynamic", "static")): (10, 20, 100, 150),
-    ("standard", "ToolHome", "Cont", "td3", ("td3-dynamic",)): (3, 10),
+    ("standard", "ToolHome", "Cont", "td3", ("td3-dynamic",)): (3, 10, 20),
+    ("standard", "ToolHome", "Cont", "td3", ("td3-dynamic-edges",)): (5, 10, 20),
+    ("standard", "ToolHome", "Cont", "td3", ("td3-static",)): (5, 20),
 }
 
 

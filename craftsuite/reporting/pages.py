@@ -161,9 +161,9 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
         if pairs:
             lines += ["", f"Against scratch, {COMPARED['success']} (the difference of the means with Welch's "
                       "95% t-interval; the probability that a run beats a scratch run, with its bootstrap interval): "
-                      + "; ".join(_comparison_text(e, base) for e, base in pairs) + ".", "",
+                      + "; ".join(_comparison_text(*pair) for pair in in_metric(pairs, "success")) + ".", "",
                       f"Against scratch, {COMPARED['auc']} (how soon a run learned; the same rules): "
-                      + "; ".join(_comparison_text(e, base, "auc") for e, base in pairs) + "."]
+                      + "; ".join(_comparison_text(*pair) for pair in in_metric(pairs, "auc")) + "."]
         lines += obstacles_markdown(rows)
         notes = [f"*{e.label}: " + "; ".join(f"{k} = {json.dumps(v)}" for k, v in e.differs.items()) + "*"
                  for e in rows if e.variant]
@@ -249,10 +249,10 @@ def obstacles_markdown(rows: list[Entry]) -> list[str]:
             "|---|---|---|---|---|", *lines, *unread]
 
 
-def _comparison_text(entry: Entry, baseline: Entry, metric: str = "success") -> str:
-    if entry.budget != baseline.budget:  # never set side by side as if they were one comparison
+def _comparison_text(entry: Entry, baseline: Entry, c: Comparison | None) -> str:
+    """One pair of ``in_metric`` in words (None: the two ran at other budgets)."""
+    if c is None:
         return f"`{entry.label}` not compared: {entry.budget:,} transitions against {baseline.budget:,}"
-    c = compare(entry, baseline, metric)
     return (f"`{entry.label}` {_fmt(c.difference, signed=True)}, P(> `{baseline.label}`) {_fmt(c.improvement)}: "
             f"**{c.verdict}**")
 
@@ -367,7 +367,12 @@ def _tally_text(pairs, metric: str = "success") -> str:
     because every value of both sides was 0 (or 1)."""
     tally = decided_by_regime(pairs).values()
     return (f"on {sum(_decided(t) for t in tally)} of {len(pairs)} comparisons, {sum(t['trivial'] for t in tally)} "
-            f"of them only because every seed of both sat at 0 or at 1{ALL_SAME[metric]}")
+            f"of them only {_all_same(metric)}")
+
+
+def _all_same(metric: str) -> str:
+    """Why a comparison in ``metric`` was decided trivially, as the counts say it."""
+    return f"because every seed of both sat at 0 or at 1{ALL_SAME[metric]}"
 
 
 def _by_regime_text(pairs) -> str:
@@ -640,7 +645,7 @@ def _verdicts_text(pairs, metric: str = "success") -> str:
     return "; ".join(
         f"`{regime}` {t['comparisons']} comparison{'s' if t['comparisons'] > 1 else ''}: ahead on {t['ahead']}, "
         f"behind on {t['behind']}, no difference of {SMALLEST_DIFFERENCE:g} or more on {t['no difference']} "
-        f"({t['trivial']} of them only because every seed of both sat at 0 or at 1{ALL_SAME[metric]}), undecided on "
+        f"({t['trivial']} of them only {_all_same(metric)}), undecided on "
         f"{t['comparisons'] - _decided(t)}" + _needed_range(t["seeds to decide"])
         for regime, t in decided_by_regime(pairs).items())
 

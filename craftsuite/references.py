@@ -76,7 +76,9 @@ def _ids_of(name: str) -> list[str]:
 
 def scratch_success(results) -> dict[str, list[str]]:
     """Per task, TD3 from scratch in MuJoCo as the results archive under ``results`` holds it
-    (every suite's directory): the mean final greedy success [95% t], at each budget run."""
+    (every suite's directory): the mean final greedy success [95% t], at each budget and
+    learner regime run (a regime changes how hard a rung reads: n-step returns learn it
+    sooner)."""
     from .ids import CONT
     from .reporting.board import build
 
@@ -87,7 +89,7 @@ def scratch_success(results) -> dict[str, list[str]]:
                 s = e.stats["success"]
                 interval = f" [{s.low:.2f}, {s.high:.2f}]" if s.has_interval else ""
                 out.setdefault(e.task, []).append(f"{s.value:.2f}{interval} at {e.budget / 1e6:g}M "
-                                                  f"({len(e.seeds)} seeds, {students.parent.name})")
+                                                  f"({len(e.seeds)} seeds, {students.parent.name}, {e.regime})")
     return out
 
 
@@ -120,8 +122,9 @@ def tasks_page(episodes: int = 100, progress: bool = True, results="results") ->
         "paper's tasks.",
         "",
         "Scratch success: TD3 from scratch in MuJoCo, greedy success at the last evaluation, the mean over seeds",
-        "[95% t-interval], at the budget its suite gives the rung (from the results archive, `results/`). Each",
-        "middle rung is calibrated to land between 0.2 and 0.8 there: where methods can differ.",
+        "[95% t-interval], at each budget and learner regime a suite ran it (from the results archive, `results/`).",
+        "Each middle rung is calibrated to land between 0.2 and 0.8 at its suite's budget in its suite's regime:",
+        "where methods can differ.",
         "",
         f"References, {episodes} episodes per id on seeds 0-{episodes - 1}: the *scripted* planner (walks to the "
         "next object the objective needs) and a uniformly *random* policy. Steps are decisions per completed "

@@ -79,7 +79,8 @@ def main(argv=None) -> int:
         for i in range(len(out[method][0]["windows"])):
             w = [s["windows"][i] for s in out[method]]
             tot = {k: sum(x[k] for x in w) for k in w[0] if k not in ("from", "to")}
-            print(f"  {w[0]['from']:>6,}-{w[0]['to']:>6,}: {tot['episodes']:4d} episodes: {tot['completed']:4d} completed, "
+            print(f"  {w[0]['from']:>6,}-{w[0]['to']:>6,}: {tot['episodes']:4d} episodes: "
+                  f"{tot['completed']:4d} completed, "
                   f"{tot['broken']:4d} broken, {tot['timed out']:3d} timed out; "
                   f"{tot['reached one edge from acceptance']:4d} reached one edge from acceptance")
         for s in out[method]:

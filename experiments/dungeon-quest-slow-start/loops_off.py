@@ -11,3 +11,15 @@ for _name in ("static", "dynamic"):
     register_method(Method(f"{_name}-loops-off", _row.world, _row.algorithm, _row.product, _row.distill,
                            target={"self_loops": False},
                            description=f"{_name} with the distilled target off the automaton's self-loops"))
+
+
+def main() -> int:
+    """Print the rows this module registers, as the command line reads them."""
+    for name in ("static-loops-off", "dynamic-loops-off"):
+        row = METHODS[name]
+        print(f"loops_off:{name}: {row.description} (target {dict(row.target)})")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -275,8 +275,13 @@ def outside(record: dict, kind: str, suite, rungs: list[str]) -> str | None:
     asked = [("task", rungs)] + ([("world", suite.worlds), ("method", suite.methods)] if kind == "students" else [])
     for field, known in asked:
         if record.get(field) not in known:
+            # a method beyond the suite's (a row of the user's own, or one the suite leaves out) ran
+            # in this suite's transfer all the same: no suite's archive takes it
+            fix = ("archive it with --suite set to the suite that ran it" if field != "method" else
+                   f"a method beyond a suite's is kept in an archive of its own (craftsuite transfer "
+                   f"--archive DIR) or read where it is (craftsuite leaderboard RUNS ARCHIVE/{suite.name})")
             return (f"{field} {record.get(field)} is not one of suite {suite.name}'s {field}s ({', '.join(known)}): "
-                    "archive it with --suite set to the suite that ran it")
+                    f"{fix}")
     return None
 
 

@@ -275,14 +275,24 @@ def outside(record: dict, kind: str, suite, rungs: list[str]) -> str | None:
     asked = [("task", rungs)] + ([("world", suite.worlds), ("method", suite.methods)] if kind == "students" else [])
     for field, known in asked:
         if record.get(field) not in known:
-            # a method beyond the suite's (a row of the user's own, or one the suite leaves out) ran
-            # in this suite's transfer all the same: no suite's archive takes it
-            fix = ("archive it with --suite set to the suite that ran it" if field != "method" else
-                   f"a method beyond a suite's is kept in an archive of its own (craftsuite transfer "
-                   f"--archive DIR) or read where it is (craftsuite leaderboard RUNS ARCHIVE/{suite.name})")
             return (f"{field} {record.get(field)} is not one of suite {suite.name}'s {field}s ({', '.join(known)}): "
-                    f"{fix}")
+                    f"{_elsewhere(field, record.get(field), suite.name)}")
     return None
+
+
+def _elsewhere(field: str, value, suite: str) -> str:
+    """Where a run that is not one of ``suite``'s can go instead."""
+    from .suites import SUITES
+
+    if field == "method":
+        others = [name for name, s in SUITES.items() if value in s.methods and s.archived]
+        if others:
+            return f"archive it with --suite set to a suite that runs it ({', '.join(others)})"
+        # a row of the user's own (or one no suite runs) can still run in this suite's transfer
+        return ("no suite runs that method: run its transfer again with the same --out and --archive DIR (an "
+                "archive of its own, not results) to keep it, or read it where it is beside this archive "
+                f"(craftsuite leaderboard RUNS ARCHIVE/{suite} --out DIR)")
+    return "archive it with --suite set to the suite that ran it"
 
 
 @dataclass

@@ -12,12 +12,18 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import statistics
 from pathlib import Path
 
+import gymnasium as gym
+
+import craftsuite  # noqa: F401  (registers the ids)
+from craftsuite.ids import env_id
 from craftsuite.reached import bits
-from craftsuite.reporting.obstacles import _spec, distances
+from craftsuite.reporting.obstacles import distances
 from craftsuite.runs import EPISODE_FIELDS, read_config, read_csv
+from craftsuite.task_registry import resolve_task
 
 
 def first_at(evals: list[dict], level: float = 0.8) -> int | None:
@@ -25,7 +31,7 @@ def first_at(evals: list[dict], level: float = 0.8) -> int | None:
     return next((int(e["step"]) for e in evals if float(e["success"]) >= level), None)
 
 
-def classify(row: dict, sink: set[int], near: set[int], limit: int) -> str:
+def classify(row: dict, sink: set[int], limit: int) -> str:
     """One training episode's ending: completed, broken (it entered the rejecting sink),
     timed out (the step limit), or other (a truncation before the limit)."""
     if int(float(row["success"])):
@@ -37,17 +43,16 @@ def classify(row: dict, sink: set[int], near: set[int], limit: int) -> str:
 
 def read_run(run: Path, window: int, until: int) -> dict:
     config = read_config(run)
-    automaton = _spec(run, config).automaton
+    automaton = resolve_task(config["task"]).automaton
     sink = {q for q, r in enumerate(automaton.rejecting.tolist()) if r}
     near = {q for q, d in enumerate(distances(automaton)) if d == 1}
     evals = read_csv(run / "evals.csv", ("step", "success"), True)
-    limit = round(max(float(e.get("length") or 0) for e in read_csv(run / "evals.csv", ("step", "success", "length"),
-                                                                          True)))
+    limit = gym.spec(env_id(config["task"], config["world"])).max_episode_steps  # the world's episode limit
     episodes = read_csv(run / "episodes.csv", EPISODE_FIELDS, True)  # (or the archive's .gz)
     windows = []
     for lo in range(0, until, window):
         rows = [r for r in episodes if lo < int(r["step"]) <= lo + window]
-        ends = [classify(r, sink, near, limit) for r in rows]
+        ends = [classify(r, sink, limit) for r in rows]
         windows.append({"from": lo, "to": lo + window, "episodes": len(rows),
                         **{k: ends.count(k) for k in ("completed", "broken", "timed out", "other")},
                         "reached one edge from acceptance": sum(bool(set(bits(int(r["states"]))) & near)
@@ -87,8 +92,11 @@ def main(argv=None) -> int:
             w0 = s["windows"][0]
             print(f"  seed {s['seed']:2d}: first at 80% {s['first at 80%']!s:>6}, first window {w0['episodes']:3d} "
                   f"episodes, {w0['broken']:3d} broken, {w0['timed out']:2d} timed out")
-        firsts = [s["first at 80%"] for s in out[method] if s["first at 80%"] is not None]
-        print(f"  median first at 80%: {statistics.median(firsts):,.0f} ({len(firsts)} of {len(out[method])} seeds)")
+        # a seed that never reached 80% counts as later than any that did
+        firsts = [s["first at 80%"] if s["first at 80%"] is not None else math.inf for s in out[method]]
+        late = sum(f >= 20_000 for f in firsts)
+        print(f"  median first at 80%: {statistics.median(firsts):,.0f}; first at 20,000 or later (or never): "
+              f"{late} of {len(firsts)} seeds")
     if args.out:
         Path(args.out).write_text(json.dumps(out, indent=1) + "\n")
     return 0

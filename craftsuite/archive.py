@@ -270,29 +270,37 @@ def size(archive: Path) -> int:
 
 def outside(record: dict, kind: str, suite, rungs: list[str]) -> str | None:
     """Why a run (``record``: its config.json) is not one of ``suite``'s (a ``suites.Suite``
-    whose rungs are ``rungs``): a task it does not run or, for a student, a world or method.
-    None: it is one. Its budget and other settings are not asked (see ``add``)."""
+    whose rungs are ``rungs``): a task it does not run or, for a student, a world or method,
+    and where it can go instead. None: it is one. Its budget and other settings are not asked
+    (see ``add``)."""
+    missed = _missed(record, kind, suite, rungs)
+    if missed is None:
+        return None
+    field, known = missed
+    return (f"{field} {record.get(field)} is not one of suite {suite.name}'s {field}s ({', '.join(known)}): "
+            f"{_elsewhere(record, kind, suite.name)}")
+
+
+def _missed(record: dict, kind: str, suite, rungs: list[str]) -> tuple[str, tuple] | None:
+    """The first field of ``record`` that ``suite`` does not run, with the values it does."""
     asked = [("task", rungs)] + ([("world", suite.worlds), ("method", suite.methods)] if kind == "students" else [])
-    for field, known in asked:
-        if record.get(field) not in known:
-            return (f"{field} {record.get(field)} is not one of suite {suite.name}'s {field}s ({', '.join(known)}): "
-                    f"{_elsewhere(field, record.get(field), suite.name)}")
-    return None
+    return next(((field, tuple(known)) for field, known in asked if record.get(field) not in known), None)
 
 
-def _elsewhere(field: str, value, suite: str) -> str:
-    """Where a run that is not one of ``suite``'s can go instead."""
+def _elsewhere(record: dict, kind: str, suite: str) -> str:
+    """Where a run that is not one of ``suite``'s can go instead: the archived suites whose
+    task, world and method it is, else an archive of its own (a transfer runs rungs, worlds
+    and methods beyond its suite's, and keeps them only where --archive DIR says)."""
     from .suites import SUITES
 
-    if field == "method":
-        others = [name for name, s in SUITES.items() if value in s.methods and s.archived]
-        if others:
-            return f"archive it with --suite set to a suite that runs it ({', '.join(others)})"
-        # a row of the user's own (or one no suite runs) can still run in this suite's transfer
-        return ("no suite runs that method: run its transfer again with the same --out and --archive DIR (an "
-                "archive of its own, not results) to keep it, or read it where it is beside this archive "
-                f"(craftsuite leaderboard RUNS ARCHIVE/{suite} --out DIR)")
-    return "archive it with --suite set to the suite that ran it"
+    fits = [name for name, s in SUITES.items() if name != suite and s.archived
+            and _missed(record, kind, s, [spec.name for spec in s.rungs()]) is None]
+    if fits:
+        return f"archive it with --suite set to a suite that runs it ({', '.join(fits)})"
+    read = (f", or read it where it is beside this archive (craftsuite leaderboard RUNS ARCHIVE/{suite} --out DIR)"
+            if kind == "students" else "")
+    return ("no suite runs it: run its transfer again with the same --out and --archive DIR (an archive of its own, "
+            f"not results) to keep it{read}")
 
 
 @dataclass

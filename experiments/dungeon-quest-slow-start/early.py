@@ -12,23 +12,18 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
-import statistics
 from pathlib import Path
 
 import gymnasium as gym
 
 import craftsuite  # noqa: F401  (registers the ids)
 from craftsuite.ids import env_id
+from craftsuite import stats
 from craftsuite.reached import bits
+from craftsuite.reporting.board import run_metrics
 from craftsuite.reporting.obstacles import distances
 from craftsuite.runs import EPISODE_FIELDS, read_config, read_csv
 from craftsuite.task_registry import resolve_task
-
-
-def first_at(evals: list[dict], level: float = 0.8) -> int | None:
-    """The transitions at the first evaluation whose greedy success is at least ``level``."""
-    return next((int(e["step"]) for e in evals if float(e["success"]) >= level), None)
 
 
 def classify(row: dict, sink: set[int], limit: int) -> str:
@@ -46,9 +41,12 @@ def read_run(run: Path, window: int, until: int) -> dict:
     automaton = resolve_task(config["task"]).automaton
     sink = {q for q, r in enumerate(automaton.rejecting.tolist()) if r}
     near = {q for q, d in enumerate(distances(automaton)) if d == 1}
-    evals = read_csv(run / "evals.csv", ("step", "success"), True)
     limit = gym.spec(env_id(config["task"], config["world"])).max_episode_steps  # the world's episode limit
-    episodes = read_csv(run / "episodes.csv", EPISODE_FIELDS, True)  # (or the archive's .gz)
+    try:
+        episodes = read_csv(run / "episodes.csv", EPISODE_FIELDS, True)  # (or the archive's .gz)
+    except ValueError as err:  # a record made before episodes.csv kept what the episodes reached
+        raise SystemExit(f"{run / 'episodes.csv'}: {err}: this reads runs whose episodes record 'seen' and "
+                         "'states'; give --students and --methods of such runs (one budget and regime)") from None
     windows = []
     for lo in range(0, until, window):
         rows = [r for r in episodes if lo < int(r["step"]) <= lo + window]
@@ -57,7 +55,8 @@ def read_run(run: Path, window: int, until: int) -> dict:
                         **{k: ends.count(k) for k in ("completed", "broken", "timed out", "other")},
                         "reached one edge from acceptance": sum(bool(set(bits(int(r["states"]))) & near)
                                                                 for r in rows)})
-    return {"seed": config["seed"], "first at 80%": first_at(evals), "final": float(evals[-1]["success"]),
+    metrics = run_metrics(run)  # the board's reading: first evaluation at 80%, final success
+    return {"seed": config["seed"], "first at 80%": metrics["steps_to_80"], "final": metrics["success"],
             "limit": limit, "windows": windows}
 
 
@@ -93,9 +92,9 @@ def main(argv=None) -> int:
             print(f"  seed {s['seed']:2d}: first at 80% {s['first at 80%']!s:>6}, first window {w0['episodes']:3d} "
                   f"episodes, {w0['broken']:3d} broken, {w0['timed out']:2d} timed out")
         # a seed that never reached 80% counts as later than any that did
-        firsts = [s["first at 80%"] if s["first at 80%"] is not None else math.inf for s in out[method]]
-        late = sum(f >= 20_000 for f in firsts)
-        print(f"  median first at 80%: {statistics.median(firsts):,.0f}; first at 20,000 or later (or never): "
+        firsts = [s["first at 80%"] for s in out[method]]
+        late = sum(f is None or f >= 20_000 for f in firsts)
+        print(f"  median first at 80%: {stats.reached(firsts).overall:,.0f}; first at 20,000 or later (or never): "
               f"{late} of {len(firsts)} seeds")
     if args.out:
         Path(args.out).write_text(json.dumps(out, indent=1) + "\n")

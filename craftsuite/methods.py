@@ -47,6 +47,10 @@ class Method:
     target: Mapping = field(default_factory=dict, hash=False)
     description: str = ""
     shaping: str | None = None  # None, "static" or "dynamic": the potential of reward shaping
+    # Phi = potential_sign * the values: +1 pays a step toward acceptance at once; -1 is
+    # Toro Icarte et al.'s code (Phi = -V). Both keep the optimal policy; they differ in
+    # where learning starts (shaping by Phi is an unshaped learner started at Phi: Wiewiora 2003)
+    potential_sign: int = 1
 
     def __post_init__(self):
         where = f"METHODS row {self.name!r}"
@@ -63,6 +67,9 @@ class Method:
         if self.shaping and (self.crm or self.distill or not self.product):
             raise MethodError(f"{where}: shaping is a method of its own: with the automaton state, without a "
                               "distilled target or CRM")
+        if self.potential_sign not in (1, -1) or (self.potential_sign != 1 and not self.shaping):
+            raise MethodError(f"{where}: potential_sign is 1 or -1, and -1 only with shaping; "
+                              f"got {self.potential_sign!r}")
         unknown = sorted(set(self.target) - set(TARGET_DEFAULTS))
         if unknown or (self.target and self.distill is None):
             raise MethodError(f"{where}: target takes {sorted(TARGET_DEFAULTS)} and only with distill; "
@@ -108,6 +115,8 @@ class Method:
                "target": self.target_kwargs() if self.distill else None}
         if self.shaping:  # only where set: a row without it records (and hashes) the four fields alone
             out["shaping"] = self.shaping
+        if self.potential_sign != 1:  # likewise: the rows with Phi = V record what they always did
+            out["potential_sign"] = self.potential_sign
         return out
 
     def target_kwargs(self, **given) -> dict:

@@ -36,7 +36,8 @@ def test_a_users_module_registers_a_row_the_suites_run(user_module):
     assert "dqn-mine" in methods_for("Grid10")
     assert methods.external_rows() == [{"name": "dqn-mine", "world": "Grid", "algorithm": "dqn", "product": False,
                                         "distill": None, "crm": False, "target": {},
-                                        "description": "my DQN from scratch", "shaping": None}]
+                                        "description": "my DQN from scratch", "shaping": None,
+                                        "potential_sign": 1}]
     register_method(METHODS["dqn-mine"])  # the same row again: nothing
 
 

@@ -153,7 +153,7 @@ class Population:
                 raise EngineError(f"method {method!r} shapes with a teacher's values: give its table (table.npz)")
             values = table if row.shaping == "dynamic" else static_distillation(automaton,
                                                                                completion_reward=completion_reward)
-            shaping = Shaping(automaton, potential(values, automaton), float(settings["gamma"]))
+            shaping = Shaping(automaton, row.potential_sign * potential(values, automaton), float(settings["gamma"]))
         self.replay = PopulationReplay(self.K, int(settings["buffer_size"]), n_envs, obs_dim, action_shape,
                                        action_dtype, prioritized=bool(settings.get("prioritized", True)),
                                        crm=crm, seed=seeds[0] + 1, sparse_width=sparse_width if self.discrete else None,

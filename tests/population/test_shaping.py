@@ -47,12 +47,13 @@ def _q_values(table, rewards):
     return q
 
 
-def test_the_shaped_optimum_is_the_unshaped_one_on_a_tabular_task():
+@pytest.mark.parametrize("sign", [1, -1])  # Phi = V, and Toro Icarte et al.'s Phi = -V
+def test_the_shaped_optimum_is_the_unshaped_one_on_a_tabular_task(sign):
     spec = resolve_task("FirstTool")
     a = spec.automaton
     states, table = _line_world(a)
-    phi = potential(static_distillation(a, completion_reward=spec.completion_reward), a)
-    assert phi[0] > 0 and phi[a.accepting].max() == 0  # a potential that says something, 0 where episodes end
+    phi = sign * potential(static_distillation(a, completion_reward=spec.completion_reward), a)
+    assert sign * phi[0] > 0 and phi[a.accepting].max() == 0  # a potential that says something, 0 where episodes end
     shape = Shaping(a, phi, GAMMA)
     w, sigma, term = table[..., 4].astype(int), table[..., 3].astype(int), table[..., 2]
     rewards = table[..., 1]
@@ -111,3 +112,30 @@ def test_a_shaping_row_is_a_method_of_its_own():
         Method("x", "Grid", "dqn", True, shaping="learned")
     assert METHODS["dynamic-rs"].needs_table and not METHODS["rs"].needs_table
     assert "shaping" not in METHODS["dqn"].settings() and METHODS["td3-rs"].settings()["shaping"] == "static"
+
+
+def test_the_potentials_sign_is_a_rows_and_only_a_shaping_rows():
+    with pytest.raises(MethodError, match="potential_sign is 1 or -1"):
+        Method("x", "Cont", "td3", True, shaping="static", potential_sign=0)
+    with pytest.raises(MethodError, match="-1 only with shaping"):
+        Method("x", "Cont", "td3", True, potential_sign=-1)
+    negated = Method("x", "Cont", "td3", True, shaping="static", potential_sign=-1)
+    # a row with Phi = -V records it (its runs are keyed apart); Phi = V rows record what they always did
+    assert negated.settings()["potential_sign"] == -1 and "potential_sign" not in METHODS["td3-rs"].settings()
+
+
+def test_the_engine_shapes_with_the_rows_sign(tmp_path, monkeypatch):
+    from craftsuite import methods
+    from craftsuite.population import engine
+
+    made = []
+    monkeypatch.setattr(engine, "Shaping", lambda automaton, phi, gamma: made.append(phi) or Shaping(automaton, phi,
+                                                                                                     gamma))
+    monkeypatch.setitem(methods._ROWS, "rs-negated", Method("rs-negated", "Grid", "dqn", True, shaping="static",
+                                                             potential_sign=-1))
+    tiny = {"learning_starts": 100, "batch_size": 16, "policy_kwargs": {"net_arch": [16]}}
+    for method in ("rs", "rs-negated"):
+        train_population([StudentConfig(task="FirstTool", method=method, world="Grid7", steps=200, eval_every=200,
+                                        eval_episodes=1, engine="population", hyperparameters=tiny)],
+                         tmp_path / method, progress=False)
+    assert made[0][0] > 0 and np.array_equal(made[1], -made[0])

@@ -99,3 +99,16 @@ def _registered_tasks_are_the_tests_own():
     for env_id in set(gym.registry) - ids:
         del gym.registry[env_id]
 
+
+
+@pytest.fixture(autouse=True)
+def _registered_methods_are_the_tests_own():
+    """A METHODS row a test (or a module it imports) registers is gone after it: the suites,
+    the command line and the leaderboard read every row, so one left behind would change
+    tests that follow."""
+    from craftsuite import methods
+
+    rows = set(methods.METHODS)
+    yield
+    for name in set(methods.METHODS) - rows:
+        del methods._ROWS[name]

@@ -8,7 +8,6 @@ from pathlib import Path
 
 import pytest
 
-from craftsuite import methods
 
 EXPERIMENTS = sorted(p for p in (Path(__file__).resolve().parents[1] / "experiments").iterdir() if p.is_dir())
 
@@ -30,14 +29,11 @@ def test_each_experiment_script_imports(script, monkeypatch):
     monkeypatch.syspath_prepend(str(script.parent))  # scripts import their neighbours, as when run there
     spec = importlib.util.spec_from_file_location(f"experiment_{script.parent.name}_{script.stem}", script)
     module = importlib.util.module_from_spec(spec)
-    before = set(methods.METHODS)
-    try:
+    try:  # (a script's own method rows go with the test: conftest)
         spec.loader.exec_module(module)
         assert callable(getattr(module, "main", None)), f"{script} has no main()"
     finally:
         sys.modules.pop(spec.name, None)
-        for name in set(methods.METHODS) - before:  # a script's own method rows stay its own
-            del methods._ROWS[name]
 
 
 def _load(script: Path):

@@ -25,9 +25,7 @@ def user_module(tmp_path, monkeypatch):
     (tmp_path / "my_methods.py").write_text(MODULE)
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.setenv("PYTHONPATH", str(tmp_path))  # the spawned workers' path too
-    yield "my_methods"
-    for name in [n for n in METHODS if n not in methods.BUILTIN]:
-        del methods._ROWS[name]
+    yield "my_methods"  # (its rows go with the test: conftest)
     sys.modules.pop("my_methods", None)
 
 
@@ -41,14 +39,7 @@ def test_a_users_module_registers_a_row_the_suites_run(user_module):
     register_method(METHODS["dqn-mine"])  # the same row again: nothing
 
 
-@pytest.fixture
-def clean_rows():
-    yield
-    for name in [n for n in METHODS if n not in methods.BUILTIN]:
-        del methods._ROWS[name]
-
-
-def test_transfer_trains_a_users_row_in_a_spawned_worker(tmp_path, clean_rows):
+def test_transfer_trains_a_users_row_in_a_spawned_worker(tmp_path):
     # registered from Python (a notebook, say), not by a module a worker could import
     register_method(Method("dqn-mine", "Grid", "dqn", False, description="my DQN from scratch"))
     out = tmp_path / "out"

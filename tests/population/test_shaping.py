@@ -125,14 +125,13 @@ def test_the_potentials_sign_is_a_rows_and_only_a_shaping_rows():
 
 
 def test_the_engine_shapes_with_the_rows_sign(tmp_path, monkeypatch):
-    from craftsuite import methods
+    from craftsuite.methods import register_method
     from craftsuite.population import engine
 
     made = []
     monkeypatch.setattr(engine, "Shaping", lambda automaton, phi, gamma: made.append(phi) or Shaping(automaton, phi,
                                                                                                      gamma))
-    monkeypatch.setitem(methods._ROWS, "rs-negated", Method("rs-negated", "Grid", "dqn", True, shaping="static",
-                                                             potential_sign=-1))
+    register_method(Method("rs-negated", "Grid", "dqn", True, shaping="static", potential_sign=-1))
     tiny = {"learning_starts": 100, "batch_size": 16, "policy_kwargs": {"net_arch": [16]}}
     for method in ("rs", "rs-negated"):
         train_population([StudentConfig(task="FirstTool", method=method, world="Grid7", steps=200, eval_every=200,

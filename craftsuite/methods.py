@@ -68,7 +68,8 @@ class Method:
         if self.shaping and (self.crm or self.distill or not self.product):
             raise MethodError(f"{where}: shaping is a method of its own: with the automaton state, without a "
                               "distilled target or CRM")
-        if self.potential_sign not in (1, -1) or (self.potential_sign != 1 and not self.shaping):
+        if type(self.potential_sign) is not int or self.potential_sign not in (1, -1) or (
+                self.potential_sign == -1 and not self.shaping):  # an int: -1.0 would key its runs apart
             raise MethodError(f"{where}: potential_sign is 1 or -1, and -1 only with shaping; "
                               f"got {self.potential_sign!r}")
         unknown = sorted(set(self.target) - set(TARGET_DEFAULTS))

@@ -22,8 +22,8 @@ import gymnasium as gym
 import craftsuite  # noqa: F401  (registers the ids)
 from craftsuite.ids import env_id
 from craftsuite.reached import bits
-from craftsuite.reporting.board import COMPARED, build, compare, run_metrics
-from craftsuite.runs import EPISODE_FIELDS, read_config, read_csv
+from craftsuite.reporting.board import COMPARED, build, compare
+from craftsuite.runs import EPISODE_FIELDS, read_csv
 from craftsuite.task_registry import resolve_task
 
 ENDINGS = ("completed", "broken", "timed out", "idle")
@@ -42,40 +42,36 @@ def ending(row: dict, sink: set[int], start: int, limit: int) -> list[str]:
     return ["timed out", "idle"] if states == {start} else ["timed out"]
 
 
-def read_cell(runs: list[Path], window: int, steps: int) -> dict:
-    automaton = resolve_task(read_config(runs[0])["task"]).automaton
+def read_cell(entry, window: int) -> dict:
+    """One leaderboard entry's training episodes, counted per window of transitions."""
+    automaton = resolve_task(entry.task).automaton
     sink = {q for q, r in enumerate(automaton.rejecting.tolist()) if r}
-    config = read_config(runs[0])
-    limit = gym.spec(env_id(config["task"], config["world"])).max_episode_steps
-    counts = {lo: dict.fromkeys(("episodes", *ENDINGS), 0) for lo in range(0, steps, window)}
-    for run in runs:
+    # the world's episode limit, or the one the runs set
+    limit = entry.world_kwargs.get("max_episode_steps") or gym.spec(env_id(entry.task, entry.world)).max_episode_steps
+    counts = {lo: dict.fromkeys(("episodes", *ENDINGS), 0) for lo in range(0, entry.budget, window)}
+    for run in entry.runs:
         for row in read_csv(run / "episodes.csv", EPISODE_FIELDS, True):
-            lo = min((int(row["step"]) - 1) // window * window, steps - window)
+            lo = min((int(row["step"]) - 1) // window * window, entry.budget - window)
             counts[lo]["episodes"] += 1
             for name in ending(row, sink, int(automaton.initial), limit):
                 counts[lo][name] += 1
-    return {"windows": counts, "final": [run_metrics(r)["success"] for r in runs]}
-
-
-def cell_runs(students: Path, task: str, world: str, method: str, steps: int) -> list[Path]:
-    """The archived runs of one cell at one budget whose episodes record what they reached."""
-    found = []
-    for run in sorted(students.glob(f"student-{task}-{world}-{method}-s*")):
-        config = read_config(run)
-        if config["method"] == method and config["steps"] == steps:
-            found.append(run)
-    return sorted(found, key=lambda r: read_config(r)["seed"])
+    return {"windows": counts, "final": entry.values["success"]}
 
 
 def cells(roots: list[Path], task: str, world: str, steps: int) -> dict:
-    """Each method's leaderboard entry of the cell (``n-step-wide``, one setting), from the
-    first root that holds it: a rerun at another commit keeps the run key of the run it
-    repeats, so two roots are never pooled."""
+    """Each method's leaderboard entry of the cell (finished runs, ``n-step-wide``, one
+    setting), from the first root that holds it: a rerun at another commit keeps the run key
+    of the run it repeats, so two roots are never pooled."""
     out = {}
     for root in roots:
-        for e in build(root).entries:
-            if (e.task, e.world, e.budget, e.regime, e.variant) == (task, world, steps, "n-step-wide", ""):
-                out.setdefault(e.method, e)
+        here = [e for e in build(root).entries
+                if (e.task, e.world, e.budget, e.regime) == (task, world, steps, "n-step-wide")]
+        for method in {e.method for e in here} - set(out):
+            mine = [e for e in here if e.method == method]
+            if len(mine) > 1:
+                raise SystemExit(f"{root}: {method}'s runs of {task} in {world} at {steps:,} transitions differ in "
+                                 f"more than the seed ({', '.join(e.label for e in mine)}): give a root of one setting")
+            out[method] = mine[0]
     return out
 
 
@@ -89,26 +85,24 @@ def main(argv=None) -> int:
     ap.add_argument("--window", type=int, default=20_000)
     ap.add_argument("--pairs", nargs="*", default=[], help="A:B, method A against method B")
     args = ap.parse_args(argv)
-    roots = [Path(s) for s in args.students]
+    found = cells([Path(s) for s in args.students], args.task, args.world, args.steps)
     for method in args.methods:
-        found_in = (cell_runs(root, args.task, args.world, method, args.steps) for root in roots)
-        runs = next((r for r in found_in if r), [])
-        if not runs:
-            raise SystemExit(f"no {method} runs of {args.task} in {args.world} at {args.steps:,} transitions under "
-                             f"{args.students}: name a directory of student runs with --students")
+        if method not in found:
+            raise SystemExit(f"no finished {method} runs of {args.task} in {args.world} at {args.steps:,} transitions "
+                             f"under {' '.join(args.students)}: name directories of student runs with --students")
         try:
-            cell = read_cell(runs, args.window, args.steps)
+            cell = read_cell(found[method], args.window)
         except ValueError as err:  # a record made before episodes.csv kept the states its episodes visited
             raise SystemExit(f"{method}: {err}: this reads runs whose episodes record 'seen' and 'states'") from None
         finals = " ".join(f"{s:.2f}" for s in cell["final"])
-        print(f"== {method} ({len(runs)} seeds; final greedy success {finals})")
+        print(f"== {method} ({len(found[method].runs)} seeds; final greedy success {finals})")
         for lo, c in cell["windows"].items():
             print(f"  {lo:>7,}-{lo + args.window:>7,}: {c['episodes']:5d} episodes: {c['completed']:4d} completed, "
-                  f"{c['broken']:4d} broken, {c['timed out']:4d} timed out ({c['idle']:4d} idle in the initial state)")
-    found = cells(roots, args.task, args.world, args.steps) if args.pairs else {}
+                  f"{c['broken']:4d} broken, {c['timed out']:4d} timed out ({c['idle']:4d} idle in the initial state; "
+                  f"{c['timed out'] / max(c['episodes'], 1):.0%} of the episodes timed out)")
     for pair in args.pairs:
         a, _, b = pair.partition(":")
-        if a not in found or b not in found:
+        if a not in found or b not in found:  # (read above only where named in --methods)
             raise SystemExit(f"--pairs {pair}: no {a if a not in found else b} cell of {args.task} in {args.world} at "
                              f"{args.steps:,} transitions under {' '.join(args.students)}")
         for metric, words in COMPARED.items():

@@ -119,9 +119,17 @@ def test_the_potentials_sign_is_a_rows_and_only_a_shaping_rows():
         Method("x", "Cont", "td3", True, shaping="static", potential_sign=0)
     with pytest.raises(MethodError, match="-1 only with shaping"):
         Method("x", "Cont", "td3", True, potential_sign=-1)
+    with pytest.raises(MethodError, match="potential_sign is 1 or -1"):
+        Method("x", "Cont", "td3", True, shaping="static", potential_sign=-1.0)
     negated = Method("x", "Cont", "td3", True, shaping="static", potential_sign=-1)
     # a row with Phi = -V records it (its runs are keyed apart); Phi = V rows record what they always did
     assert negated.settings()["potential_sign"] == -1 and "potential_sign" not in METHODS["td3-rs"].settings()
+    # and it reaches a spawned worker whole (rows from outside the package travel as data)
+    from craftsuite.methods import external_rows, register_method
+
+    register_method(negated)
+    (shipped,) = [row for row in external_rows() if row["name"] == "x"]
+    assert Method(**shipped) == negated
 
 
 def test_the_engine_shapes_with_the_rows_sign(tmp_path, monkeypatch):

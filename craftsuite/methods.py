@@ -48,9 +48,10 @@ class Method:
     target: Mapping = field(default_factory=dict, hash=False)
     description: str = ""
     shaping: str | None = None  # None, "static" or "dynamic": the potential of reward shaping
-    # Phi = potential_sign * the values: +1 pays a step toward acceptance at once; -1 is
-    # Toro Icarte et al.'s code (Phi = -V). Both keep the optimal policy; they differ in
-    # where learning starts (shaping by Phi is an unshaped learner started at Phi: Wiewiora 2003)
+    # Phi = potential_sign * the values: +1 as the baseline was asked for; -1 takes the sign
+    # of Toro Icarte et al.'s code (Phi = -V; not its scale or discount). Both keep the optimal
+    # policy; they differ in where learning starts (shaping by Phi is an unshaped learner
+    # started at Phi: Wiewiora 2003)
     potential_sign: int = 1
 
     def __post_init__(self):

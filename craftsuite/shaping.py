@@ -1,7 +1,7 @@
 """Potential-based reward shaping from the automaton: the reward-machine literature's
 baseline (Toro Icarte et al., JAIR 2022, "RS"), with the automaton's values as potential
-(their code takes minus the values, a row's ``potential_sign=-1``; either keeps the optimal
-policy, and Phi = V pays a step toward acceptance at once).
+(their code takes minus the values, with a discount and scale of its own; a row's
+``potential_sign=-1`` takes their sign; either keeps the optimal policy).
 
 A shaped step pays ``r + gamma * Phi(w') - Phi(w)`` (Ng, Harada and Russell 1999), which
 leaves the optimal policy unchanged: over any trajectory the added terms telescope to

@@ -51,7 +51,7 @@ def read_cell(entry, window: int) -> dict:
     counts = {lo: dict.fromkeys(("episodes", *ENDINGS), 0) for lo in range(0, entry.budget, window)}
     for run in entry.runs:
         for row in read_csv(run / "episodes.csv", EPISODE_FIELDS, True):
-            lo = min((int(row["step"]) - 1) // window * window, entry.budget - window)
+            lo = min((int(row["step"]) - 1) // window * window, max(counts))  # the last window takes the rest
             counts[lo]["episodes"] += 1
             for name in ending(row, sink, int(automaton.initial), limit):
                 counts[lo][name] += 1
@@ -97,7 +97,8 @@ def main(argv=None) -> int:
         finals = " ".join(f"{s:.2f}" for s in cell["final"])
         print(f"== {method} ({len(found[method].runs)} seeds; final greedy success {finals})")
         for lo, c in cell["windows"].items():
-            print(f"  {lo:>7,}-{lo + args.window:>7,}: {c['episodes']:5d} episodes: {c['completed']:4d} completed, "
+            end = min(lo + args.window, args.steps)
+            print(f"  {lo:>7,}-{end:>7,}: {c['episodes']:5d} episodes: {c['completed']:4d} completed, "
                   f"{c['broken']:4d} broken, {c['timed out']:4d} timed out ({c['idle']:4d} idle in the initial state; "
                   f"{c['timed out'] / max(c['episodes'], 1):.0%} of the episodes timed out)")
     for pair in args.pairs:

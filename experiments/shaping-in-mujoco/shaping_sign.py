@@ -1,6 +1,7 @@
 """Two rows of this experiment's own (``craftsuite.methods.register_method``): the MuJoCo
 shaping baselines with one change, the potential negated (``potential_sign=-1``: Phi = -V,
-as Toro Icarte et al.'s code takes it, against the package's Phi = V). On the command line:
+the sign of Toro Icarte et al.'s code but not its scale or discount, against the package's
+Phi = V). On the command line:
 ``--methods shaping_sign:td3-rs-negated shaping_sign:td3-dynamic-rs-negated``, with this
 folder on PYTHONPATH."""
 

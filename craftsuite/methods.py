@@ -9,10 +9,9 @@ world), whether the policy sees the automaton state, and how the student uses th
 automaton: a distilled target (``static`` or ``dynamic``, with the ``DistilledTarget``
 keywords in ``target``), counterfactual experience (``crm``), or potential-based reward
 shaping from the automaton's values (``shaping``: ``static`` or ``dynamic``, the potential
-solved from the automaton or distilled from a teacher, negated where ``potential_sign`` is -1;
-``craftsuite.shaping``). A variant
-of a method is a row of its own, never a hyperparameter of a suite, so a leaderboard row
-says what ran.
+solved from the automaton or distilled from a teacher, negated where ``potential_sign`` is
+-1; ``craftsuite.shaping``). A variant of a method is a row of its own, never a
+hyperparameter of a suite, so a leaderboard row says what ran.
 """
 
 from __future__ import annotations

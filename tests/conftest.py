@@ -100,7 +100,6 @@ def _registered_tasks_are_the_tests_own():
         del gym.registry[env_id]
 
 
-
 @pytest.fixture(autouse=True)
 def _registered_methods_are_the_tests_own():
     """A METHODS row a test (or a module it imports) registers is gone after it: the suites,

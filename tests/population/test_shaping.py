@@ -47,7 +47,7 @@ def _q_values(table, rewards):
     return q
 
 
-@pytest.mark.parametrize("sign", [1, -1])  # Phi = V, and Toro Icarte et al.'s Phi = -V
+@pytest.mark.parametrize("sign", [1, -1])  # Phi = V, and Phi = -V (the sign of Toro Icarte et al.'s code)
 def test_the_shaped_optimum_is_the_unshaped_one_on_a_tabular_task(sign):
     spec = resolve_task("FirstTool")
     a = spec.automaton

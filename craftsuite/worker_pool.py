@@ -43,6 +43,14 @@ def _report_and_watch(driver: int, started, stopping, rows=()) -> None:
     _exit_with(driver)
 
 
+def _run_with_rows(rows, job, *args):
+    """A Ray task: register ``rows``, the method rows the driver registered from outside the
+    package (a Ray worker, like a spawned one, starts with the package's rows alone; a worker
+    that ran one already has them, and registering a row twice is nothing), then run ``job``."""
+    register_rows(rows)
+    return job(*args)
+
+
 def connect_ray(address: str):
     """Ray, joined to the cluster at ``address`` (``"local"``: one started in this process;
     one already joined is kept); returns the module and whether this call joined it.
@@ -93,9 +101,10 @@ class WorkerPool:
     Ray cluster (``"local"`` starts one in this process, an address joins one)."""
 
     def __init__(self, jobs: int, workers: int | None = None, ray: str | None = None):
-        self.ray, self.started, self.remote = None, False, {}
+        self.ray, self.started, self._task = None, False, None
         if ray is not None:
             self.ray, self.started = connect_ray(ray)
+            self._rows = external_rows()
         else:
             context = mp.get_context("spawn")
             # the workers' pids, as each reports them: what an abort stops
@@ -107,9 +116,9 @@ class WorkerPool:
 
     def submit(self, job, *args) -> Future:
         if self.ray is not None:
-            if job not in self.remote:
-                self.remote[job] = self.ray.remote(num_cpus=1)(job)
-            return self.remote[job].remote(*args).future()
+            if self._task is None:
+                self._task = self.ray.remote(num_cpus=1)(_run_with_rows)
+            return self._task.remote(self._rows, job, *args).future()
         return self.pool.submit(job, *args)
 
     def close(self, abort: bool = False) -> None:

@@ -4,11 +4,14 @@ the package's own rows, in spawned workers too."""
 
 import importlib.metadata
 import json
+import multiprocessing as mp
 import sys
+from concurrent.futures import ProcessPoolExecutor
+from types import SimpleNamespace
 
 import pytest
 
-from craftsuite import methods
+from craftsuite import methods, worker_pool
 from craftsuite.cli import main
 from craftsuite.methods import METHODS, Method, MethodError, methods_for, register_method, resolve_method
 
@@ -50,6 +53,29 @@ def test_transfer_trains_a_users_row_in_a_spawned_worker(tmp_path):
     (run,) = (out / "students").glob("student-Reach-Grid10-dqn-mine-s0-*")
     assert json.loads((run / "result.json").read_text())["steps"] == 2000
     assert "| dqn-mine |" in (out / "leaderboard.md").read_text()
+
+
+class _FreshWorkerRay:
+    """The part of Ray the pool uses, each task run in a newly spawned process: as a Ray
+    worker, it starts with the package's rows alone."""
+
+    def remote(self, num_cpus):
+        def task(function):
+            def submit(*args):
+                pool = ProcessPoolExecutor(1, mp_context=mp.get_context("spawn"))
+                future = pool.submit(function, *args)
+                pool.shutdown(wait=False)
+                return SimpleNamespace(future=lambda: future)
+            return SimpleNamespace(remote=submit)
+        return task
+
+
+def test_a_ray_worker_gets_the_rows_registered_in_the_driver(monkeypatch):
+    register_method(Method("dqn-mine", "Grid", "dqn", False, description="my DQN from scratch"))
+    monkeypatch.setattr(worker_pool, "connect_ray", lambda address: (_FreshWorkerRay(), False))
+    pool = worker_pool.WorkerPool(1, ray="local")
+    assert "dqn-mine" in pool.submit(methods_for, "Grid10").result(timeout=120)
+    pool.close()
 
 
 @pytest.mark.parametrize("row, message", [

@@ -50,6 +50,15 @@ class Estimate:
         return not (math.isnan(self.low) or math.isnan(self.high))
 
 
+def shared_level(looks: int) -> float:
+    """The level of each of ``looks`` readings of one comparison that together err at most
+    as one reading at ``LEVEL`` does (Bonferroni: 1 - 0.05/k; conservative, and a guarantee
+    only where k was fixed before the first reading)."""
+    if looks < 1:
+        raise ValueError(f"looks: a comparison is read at least once, got {looks}")
+    return 1 - (1 - LEVEL) / looks
+
+
 def t_interval(values, level: float = LEVEL, bounds: tuple[float, float] = (-math.inf, math.inf)) -> Estimate:
     """The mean of ``values`` (one per seed) and its Student t-interval, clipped to
     ``bounds`` (a success rate's [0, 1]: the true mean lies inside them, so clipping loses
@@ -168,10 +177,11 @@ def aggregate_iqm(per_task: list) -> Estimate:
     return Estimate(iqm(np.concatenate(samples)), float(low), float(high))
 
 
-def probability_of_improvement(x_per_task: list, y_per_task: list) -> Estimate:
+def probability_of_improvement(x_per_task: list, y_per_task: list, level: float = LEVEL) -> Estimate:
     """P(X > Y): the probability that a run of method X scores higher than a run of Y on
     the same task (ties count half: the Mann-Whitney U over the pairs), averaged over the
-    tasks, with a stratified-bootstrap interval (X's and Y's runs resampled per task)."""
+    tasks, with a stratified-bootstrap interval at ``level`` (X's and Y's runs resampled per
+    task)."""
     if len(x_per_task) != len(y_per_task) or not x_per_task:
         raise ValueError("probability of improvement: give both methods' runs on the same, non-empty list of tasks")
     samples = [np.asarray(s, dtype=float) for pair in zip(x_per_task, y_per_task) for s in pair]
@@ -183,7 +193,7 @@ def probability_of_improvement(x_per_task: list, y_per_task: list) -> Estimate:
 
         return np.mean([p_greater(x, y) for x, y in zip(xs[::2], xs[1::2])], axis=0)
 
-    low, high = _bootstrap(samples, statistic)
+    low, high = _bootstrap(samples, statistic, level)
     return Estimate(float(statistic(*samples)), float(low), float(high))
 
 

@@ -425,9 +425,14 @@ class Comparison:
     # "undecided", "too few seeds"
     verdict: str
     trivial: bool = False  # decided only because every seed of both sat at 0 (or at 1)
-    # undecided: the seeds a side that would decide it if the difference and spreads held
-    # (``stats.seeds_to_resolve``); None where decided or not to be said
+    # undecided: the seeds a side that would decide it at its next look (one more reading) if
+    # the difference and spreads held (``stats.seeds_to_resolve``); None where decided or not to be said
     seeds_to_decide: int | None = None
+    looks: int = 1  # the readings taken of it (``looks``): every interval of it is at ``level``
+
+    @property
+    def level(self) -> float:
+        return stats.shared_level(self.looks)
 
     @property
     def decided(self) -> bool:
@@ -450,7 +455,7 @@ def probability_side(improvement: stats.Estimate, n: int, m: int) -> str | None:
     return "ahead" if improvement.low > 0.5 else "behind" if improvement.high < 0.5 else None
 
 
-def compare(entry: Entry, baseline: Entry, metric: str = "success") -> Comparison:
+def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int = 1) -> Comparison:
     """``entry`` against ``baseline`` (same task and world) in ``metric`` (one of
     ``COMPARED``; both lie in [0, 1]): *ahead* or *behind* where their t-intervals are apart,
     or where the probability of improvement's interval excludes one half and Welch's interval
@@ -458,16 +463,19 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success") -> Compariso
     difference's interval also lies within +-``SMALLEST_DIFFERENCE``: a real but small gap);
     else *no difference of 0.2 or more* where the interval of the difference lies within
     +-``SMALLEST_DIFFERENCE``; else *undecided*. One rule and one smallest difference for
-    every metric, so that no threshold is chosen after the figures are seen."""
+    every metric, so that no threshold is chosen after the figures are seen. Every interval
+    is at 95%, or for a comparison read ``looks`` times at ``stats.shared_level(looks)``."""
     if metric not in COMPARED:
         raise ValueError(f"no comparison in {metric!r}: compare in one of {sorted(COMPARED)}")
     mine, theirs = entry.values[metric], baseline.values[metric]
-    diff = stats.difference(mine, theirs)
+    level = stats.shared_level(looks)
+    diff = stats.difference(mine, theirs, level)
     try:
-        better = stats.probability_of_improvement([mine], [theirs])
+        better = stats.probability_of_improvement([mine], [theirs], level)
     except ValueError:  # fewer than 2 runs on a side
         better = stats.Estimate(math.nan)
-    apart = verdict(entry, baseline, metric)
+    a, b = (stats.t_interval(values, level, bounds=METRICS[metric]) for values in (mine, theirs))
+    apart = "ahead" if a.low > b.high else "behind" if a.high < b.low else None  # NaN (no interval): neither
     if math.isnan(diff.value):
         said = "not measured"
     elif not (diff.has_interval and better.has_interval):
@@ -484,13 +492,13 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success") -> Compariso
         said = f"no difference of {SMALLEST_DIFFERENCE:g} or more"
         if {*mine, *theirs} in ({0.0}, {1.0}):  # said plainly: no comparison tells methods apart there
             said += f" (every seed of both at {mine[0]:g}{ALL_SAME[metric]})"
-            return Comparison(diff, better, said, trivial=True)
+            return Comparison(diff, better, said, trivial=True, looks=looks)
     else:
-        return Comparison(diff, better, "undecided",
-                          seeds_to_decide=stats.seeds_to_resolve(mine, theirs, SMALLEST_DIFFERENCE))
+        return Comparison(diff, better, "undecided", looks=looks, seeds_to_decide=stats.seeds_to_resolve(
+            mine, theirs, SMALLEST_DIFFERENCE, stats.shared_level(looks + 1)))
     if said in ("ahead", "behind") and -SMALLEST_DIFFERENCE < diff.low and diff.high < SMALLEST_DIFFERENCE:
         said += f", by less than {SMALLEST_DIFFERENCE:g}"
-    return Comparison(diff, better, said)
+    return Comparison(diff, better, said, looks=looks)
 
 
 def distilled_against_scratch(rows: list[Entry], self_reported: bool = False) -> list[tuple[Entry, Entry]]:

@@ -40,6 +40,7 @@ from .board import (
 )
 from .coverage import Coverage, coverage, coverage_markdown
 from .learned import Learned, learned, learned_markdown
+from .looks import looks
 from .plots import draw_curves, draw_profiles, file_part, save_figures
 from .sources import read_runs, session_line
 from .timing import rates, training_time_lines, wall_time_lines
@@ -254,7 +255,12 @@ def _comparison_text(entry: Entry, baseline: Entry, c: Comparison | None) -> str
     if c is None:
         return f"`{entry.label}` not compared: {entry.budget:,} transitions against {baseline.budget:,}"
     return (f"`{entry.label}` {_fmt(c.difference, signed=True)}, P(> `{baseline.label}`) {_fmt(c.improvement)}: "
-            f"**{c.verdict}**")
+            f"**{c.verdict}**{_looks_text(c)}")
+
+
+def _looks_text(c: Comparison) -> str:
+    """Where a comparison was read more than once: at what level, and why."""
+    return "" if c.looks == 1 else f" (its {c.looks} looks: every interval at {c.level:.1%})"
 
 
 def comparisons(boards: list[Board]) -> list[tuple[Entry, Entry, Comparison | None]]:
@@ -269,7 +275,7 @@ def in_metric(pairs, metric: str) -> list[tuple[Entry, Entry, Comparison | None]
     """``pairs`` (each starting with a method's entry and its baseline's, as ``comparisons``
     gives them) with their verdicts in ``metric``, one of ``board.COMPARED``: None where the
     two ran at other budgets."""
-    return [(entry, base, compare(entry, base, metric) if entry.budget == base.budget else None)
+    return [(entry, base, compare(entry, base, metric, looks(entry)) if entry.budget == base.budget else None)
             for entry, base, *_ in pairs]
 
 
@@ -345,9 +351,12 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
             "probability's interval alone errs up to twice its 5% at 5-10 seeds a side: docs/performance.md; "
             f"*by less than {SMALLEST_DIFFERENCE:g}* added where the difference's interval lies within "
             f"±{SMALLEST_DIFFERENCE:g} as well); "
-            f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}. An undecided "
-            "row says how many seeds a side the interval rules would need to decide it if its means and spreads held "
-            "(a planning figure: a spread read from a handful of seeds is itself uncertain)."
+            f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}. A comparison "
+            "that got more seeds after an earlier reading left it undecided had more than one chance to be decided: "
+            "read k times (the archive's looks.json), every interval of it is at 1 − 0.05/k (Bonferroni), and its "
+            "row says so. An undecided row says how many seeds a side the interval rules would need to decide it at "
+            "its next reading if its means and spreads held (a planning figure: a spread read from a handful of "
+            "seeds is itself uncertain)."
             + _by_regime_text(pairs), "",
             "Decided in AUC (the mean greedy success over the evaluations during training: how soon and how steadily "
             "a run learned, where final success says only where it ended), by the same rules and the same smallest "
@@ -359,7 +368,7 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
 def _cells(c: Comparison, entry: Entry, base: Entry) -> str:
     """A comparison's difference, probability and verdict, as three cells of a table row."""
     return (f"{_fmt(c.difference, signed=True)} | {_fmt(c.improvement)} | "
-            f"{c.verdict}{_seeds_to_decide(c, entry, base)}")
+            f"{c.verdict}{_looks_text(c)}{_seeds_to_decide(c, entry, base)}")
 
 
 def _tally_text(pairs, metric: str = "success") -> str:

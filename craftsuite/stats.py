@@ -53,7 +53,7 @@ class Estimate:
 def shared_level(looks: int) -> float:
     """The level of each of ``looks`` readings of one comparison that together err at most
     as one reading at ``LEVEL`` does (Bonferroni: 1 - 0.05/k; conservative, and a guarantee
-    only where k was fixed before the first reading)."""
+    only where k was fixed before the first reading and every reading taken at that level)."""
     if looks < 1:
         raise ValueError(f"looks: a comparison is read at least once, got {looks}")
     return 1 - (1 - LEVEL) / looks

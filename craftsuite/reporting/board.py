@@ -378,11 +378,13 @@ def verdict(entry: Entry, baseline: Entry, metric: str) -> str:
         return "neither learned"
     if not (a.has_interval and b.has_interval):
         return "too few seeds"
-    if a.low > b.high:
-        return "ahead"
-    if a.high < b.low:
-        return "behind"
-    return "no difference measured"
+    return _apart(a, b) or "no difference measured"
+
+
+def _apart(a: stats.Estimate, b: stats.Estimate) -> str | None:
+    """"ahead" or "behind" where the intervals ``a`` and ``b`` are apart; None where they
+    overlap or either has none (NaN compares false)."""
+    return "ahead" if a.low > b.high else "behind" if a.high < b.low else None
 
 
 def _transfer_target(entry: Entry, baseline: Entry) -> str:
@@ -428,7 +430,7 @@ class Comparison:
     # undecided: the seeds a side that would decide it at its next look (one more reading) if
     # the difference and spreads held (``stats.seeds_to_resolve``); None where decided or not to be said
     seeds_to_decide: int | None = None
-    looks: int = 1  # the readings taken of it (``looks``): every interval of it is at ``level``
+    looks: int = 1  # the readings taken of it (``reporting.looks``): every interval of it is at ``level``
 
     @property
     def level(self) -> float:
@@ -449,7 +451,7 @@ def probability_side(improvement: stats.Estimate, n: int, m: int) -> str | None:
     """"ahead" or "behind" where the probability of improvement's interval excludes one half,
     from ``n`` and ``m`` runs; else None. The bootstrap interval reads [1, 1] for any complete
     separation, 3 seeds a side too: it counts only from 5 seeds a side (there, an exact
-    Mann-Whitney p = 0.008)."""
+    Mann-Whitney p = 0.008, within the error of a comparison read up to 6 times)."""
     if min(n, m) < 5 or not improvement.has_interval:
         return None
     return "ahead" if improvement.low > 0.5 else "behind" if improvement.high < 0.5 else None
@@ -464,7 +466,9 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
     else *no difference of 0.2 or more* where the interval of the difference lies within
     +-``SMALLEST_DIFFERENCE``; else *undecided*. One rule and one smallest difference for
     every metric, so that no threshold is chosen after the figures are seen. Every interval
-    is at 95%, or for a comparison read ``looks`` times at ``stats.shared_level(looks)``."""
+    is at 95%, or for a comparison read ``looks`` times at ``stats.shared_level(looks)``
+    (``reporting.looks``); an undecided one's seeds to decide are figured at the level of its
+    next reading, ``looks + 1``."""
     if metric not in COMPARED:
         raise ValueError(f"no comparison in {metric!r}: compare in one of {sorted(COMPARED)}")
     mine, theirs = entry.values[metric], baseline.values[metric]
@@ -474,8 +478,7 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
         better = stats.probability_of_improvement([mine], [theirs], level)
     except ValueError:  # fewer than 2 runs on a side
         better = stats.Estimate(math.nan)
-    a, b = (stats.t_interval(values, level, bounds=METRICS[metric]) for values in (mine, theirs))
-    apart = "ahead" if a.low > b.high else "behind" if a.high < b.low else None  # NaN (no interval): neither
+    apart = _apart(*(stats.t_interval(values, level, bounds=METRICS[metric]) for values in (mine, theirs)))
     if math.isnan(diff.value):
         said = "not measured"
     elif not (diff.has_interval and better.has_interval):

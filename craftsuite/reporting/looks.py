@@ -7,13 +7,20 @@ The results page reads such a comparison at ``stats.shared_level(k)`` for its k 
 the runs, so it is data, kept where the runs are: an archive's ``looks.json``, beside its
 ``students/`` (``results/<suite>/looks.json``), a list of items such as
 
-    {"task": "ToolHome", "world": "Cont", "regime": "n-step-wide",
+    {"task": "ToolHome", "world": "Cont", "regime": "n-step-wide", "budget": 250000,
      "methods": ["td3-dynamic"], "read_at": [3, 10]}
 
-``read_at``: the distilled side's seeds at each reading taken (in any order). A reading at
-the seeds the runs have now is the page's own; each one at fewer seeds is one look more. A
-comparison no item names was read once. Whoever adds seeds to a comparison because a reading
-left it undecided adds that reading here.
+An item names one setting of the distilled methods (the task, the world's name, the learner
+regime and the transitions per run) and the distilled side's seeds at each reading taken.
+Whoever adds seeds to a comparison because a reading left it undecided adds that reading
+here.
+
+The count (``looks``): 1, for the reading the page takes now, and one more for each seed count
+named below the seeds the entry has now (a reading at today's seeds is the page's own; one
+above them is of runs not here). An entry pooled from several archives counts the readings
+named in any of them. A comparison no item names, or whose runs lie in no archive (a
+transfer's output, an entry built by hand), was read once. An item that names no runs of
+its archive is refused (``check``), so a misspelt name cannot pass for a reading.
 """
 
 from __future__ import annotations
@@ -22,11 +29,14 @@ import json
 from pathlib import Path
 
 FILE = "looks.json"
-FIELDS = {"task": str, "world": str, "regime": str, "methods": list, "read_at": list}
-_READ: dict[Path, tuple[int, list[dict]]] = {}  # path -> (its mtime_ns, its items)
+FIELDS = {"task": str, "world": str, "regime": str, "budget": int, "methods": list, "read_at": list}
+KINDS = {str: "a text", int: "a whole number", list: "a list"}
+EXAMPLE = ('{"task": "ToolHome", "world": "Cont", "regime": "n-step-wide", "budget": 250000, '
+           '"methods": ["td3-dynamic"], "read_at": [5, 10]}')
+_READ: dict[Path, tuple[int, tuple[dict, ...]]] = {}  # path -> (its mtime_ns, its items)
 
 
-def read(path) -> list[dict]:
+def read(path) -> tuple[dict, ...]:
     """The items of a ``looks.json``, checked.
 
     Raises:
@@ -39,42 +49,72 @@ def read(path) -> list[dict]:
     try:
         items = json.loads(path.read_text())
     except ValueError as err:
-        raise ValueError(f"{path} is not valid JSON ({err})") from None
+        raise ValueError(f"{path} is not valid JSON ({err}); fix it, or delete the file if no comparison "
+                         "was read more than once") from None
     if not isinstance(items, list):
-        raise ValueError(f"{path}: expected a list of comparisons, each "
-                         f"{{{', '.join(FIELDS)}}}, got {type(items).__name__}")
+        raise ValueError(f"{path}: expected a list of comparisons such as {EXAMPLE}, got {type(items).__name__}")
     for i, item in enumerate(items):
         where = f"{path}: item {i}"
         if not isinstance(item, dict):
-            raise ValueError(f"{where}: expected an object with {', '.join(FIELDS)}, got {type(item).__name__}")
+            raise ValueError(f"{where}: expected an object such as {EXAMPLE}, got {type(item).__name__}")
         missing, unknown = [f for f in FIELDS if f not in item], sorted(set(item) - set(FIELDS))
         if missing or unknown:
             wrong = [f"no {', '.join(missing)}"] * bool(missing) + [f"unknown {', '.join(unknown)}"] * bool(unknown)
-            raise ValueError(f"{where}: {'; '.join(wrong)} (an item has exactly {', '.join(FIELDS)})")
+            raise ValueError(f"{where}: {'; '.join(wrong)} (an item has exactly {', '.join(FIELDS)}, e.g. {EXAMPLE})")
         for name, kind in FIELDS.items():
-            if not isinstance(item[name], kind):
-                raise ValueError(f"{where}: {name} must be a {kind.__name__}, got {item[name]!r}")
+            if not isinstance(item[name], kind) or isinstance(item[name], bool):
+                raise ValueError(f"{where}: {name} must be {KINDS[kind]}, got {item[name]!r} (e.g. {EXAMPLE})")
         if not item["methods"] or not all(isinstance(m, str) for m in item["methods"]):
-            raise ValueError(f"{where}: methods must name the distilled methods read, got {item['methods']!r}")
-        if not all(isinstance(n, int) and not isinstance(n, bool) and n > 0 for n in item["read_at"]):
-            raise ValueError(f"{where}: read_at must be the seeds (whole numbers above 0) at each reading, "
-                             f"got {item['read_at']!r}")
-    _READ[path] = (stamp, items)
-    return items
+            raise ValueError(f"{where}: methods must name the distilled methods read, got {item['methods']!r} "
+                             '(e.g. "methods": ["td3-dynamic"])')
+        if not item["read_at"] or not all(isinstance(n, int) and not isinstance(n, bool) and n > 0
+                                          for n in item["read_at"]):
+            raise ValueError(f"{where}: read_at must list the seeds (whole numbers above 0) at each reading, got "
+                             f'{item["read_at"]!r} (e.g. "read_at": [5, 10])')
+    _READ[path] = (stamp, tuple(items))
+    return _READ[path][1]
 
 
 def looks(entry) -> int:
     """The readings of ``entry`` (a distilled method's ``board.Entry``) against its scratch
-    counterpart: 1, and one more for each seed count below its seeds now at which the
-    ``looks.json`` of an archive its runs lie in says it was read."""
+    counterpart (the module's docstring says how they are counted)."""
     seeds = len(entry.seeds)
-    earlier = set()
-    for path in sorted({run.parent.parent / FILE for run in entry.runs}):
-        if path.is_file():
-            earlier |= {n for item in read(path) if _names(item, entry) for n in item["read_at"] if n < seeds}
+    earlier = {n for item in _items(entry) if _names(item, entry) for n in item["read_at"] if n < seeds}
     return len(earlier) + 1
 
 
+def check(entries) -> None:
+    """Refuse a ``looks.json`` item that names no runs of ``entries`` (a board's, of every
+    archive they lie in), or names a method that is not distilled.
+
+    Raises:
+        ValueError: one line naming the file, the item and what it names.
+    """
+    from ..methods import is_distilled
+
+    entries = list(entries)
+    for path in sorted({p for e in entries for p in _paths(e)}):
+        mine = [e for e in entries if path in _paths(e)]
+        for i, item in enumerate(read(path)):
+            named = f"{item['task']} in {item['world']}, {item['regime']}, {item['budget']:,} transitions"
+            for method in item["methods"]:
+                if not is_distilled(method):
+                    raise ValueError(f"{path}: item {i}: {method!r} is not a distilled method; name the distilled "
+                                     "side of the comparison read")
+                if not any(_names(item, e) and e.method == method for e in mine):
+                    raise ValueError(f"{path}: item {i} names no runs of {method} ({named}) under "
+                                     f"{path.parent / 'students'}; fix the name or remove the item")
+
+
+def _paths(entry) -> set[Path]:
+    """The ``looks.json`` of every archive ``entry``'s runs lie in (``<archive>/students/<run>``)."""
+    return {path for run in entry.runs if (path := run.parent.parent / FILE).is_file()}
+
+
+def _items(entry) -> list[dict]:
+    return [item for path in sorted(_paths(entry)) for item in read(path)]
+
+
 def _names(item: dict, entry) -> bool:
-    return ((item["task"], item["world"], item["regime"]) == (entry.task, entry.world, entry.regime)
-            and entry.method in item["methods"])
+    return ((item["task"], item["world"], item["regime"], item["budget"])
+            == (entry.task, entry.world, entry.regime, entry.budget) and entry.method in item["methods"])

@@ -161,7 +161,8 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
                                                  for e, base in same) + "."]
         if pairs:
             lines += ["", f"Against scratch, {COMPARED['success']} (the difference of the means with Welch's "
-                      "95% t-interval; the probability that a run beats a scratch run, with its bootstrap interval): "
+                      "t-interval, 95% unless said; the probability that a run beats a scratch run, with its bootstrap "
+                      "interval): "
                       + "; ".join(_comparison_text(*pair) for pair in in_metric(pairs, "success")) + ".", "",
                       f"Against scratch, {COMPARED['auc']} (how soon a run learned; the same rules): "
                       + "; ".join(_comparison_text(*pair) for pair in in_metric(pairs, "auc")) + "."]
@@ -255,12 +256,18 @@ def _comparison_text(entry: Entry, baseline: Entry, c: Comparison | None) -> str
     if c is None:
         return f"`{entry.label}` not compared: {entry.budget:,} transitions against {baseline.budget:,}"
     return (f"`{entry.label}` {_fmt(c.difference, signed=True)}, P(> `{baseline.label}`) {_fmt(c.improvement)}: "
-            f"**{c.verdict}**{_looks_text(c)}")
+            f"**{c.verdict}**" + _notes([_looks_text(c)]))
 
 
 def _looks_text(c: Comparison) -> str:
-    """Where a comparison was read more than once: at what level, and why."""
-    return "" if c.looks == 1 else f" (its {c.looks} looks: every interval at {c.level:.1%})"
+    """Where a comparison was read more than once: how often, and at what level (else "")."""
+    return "" if c.looks == 1 else f"read {c.looks} times: every interval at {c.level:.1%}"
+
+
+def _notes(notes: list[str]) -> str:
+    """A verdict's notes, those that say something, as one parenthesis."""
+    said = [n for n in notes if n]
+    return f" ({'; '.join(said)})" if said else ""
 
 
 def comparisons(boards: list[Board]) -> list[tuple[Entry, Entry, Comparison | None]]:
@@ -324,8 +331,8 @@ def _needed(c: Comparison, entry: Entry, base: Entry) -> int | None:
 
 def _seeds_to_decide(c: Comparison, entry: Entry, base: Entry) -> str:
     need = _needed(c, entry, base)
-    return "" if need is None else f" (at these means and spreads: about {need} seeds a side, against " \
-        f"{_now(entry, base)})"
+    return "" if need is None else f"at these means and spreads: about {need} seeds a side, against " \
+        f"{_now(entry, base)}"
 
 
 def comparisons_markdown(pairs, auc=None) -> list[str]:
@@ -342,8 +349,8 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
                             if c is None else f"| {entry.budget:,} | {_cells(c, entry, base)} | "
                             f"{_cells(in_auc, entry, base)} |"))
     return ["| rung | world | learner regime | distilled − scratch | transitions per run "
-            "| difference in success [95% Welch t] | P(distilled > scratch) [95% bootstrap] | verdict "
-            "| difference in AUC [95% Welch t] | P(distilled > scratch) in AUC | verdict in AUC |",
+            "| difference in success [Welch t, 95% unless the verdict says] | P(distilled > scratch) [bootstrap] "
+            "| verdict | difference in AUC [Welch t] | P(distilled > scratch) in AUC | verdict in AUC |",
             "|---|---|---|---|---|---|---|---|---|---|---|", *rows, "",
             f"Decided in final greedy success (ahead, behind, or no difference of {SMALLEST_DIFFERENCE:g} or more) "
             f"{_tally_text(pairs)}: *ahead*/*behind* where the two t-intervals are apart, or where the "
@@ -353,10 +360,10 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
             f"±{SMALLEST_DIFFERENCE:g} as well); "
             f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}. A comparison "
             "that got more seeds after an earlier reading left it undecided had more than one chance to be decided: "
-            "read k times (the archive's looks.json), every interval of it is at 1 − 0.05/k (Bonferroni), and its "
-            "row says so. An undecided row says how many seeds a side the interval rules would need to decide it at "
-            "its next reading if its means and spreads held (a planning figure: a spread read from a handful of "
-            "seeds is itself uncertain)."
+            f"read k times (the archive's looks.json), every interval of it is at 1 − {1 - stats.LEVEL:g}/k "
+            "(Bonferroni), and its row says so. An undecided row says how many seeds a side the interval rules "
+            "would need to decide it at its next reading if its means and spreads held (a planning figure: a "
+            "spread read from a handful of seeds is itself uncertain)."
             + _by_regime_text(pairs), "",
             "Decided in AUC (the mean greedy success over the evaluations during training: how soon and how steadily "
             "a run learned, where final success says only where it ended), by the same rules and the same smallest "
@@ -368,7 +375,7 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
 def _cells(c: Comparison, entry: Entry, base: Entry) -> str:
     """A comparison's difference, probability and verdict, as three cells of a table row."""
     return (f"{_fmt(c.difference, signed=True)} | {_fmt(c.improvement)} | "
-            f"{c.verdict}{_looks_text(c)}{_seeds_to_decide(c, entry, base)}")
+            f"{c.verdict}" + _notes([_looks_text(c), _seeds_to_decide(c, entry, base)]))
 
 
 def _tally_text(pairs, metric: str = "success") -> str:

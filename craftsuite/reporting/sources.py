@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..suites import SUITES
+from . import looks
 from .board import Board, build
 
 
@@ -73,7 +74,8 @@ def read_runs(path, *, transfer: bool = False, suite_cells: bool = False) -> Run
     Raises:
         FileNotFoundError: no such directory.
         ValueError: no finished student run in it, with the unfinished counted and each
-            damaged record named; or a damaged ``suite.json`` or ``provenance.json``.
+            damaged record named; or a damaged ``suite.json``, ``provenance.json`` or
+            ``looks.json`` (``looks.check``).
     """
     from ..provenance import read
 
@@ -91,6 +93,7 @@ def read_runs(path, *, transfer: bool = False, suite_cells: bool = False) -> Run
         raise ValueError(f"no finished student runs under {students}"
                          + (f" ({unfinished} unfinished)" if unfinished else "")
                          + "".join(f"; not read: {reason}" for reason in board.unreadable))
+    looks.check([*board.entries, *(board.apart.entries if board.apart else [])])
     return RunsDirectory(path, students, board, suite, read(path))
 
 

@@ -4,9 +4,11 @@ by side, from the records in results/standard.
 
 Usage: python experiments/fresh-seeds/read.py [--archive results/standard] [--seeds 20 99] [--partial]
 
-The plan reads the fresh sample only when it is whole: while any of the nine cells lacks a
-fresh seed, this names what is missing and reads nothing (exit 1). ``--partial`` reads the
-seeds that every cell has, as the plan says for a sample cut short.
+The fresh sample is one reading, planned before it ran; the pool is read as the page reads it,
+at the level of its looks (``craftsuite.reporting.looks``). The plan reads the fresh sample
+only when it is whole: while any of the nine cells lacks a fresh seed, this names what is
+missing and reads nothing (exit 1). ``--partial`` reads the seeds that every cell has, as the
+plan says for a sample cut short.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import sys
 from pathlib import Path
 
 from craftsuite.reporting.board import build, compare, finite_mean
+from craftsuite.reporting.looks import looks
 from craftsuite.suites import SUITES
 
 RUNGS = ("KeySwordDragon", "ToolHome", "TwoToolsHome")
@@ -23,8 +26,9 @@ METHODS = ("dqn", "static", "dynamic")
 REGIME = "n-step-wide"
 
 
-def reading(entry, baseline) -> str:
-    c = compare(entry, baseline)
+def reading(entry, baseline, looks: int = 1) -> str:
+    """The page's verdict on ``entry`` against ``baseline`` read ``looks`` times."""
+    c = compare(entry, baseline, looks=looks)
     return (f"{c.difference.value:+.2f} [{c.difference.low:+.2f}, {c.difference.high:+.2f}], "
             f"P {c.improvement.value:.2f} [{c.improvement.low:.2f}, {c.improvement.high:.2f}]: {c.verdict}")
 
@@ -79,7 +83,7 @@ def main():
             (f, fb), (p, pb) = row
             mean = [finite_mean(b.values["success"]) for b in (fb, pb)]
             print(f"| {rung} | `{f.label}` | {len(f.seeds)}+{len(fb.seeds)} / {len(p.seeds)}+{len(pb.seeds)} "
-                  f"| {mean[0]:.2f} / {mean[1]:.2f} | {reading(f, fb)} | {reading(p, pb)} |")
+                  f"| {mean[0]:.2f} / {mean[1]:.2f} | {reading(f, fb)} | {reading(p, pb, looks(p))} |")
 
 
 if __name__ == "__main__":

@@ -44,23 +44,21 @@ def main() -> None:
             continue
         board = build(path.parent / "students")
         for item in read(path):
-            # of a method's settings on the task (budgets included), the one with the most seeds
-            cell = {}
-            for e in sorted(board.entries, key=lambda e: len(e.seeds)):
-                if (e.task, e.world, e.regime) == (item["task"], item["world"], item["regime"]):
-                    cell[e.method] = e
+            setting = (item["task"], item["world"], item["regime"], item["budget"])
+            cell = {e.method: e for e in board.entries if (e.task, e.world, e.regime, e.budget) == setting}
             base = scratch(item["world"])
             for method in item["methods"]:
                 missing = [m for m in (method, base) if m not in cell]
                 if missing:
-                    raise SystemExit(f"{item['task']} ({item['world']}): no {item['regime']} runs of "
-                                     f"{', '.join(missing)} under {path.parent / 'students'}; run this from the "
-                                     "project's root")
-                level = stats.shared_level(looks(cell[method]))
+                    raise SystemExit(f"{item['task']} ({item['world']}, {item['budget']:,}): no {item['regime']} "
+                                     f"runs of {', '.join(missing)} under {path.parent / 'students'}; run this from "
+                                     "the project's root")
                 x, y = cell[method].values["success"], cell[base].values["success"]
+                counted = sorted({n for n in item["read_at"] if n < len(x)} | {len(x)})  # as looks() counts them
+                level = stats.shared_level(looks(cell[method]))
                 plain, shared = stats.difference(x, y), stats.difference(x, y, level=level)
                 print(f"{item['task']} ({item['world']}) {method} - {base}, {len(x)}/{len(y)} seeds, "
-                      f"looks at {', '.join(map(str, sorted(item['read_at'])))}: {plain.value:+.2f} "
+                      f"looks at {', '.join(map(str, counted))}: {plain.value:+.2f} "
                       f"[{plain.low:+.2f}, {plain.high:+.2f}] ({reading(plain)}); at {level:.1%}: "
                       f"[{shared.low:+.2f}, {shared.high:+.2f}] ({reading(shared)})")
 

@@ -7,8 +7,9 @@ import pytest
 
 from craftsuite import stats
 from craftsuite.reporting.board import build, compare
-from craftsuite.reporting.looks import looks, read
+from craftsuite.reporting.looks import check, looks, read
 from craftsuite.reporting.pages import comparisons, comparisons_markdown
+from craftsuite.reporting.sources import read_runs
 
 from .fakes import fake_run
 
@@ -33,6 +34,12 @@ def write(root, items):
     (root / "looks.json").write_text(json.dumps(items))
 
 
+def item(method="td3-dynamic", read_at=(5,), **changes):
+    """A looks.json item naming the fixture's ToolHome runs (one-step, 1,000 transitions)."""
+    return {"task": "ToolHome", "world": "Cont", "regime": "one-step", "budget": 1000, "methods": [method],
+            "read_at": list(read_at), **changes}
+
+
 def test_the_shared_level_splits_the_error_over_the_looks():
     assert [round(stats.shared_level(k), 4) for k in (1, 2, 3)] == [0.95, 0.975, 0.9833]
     with pytest.raises(ValueError, match="read at least once"):
@@ -41,14 +48,23 @@ def test_the_shared_level_splits_the_error_over_the_looks():
 
 def test_each_earlier_reading_below_todays_seeds_is_one_look_more(archive):
     assert looks(entries(archive)["td3-dynamic"]) == 1  # no looks.json: read once
-    write(archive, [{"task": "ToolHome", "world": "Cont", "regime": "one-step", "methods": ["td3-dynamic"],
-                     "read_at": [5, 3, 10, 20]}])  # 10: today's reading; 20: not reached
+    write(archive, [item(read_at=[5, 3, 10, 20])])  # 10: today's reading; 20: not reached
     e = entries(archive)
     assert looks(e["td3-dynamic"]) == 3
     assert looks(e["td3-static"]) == 1  # another method
-    write(archive, [{"task": "ToolHome", "world": "Grid10", "regime": "one-step", "methods": ["td3-dynamic"],
-                     "read_at": [5]}])
-    assert looks(entries(archive)["td3-dynamic"]) == 1  # another world
+    for other in ({"world": "Grid10"}, {"budget": 2000}, {"regime": "n-step-wide"}):
+        write(archive, [item(**other)])
+        assert looks(entries(archive)["td3-dynamic"]) == 1, other  # another setting
+
+
+def test_an_entry_pooled_from_two_archives_counts_the_readings_of_both(archive, tmp_path_factory):
+    other = tmp_path_factory.mktemp("other")
+    for seed in range(10, 15):
+        fake_run(other / "students", "td3-dynamic", seed, [(1000, 0.7)], [(950, 1.0)], task="ToolHome")
+    write(archive, [item(read_at=[5])])
+    write(other, [item(read_at=[10])])
+    pooled = {e.method: e for e in build(archive / "students", other / "students")}
+    assert len(pooled["td3-dynamic"].seeds) == 15 and looks(pooled["td3-dynamic"]) == 3
 
 
 def test_a_comparison_decided_at_one_look_can_be_undecided_at_three(archive):
@@ -61,28 +77,39 @@ def test_a_comparison_decided_at_one_look_can_be_undecided_at_three(archive):
 
 
 def test_the_page_reads_the_looks_and_says_so(archive):
-    write(archive, [{"task": "ToolHome", "world": "Cont", "regime": "one-step", "methods": ["td3-dynamic"],
-                     "read_at": [3, 5]}])
-    pairs = comparisons([build(archive / "students")])
+    write(archive, [item(read_at=[3, 5])])
+    pairs = comparisons([read_runs(archive).board])
     said = {entry.method: c for entry, _, c in pairs}
     assert said["td3-dynamic"].looks == 3 and said["td3-dynamic"].verdict == "undecided"
     assert said["td3-static"].looks == 1 and said["td3-static"].verdict == "behind"
     text = "\n".join(comparisons_markdown(pairs))
-    assert "| undecided (its 3 looks: every interval at 98.3%) (at these means and spreads: about" in text
+    assert "| undecided (read 3 times: every interval at 98.3%; at these means and spreads: about" in text
     assert "on 1 of 2 comparisons" in text
+
+
+@pytest.mark.parametrize("named, problem", [
+    ({"task": "ToolHmoe"}, "item 0 names no runs of td3-dynamic (ToolHmoe in Cont, one-step, 1,000 transitions)"),
+    ({"budget": 2000}, "item 0 names no runs of td3-dynamic (ToolHome in Cont, one-step, 2,000 transitions)"),
+    ({"methods": ["td3"]}, "item 0: 'td3' is not a distilled method"),
+])
+def test_an_item_that_names_no_runs_is_refused_by_name(archive, named, problem):
+    write(archive, [item(**named)])
+    with pytest.raises(ValueError) as err:
+        read_runs(archive)
+    assert str(err.value).startswith(str(archive / "looks.json")) and problem in str(err.value)
+    check([])  # no entries: no archive, nothing to check
 
 
 @pytest.mark.parametrize("items, problem", [
     ("[", "is not valid JSON"),
     ({"task": "ToolHome"}, "expected a list of comparisons"),
-    ([{"task": "ToolHome", "world": "Cont", "regime": "one-step", "methods": ["td3-dynamic"]}],
-     "item 0: no read_at (an item has exactly task, world, regime, methods, read_at)"),
-    ([{"task": "ToolHome", "world": "Cont", "regime": "one-step", "methods": ["td3-dynamic"], "read_at": [5],
-       "seeds": 10}], "item 0: unknown seeds"),
-    ([{"task": "ToolHome", "world": "Cont", "regime": "one-step", "methods": "td3-dynamic", "read_at": [5]}],
-     "item 0: methods must be a list"),
-    ([{"task": "ToolHome", "world": "Cont", "regime": "one-step", "methods": ["td3-dynamic"], "read_at": [0]}],
-     "item 0: read_at must be the seeds (whole numbers above 0)"),
+    ([{k: v for k, v in item().items() if k != "read_at"}],
+     "item 0: no read_at (an item has exactly task, world, regime, budget, methods, read_at, e.g. {"),
+    ([item(seeds=10)], "item 0: unknown seeds"),
+    ([item(budget="1k")], "item 0: budget must be a whole number, got '1k'"),
+    ([item(methods="td3-dynamic")], "item 0: methods must be a list"),
+    ([item(read_at=[0])], "item 0: read_at must list the seeds (whole numbers above 0)"),
+    ([item(read_at=[])], "item 0: read_at must list the seeds"),
 ])
 def test_a_bad_looks_file_is_named_by_its_item_and_field(tmp_path, items, problem):
     path = tmp_path / "looks.json"

@@ -1,7 +1,9 @@
 """How many times each comparison was read before its seeds stopped growing: its looks.
 
-A comparison that got more seeds because an earlier reading left it undecided had more than
-one chance to be decided, so intervals at 95% on its final sample claim more than they hold.
+A comparison whose verdict was read (reported) at fewer seeds before its seeds grew had more
+than one chance to be decided, so intervals at 95% on its final sample claim more than they
+hold. That holds whatever made the seeds grow (an undecided reading, or a seed count planned
+in advance): counting every earlier reading is the conservative choice.
 The results page reads such a comparison at ``stats.shared_level(k)`` for its k looks (1 -
 0.05/k), every interval of it. Which readings were taken is a fact of the campaign, not of
 the runs, so it is data, kept where the runs are: an archive's ``looks.json``, beside its
@@ -12,11 +14,10 @@ the runs, so it is data, kept where the runs are: an archive's ``looks.json``, b
 
 An item names one setting of the distilled methods (the task, the world's name, the learner
 regime and the transitions per run) and the distilled side's seeds at each reading taken.
-Whoever adds seeds to a comparison because a reading left it undecided adds that reading
-here.
+Whoever adds seeds to a comparison that was read before adds that reading here.
 
-The count (``looks``): 1, for the reading the page takes now, and one more for each seed count
-named below the seeds the entry has now (a reading at today's seeds is the page's own; one
+The count (``looks``): 1, for the reading the page takes, and one more for each seed count
+named below the seeds the entry has (a reading at the entry's seeds is the page's own; one
 above them is of runs not here). An entry pooled from several archives counts the readings
 named in any of them. A comparison no item names, or whose runs lie in no archive (a
 transfer's output, an entry built by hand), was read once. An item that names no runs of

@@ -261,7 +261,7 @@ def _comparison_text(entry: Entry, baseline: Entry, c: Comparison | None) -> str
 
 def _looks_text(c: Comparison) -> str:
     """Where a comparison was read more than once: how often, and at what level (else "")."""
-    return "" if c.looks == 1 else f"read {c.looks} times: every interval at {c.level:.1%}"
+    return "" if c.looks == 1 else f"read {c.looks} times (looks.json): every interval at {c.level:.1%}"
 
 
 def _notes(notes: list[str]) -> str:
@@ -359,8 +359,8 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
             f"*by less than {SMALLEST_DIFFERENCE:g}* added where the difference's interval lies within "
             f"±{SMALLEST_DIFFERENCE:g} as well); "
             f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}. A comparison "
-            "that got more seeds after an earlier reading left it undecided had more than one chance to be decided: "
-            f"read k times (the archive's looks.json), every interval of it is at 1 − {1 - stats.LEVEL:g}/k "
+            "read at fewer seeds before its seeds grew had more than one chance to be decided: read k times "
+            f"(results/<suite>/looks.json), every interval of it is at 1 − {1 - stats.LEVEL:g}/k "
             "(Bonferroni), and its row says so. An undecided row says how many seeds a side the interval rules "
             "would need to decide it at its next reading if its means and spreads held (a planning figure: a "
             "spread read from a handful of seeds is itself uncertain)."

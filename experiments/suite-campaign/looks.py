@@ -3,10 +3,10 @@ re-read with the error shared out over their looks.
 
     python experiments/suite-campaign/looks.py
 
-A cell that gets more seeds because a first reading was undecided has had more than one
-chance to decide, so an interval at 95% on its final sample claims more than it has. A
-conservative check: read the final sample at 1 - 0.05/k for the k looks taken (Bonferroni;
-a guarantee only where k is fixed in advance and every look is read at that level, which these
+A cell read at fewer seeds before its seeds grew has had more than one chance to decide, so
+an interval at 95% on its final sample claims more than it has. A conservative check: read
+the final sample at 1 - 0.05/k for the k looks taken (Bonferroni; a guarantee only where k
+is fixed in advance and every look is read at that level, which these
 were not). The looks are the archive's data (results/<suite>/looks.json), which the results
 page reads too, every interval of such a comparison at that level. Prints, per
 distilled-against-scratch comparison of those cells, Welch's interval of the difference in

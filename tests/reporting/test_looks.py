@@ -83,7 +83,7 @@ def test_the_page_reads_the_looks_and_says_so(archive):
     assert said["td3-dynamic"].looks == 3 and said["td3-dynamic"].verdict == "undecided"
     assert said["td3-static"].looks == 1 and said["td3-static"].verdict == "behind"
     text = "\n".join(comparisons_markdown(pairs))
-    assert "| undecided (read 3 times: every interval at 98.3%; at these means and spreads: about" in text
+    assert "| undecided (read 3 times (looks.json): every interval at 98.3%; at these means and spreads: about" in text
     assert "on 1 of 2 comparisons" in text
 
 

@@ -34,19 +34,15 @@ FIELDS = {"task": str, "world": str, "regime": str, "budget": int, "methods": li
 KINDS = {str: "a text", int: "a whole number", list: "a list"}
 EXAMPLE = ('{"task": "ToolHome", "world": "Cont", "regime": "n-step-wide", "budget": 250000, '
            '"methods": ["td3-dynamic"], "read_at": [5, 10]}')
-_READ: dict[Path, tuple[int, tuple[dict, ...]]] = {}  # path -> (its mtime_ns, its items)
 
 
-def read(path) -> tuple[dict, ...]:
+def read(path) -> list[dict]:
     """The items of a ``looks.json``, checked.
 
     Raises:
         ValueError: one line naming the file, the item and the field at fault, and the fix.
     """
     path = Path(path)
-    stamp = path.stat().st_mtime_ns
-    if path in _READ and _READ[path][0] == stamp:
-        return _READ[path][1]
     try:
         items = json.loads(path.read_text())
     except ValueError as err:
@@ -72,16 +68,21 @@ def read(path) -> tuple[dict, ...]:
                                           for n in item["read_at"]):
             raise ValueError(f"{where}: read_at must list the seeds (whole numbers above 0) at each reading, got "
                              f'{item["read_at"]!r} (e.g. "read_at": [5, 10])')
-    _READ[path] = (stamp, tuple(items))
-    return _READ[path][1]
+    return items
+
+
+def readings(entry) -> list[int]:
+    """The seed counts at which ``entry`` (a distilled method's ``board.Entry``) was read
+    against its scratch counterpart, the page's own reading last (the module's docstring
+    says which count)."""
+    seeds = len(entry.seeds)
+    items = [item for path in _paths(entry) for item in read(path) if _names(item, entry)]
+    return sorted({n for item in items for n in item["read_at"] if n < seeds}) + [seeds]
 
 
 def looks(entry) -> int:
-    """The readings of ``entry`` (a distilled method's ``board.Entry``) against its scratch
-    counterpart (the module's docstring says how they are counted)."""
-    seeds = len(entry.seeds)
-    earlier = {n for item in _items(entry) if _names(item, entry) for n in item["read_at"] if n < seeds}
-    return len(earlier) + 1
+    """How many times ``entry`` was read: ``len(readings(entry))``."""
+    return len(readings(entry))
 
 
 def check(entries) -> None:
@@ -93,9 +94,11 @@ def check(entries) -> None:
     """
     from ..methods import is_distilled
 
-    entries = list(entries)
-    for path in sorted({p for e in entries for p in _paths(e)}):
-        mine = [e for e in entries if path in _paths(e)]
+    by_path: dict[Path, list] = {}
+    for e in entries:
+        for path in _paths(e):
+            by_path.setdefault(path, []).append(e)
+    for path, mine in sorted(by_path.items()):
         for i, item in enumerate(read(path)):
             named = f"{item['task']} in {item['world']}, {item['regime']}, {item['budget']:,} transitions"
             for method in item["methods"]:
@@ -107,13 +110,10 @@ def check(entries) -> None:
                                      f"{path.parent / 'students'}; fix the name or remove the item")
 
 
-def _paths(entry) -> set[Path]:
+def _paths(entry) -> list[Path]:
     """The ``looks.json`` of every archive ``entry``'s runs lie in (``<archive>/students/<run>``)."""
-    return {path for run in entry.runs if (path := run.parent.parent / FILE).is_file()}
-
-
-def _items(entry) -> list[dict]:
-    return [item for path in sorted(_paths(entry)) for item in read(path)]
+    return [path for archive in sorted({run.parent.parent for run in entry.runs})
+            if (path := archive / FILE).is_file()]
 
 
 def _names(item: dict, entry) -> bool:

@@ -21,7 +21,7 @@ from pathlib import Path
 from craftsuite import stats
 from craftsuite.methods import scratch
 from craftsuite.reporting.board import SMALLEST_DIFFERENCE, build
-from craftsuite.reporting.looks import FILE, looks, read
+from craftsuite.reporting.looks import FILE, read, readings
 
 SUITES = ("standard", "hard")  # each suite's looks: results/<suite>/looks.json (craftsuite.reporting.looks)
 
@@ -54,8 +54,8 @@ def main() -> None:
                                      f"runs of {', '.join(missing)} under {path.parent / 'students'}; run this from "
                                      "the project's root")
                 x, y = cell[method].values["success"], cell[base].values["success"]
-                counted = sorted({n for n in item["read_at"] if n < len(x)} | {len(x)})  # as looks() counts them
-                level = stats.shared_level(looks(cell[method]))
+                counted = readings(cell[method])
+                level = stats.shared_level(len(counted))
                 plain, shared = stats.difference(x, y), stats.difference(x, y, level=level)
                 print(f"{item['task']} ({item['world']}) {method} - {base}, {len(x)}/{len(y)} seeds, "
                       f"looks at {', '.join(map(str, counted))}: {plain.value:+.2f} "

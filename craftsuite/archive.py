@@ -10,8 +10,8 @@ it as one::
                                                       episodes.csv.gz, table.npz
     results/<suite>/students/<run name>/              config.json, result.json, evals.csv,
                                                       episodes.csv.gz
-    results/<suite>/looks.json                        the comparisons read more than once
-                                                      (written by hand: reporting.looks)
+    results/<suite>/looks.json                        readings of comparisons the runs' records
+                                                      cannot show (written by hand: reporting.looks)
 
 Only records: never checkpoints, replay buffers, models or TensorBoard logs (a run
 restored from here says it has no model). ``episodes.csv``, one row per training episode

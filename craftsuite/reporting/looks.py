@@ -5,23 +5,33 @@ than one chance to be decided, so intervals at 95% on its final sample claim mor
 hold. That holds whatever made the seeds grow (an undecided reading, or a seed count planned
 in advance): counting every earlier reading is the conservative choice.
 The results page reads such a comparison at ``stats.shared_level(k)`` for its k looks (1 -
-0.05/k), every interval of it. Which readings were taken is a fact of the campaign, not of
-the runs, so it is data, kept where the runs are: an archive's ``looks.json``, beside its
-``students/`` (``results/<suite>/looks.json``), a list of items such as
+0.05/k), every interval of it.
+
+The readings come from two places:
+
+* the runs' own records. Each run's ``config.json`` names the commit of the session that
+  finished it (the last of its ``provenance``); a campaign runs each part at the commit of
+  its plan, and reads its page after each part. So the runs of both sides, taken commit by
+  commit in the order those sessions began, give the seeds (distilled, scratch) after each
+  part; every such state before today's, with runs on both sides, is a reading. Two commits
+  with no reading between them count twice: conservative again;
+* ``looks.json``, beside an archive's ``students/`` (``results/<suite>/looks.json``), for a
+  reading the records cannot show (a page read part way through a part), a list of items
+  such as
 
     {"task": "ToolHome", "world": "Cont", "regime": "n-step-wide", "budget": 250000,
      "methods": ["td3-dynamic"], "read_at": [3, 10]}
 
-An item names one setting of the distilled methods (the task, the world's name, the learner
-regime and the transitions per run) and the distilled side's seeds at each reading taken.
-Whoever adds seeds to a comparison that was read before adds that reading here.
+  An item names one setting of the distilled methods (the task, the world's name, the
+  learner regime and the transitions per run) and the distilled side's seeds at each
+  reading. A count below the seeds the entry has today adds a reading, unless the records
+  already give one at that count; one at or above them is of runs not here. An entry pooled
+  from several archives counts the items of each. An item that names no runs of its
+  archive is refused (``check``), so a misspelt name cannot pass for a reading.
 
-The count (``looks``): 1, for the reading the page takes, and one more for each seed count
-named below the seeds the entry has (a reading at the entry's seeds is the page's own; one
-above them is of runs not here). An entry pooled from several archives counts the readings
-named in any of them. A comparison no item names, or whose runs lie in no archive (a
-transfer's output, an entry built by hand), was read once. An item that names no runs of
-its archive is refused (``check``), so a misspelt name cannot pass for a reading.
+The count (``looks``) is those readings and the page's own. A comparison whose runs name no
+commit (a transfer outside a checkout, an entry built by hand) and that no item names was
+read once.
 """
 
 from __future__ import annotations
@@ -71,18 +81,50 @@ def read(path) -> list[dict]:
     return items
 
 
-def readings(entry) -> list[int]:
-    """The seed counts at which ``entry`` (a distilled method's ``board.Entry``) was read
-    against its scratch counterpart, the page's own reading last (the module's docstring
-    says which count)."""
-    seeds = len(entry.seeds)
-    items = [item for path in _paths(entry) for item in read(path) if _names(item, entry)]
-    return sorted({n for item in items for n in item["read_at"] if n < seeds}) + [seeds]
+def readings(entry, baseline) -> list[tuple[int, int | None]]:
+    """The seeds (distilled, scratch) at each reading of ``entry`` (a distilled method's
+    ``board.Entry``) against ``baseline`` (its scratch counterpart), the page's own last; a
+    reading only ``looks.json`` names has None for the scratch side (the module's docstring
+    says which readings count)."""
+    now = (len(entry.seeds), len(baseline.seeds))
+    recorded = [state for state in _parts(entry, baseline) if state != now]
+    known = {x for x, _ in recorded}
+    named = {n for path in _paths(entry) for item in read(path) if _names(item, entry)
+             for n in item["read_at"] if n < now[0] and n not in known}
+    return sorted(recorded + [(n, None) for n in named], key=lambda s: (s[0], s[1] or 0)) + [now]
 
 
-def looks(entry) -> int:
-    """How many times ``entry`` was read: ``len(readings(entry))``."""
-    return len(readings(entry))
+def looks(entry, baseline) -> int:
+    """How many times ``entry`` was read against ``baseline``: ``len(readings(...))``."""
+    return len(readings(entry, baseline))
+
+
+def _parts(entry, baseline) -> list[tuple[int, int]]:
+    """The seeds (distilled, scratch) after each commit's runs of either side, in the order
+    those sessions began, where both sides had runs: each a state the page was read at."""
+    finished = {}  # commit -> [when its first session began, distilled runs, scratch runs]
+    for side, runs in enumerate((entry.runs, baseline.runs)):
+        for run in runs:
+            session = _finishing_session(run)  # (no commit named: one part of its own)
+            part = finished.setdefault(session.get("commit"), [session.get("at") or "", 0, 0])
+            part[0] = min(part[0], session.get("at") or "")
+            part[1 + side] += 1
+    states, x, y = [], 0, 0
+    for _, dx, dy in sorted(finished.values()):
+        x, y = x + dx, y + dy
+        if x and y and (x, y) not in states:
+            states.append((x, y))
+    return states
+
+
+def _finishing_session(run: Path) -> dict:
+    """The last session in a run's ``config.json`` provenance (empty: it names none)."""
+    try:
+        sessions = json.loads((Path(run) / "config.json").read_text()).get("provenance") or []
+    except (OSError, ValueError, AttributeError):
+        return {}
+    last = sessions[-1] if sessions else {}
+    return last if isinstance(last, dict) else {}
 
 
 def check(entries) -> None:

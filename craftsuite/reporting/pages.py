@@ -261,7 +261,7 @@ def _comparison_text(entry: Entry, baseline: Entry, c: Comparison | None) -> str
 
 def _looks_text(c: Comparison) -> str:
     """Where a comparison was read more than once: how often, and at what level (else "")."""
-    return "" if c.looks == 1 else f"read {c.looks} times (looks.json): every interval at {c.level:.1%}"
+    return "" if c.looks == 1 else f"read {c.looks} times: every interval at {c.level:.1%}"
 
 
 def _notes(notes: list[str]) -> str:
@@ -282,7 +282,7 @@ def in_metric(pairs, metric: str) -> list[tuple[Entry, Entry, Comparison | None]
     """``pairs`` (each starting with a method's entry and its baseline's, as ``comparisons``
     gives them) with their verdicts in ``metric``, one of ``board.COMPARED``: None where the
     two ran at other budgets."""
-    return [(entry, base, compare(entry, base, metric, looks(entry)) if entry.budget == base.budget else None)
+    return [(entry, base, compare(entry, base, metric, looks(entry, base)) if entry.budget == base.budget else None)
             for entry, base, *_ in pairs]
 
 
@@ -360,10 +360,11 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
             f"±{SMALLEST_DIFFERENCE:g} as well); "
             f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}. A comparison "
             "read at fewer seeds before its seeds grew had more than one chance to be decided: read k times "
-            f"(results/<suite>/looks.json), every interval of it is at 1 − {1 - stats.LEVEL:g}/k "
-            "(Bonferroni), and its row says so. An undecided row says how many seeds a side the interval rules "
-            "would need to decide it at its next reading if its means and spreads held (a planning figure: a "
-            "spread read from a handful of seeds is itself uncertain)."
+            "(once after each part of the campaign that added seeds to either side, as its runs' records tell, "
+            "and at each reading results/<suite>/looks.json names), every interval of it is at "
+            f"1 − {1 - stats.LEVEL:g}/k (Bonferroni), and its row says so. An undecided row says how many "
+            "seeds a side the interval rules would need to decide it at its next reading if its means and "
+            "spreads held (a planning figure: a spread read from a handful of seeds is itself uncertain)."
             + _by_regime_text(pairs), "",
             "Decided in AUC (the mean greedy success over the evaluations during training: how soon and how steadily "
             "a run learned, where final success says only where it ended), by the same rules and the same smallest "

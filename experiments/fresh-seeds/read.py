@@ -83,7 +83,7 @@ def main():
             (f, fb), (p, pb) = row
             mean = [finite_mean(b.values["success"]) for b in (fb, pb)]
             print(f"| {rung} | `{f.label}` | {len(f.seeds)}+{len(fb.seeds)} / {len(p.seeds)}+{len(pb.seeds)} "
-                  f"| {mean[0]:.2f} / {mean[1]:.2f} | {reading(f, fb)} | {reading(p, pb, looks(p))} |")
+                  f"| {mean[0]:.2f} / {mean[1]:.2f} | {reading(f, fb)} | {reading(p, pb, looks(p, pb))} |")
 
 
 if __name__ == "__main__":

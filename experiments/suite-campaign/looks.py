@@ -6,12 +6,13 @@ re-read with the error shared out over their looks.
 A cell read at fewer seeds before its seeds grew has had more than one chance to decide, so
 an interval at 95% on its final sample claims more than it has. A conservative check: read
 the final sample at 1 - 0.05/k for the k looks taken (Bonferroni; a guarantee only where k
-is fixed in advance and every look is read at that level, which these
-were not). The looks are the archive's data (results/<suite>/looks.json), which the results
-page reads too, every interval of such a comparison at that level. Prints, per
-distilled-against-scratch comparison of those cells, Welch's interval of the difference in
-final greedy success at 95% and at that level, and what that interval alone says (the
-page's *ahead*/*behind* also has other routes: this checks the difference only).
+is fixed in advance and every look is read at that level, which these were not). The looks
+are the archive's data (the sessions that finished its runs, and results/<suite>/looks.json:
+craftsuite.reporting.looks), which the results page reads too, every interval of such a
+comparison at that level. Prints, per distilled-against-scratch comparison read more than
+once, the seeds a side (distilled/scratch) at each reading, Welch's interval of the
+difference in final greedy success at 95% and at that level, and what that interval alone
+says (the page's *ahead*/*behind* also has other routes: this checks the difference only).
 """
 
 from __future__ import annotations
@@ -19,11 +20,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from craftsuite import stats
-from craftsuite.methods import scratch
 from craftsuite.reporting.board import SMALLEST_DIFFERENCE, build
-from craftsuite.reporting.looks import FILE, read, readings
+from craftsuite.reporting.looks import readings
+from craftsuite.reporting.pages import comparisons
 
-SUITES = ("standard", "hard")  # each suite's looks: results/<suite>/looks.json (craftsuite.reporting.looks)
+SUITES = ("standard", "hard")  # each suite's archive: results/<suite>
 
 
 def reading(d: stats.Estimate) -> str:
@@ -39,28 +40,18 @@ def reading(d: stats.Estimate) -> str:
 
 def main() -> None:
     for suite in SUITES:
-        path = Path("results", suite, FILE)
-        if not path.is_file():
-            continue
-        board = build(path.parent / "students")
-        for item in read(path):
-            setting = (item["task"], item["world"], item["regime"], item["budget"])
-            cell = {e.method: e for e in board.entries if (e.task, e.world, e.regime, e.budget) == setting}
-            base = scratch(item["world"])
-            for method in item["methods"]:
-                missing = [m for m in (method, base) if m not in cell]
-                if missing:
-                    raise SystemExit(f"{item['task']} ({item['world']}, {item['budget']:,}): no {item['regime']} "
-                                     f"runs of {', '.join(missing)} under {path.parent / 'students'}; run this from "
-                                     "the project's root")
-                x, y = cell[method].values["success"], cell[base].values["success"]
-                counted = readings(cell[method])
-                level = stats.shared_level(len(counted))
-                plain, shared = stats.difference(x, y), stats.difference(x, y, level=level)
-                print(f"{item['task']} ({item['world']}) {method} - {base}, {len(x)}/{len(y)} seeds, "
-                      f"looks at {', '.join(map(str, counted))}: {plain.value:+.2f} "
-                      f"[{plain.low:+.2f}, {plain.high:+.2f}] ({reading(plain)}); at {level:.1%}: "
-                      f"[{shared.low:+.2f}, {shared.high:+.2f}] ({reading(shared)})")
+        board = build(Path("results", suite, "students"))
+        for entry, base, c in comparisons([board]):
+            if c is None or c.looks == 1:
+                continue
+            x, y = entry.values["success"], base.values["success"]
+            counted = readings(entry, base)
+            level = stats.shared_level(len(counted))
+            plain, shared = stats.difference(x, y), stats.difference(x, y, level=level)
+            seen = ", ".join(f"{a}/{'?' if b is None else b}" for a, b in counted)
+            print(f"{entry.task} ({entry.world_label}, {entry.regime}, {entry.budget:,}) {entry.method} - "
+                  f"{base.method}, read at {seen} seeds: {plain.value:+.2f} [{plain.low:+.2f}, {plain.high:+.2f}] "
+                  f"({reading(plain)}); at {level:.1%}: [{shared.low:+.2f}, {shared.high:+.2f}] ({reading(shared)})")
 
 
 if __name__ == "__main__":

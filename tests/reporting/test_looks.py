@@ -1,5 +1,6 @@
 """A comparison read more than once before its seeds stopped growing is read at 1 - 0.05/k
-for its k looks, which the archive's looks.json names."""
+for its k looks: one after each campaign part that added seeds to either side (the commits
+its runs' records name), and each reading the archive's looks.json names besides."""
 
 import json
 
@@ -7,7 +8,7 @@ import pytest
 
 from craftsuite import stats
 from craftsuite.reporting.board import build, compare
-from craftsuite.reporting.looks import check, looks, read
+from craftsuite.reporting.looks import check, looks, read, readings
 from craftsuite.reporting.pages import comparisons, comparisons_markdown
 from craftsuite.reporting.sources import read_runs
 
@@ -34,6 +35,16 @@ def write(root, items):
     (root / "looks.json").write_text(json.dumps(items))
 
 
+def sessions(root, method, seeds, *parts):
+    """Give the fixture's runs of ``method`` (``seeds``) the sessions that trained them, each
+    part (commit, when it began) in turn: the last one finished them."""
+    for seed in seeds:
+        run = root / "students" / f"student-ToolHome-Cont-{method}-s{seed}"
+        config = json.loads((run / "config.json").read_text())
+        config["provenance"] = [{"at": at, "commit": commit, "versions": {}} for commit, at in parts]
+        (run / "config.json").write_text(json.dumps(config))
+
+
 def item(method="td3-dynamic", read_at=(5,), **changes):
     """A looks.json item naming the fixture's ToolHome runs (one-step, 1,000 transitions)."""
     return {"task": "ToolHome", "world": "Cont", "regime": "one-step", "budget": 1000, "methods": [method],
@@ -47,14 +58,34 @@ def test_the_shared_level_splits_the_error_over_the_looks():
 
 
 def test_each_earlier_reading_below_todays_seeds_is_one_look_more(archive):
-    assert looks(entries(archive)["td3-dynamic"]) == 1  # no looks.json: read once
+    e = entries(archive)
+    assert looks(e["td3-dynamic"], e["td3"]) == 1  # no commits named, no looks.json: read once
     write(archive, [item(read_at=[5, 3, 10, 20])])  # 10: today's reading; 20: not reached
     e = entries(archive)
-    assert looks(e["td3-dynamic"]) == 3
-    assert looks(e["td3-static"]) == 1  # another method
+    assert readings(e["td3-dynamic"], e["td3"]) == [(3, None), (5, None), (10, 10)]
+    assert looks(e["td3-static"], e["td3"]) == 1  # another method
     for other in ({"world": "Grid10"}, {"budget": 2000}, {"regime": "n-step-wide"}):
         write(archive, [item(**other)])
-        assert looks(entries(archive)["td3-dynamic"]) == 1, other  # another setting
+        e = entries(archive)
+        assert looks(e["td3-dynamic"], e["td3"]) == 1, other  # another setting
+
+
+def test_each_part_that_added_seeds_to_either_side_was_a_reading(archive):
+    first, second, third = ("aaa", "2026-01-01T10:00:00+00:00"), ("bbb", "2026-01-02T10:00:00+00:00"), \
+        ("ccc", "2026-01-03T10:00:00+00:00")
+    sessions(archive, "td3", range(5), first)
+    sessions(archive, "td3-dynamic", range(5), first)
+    sessions(archive, "td3", range(5, 10), second)  # scratch grew alone: the comparison read at 5/10
+    sessions(archive, "td3-dynamic", range(5, 8), third)
+    sessions(archive, "td3-dynamic", range(8, 10), ("ddd", "2026-01-01T12:00:00+00:00"), third)  # finished in the third
+    sessions(archive, "td3-static", range(10), first)
+    e = entries(archive)
+    assert readings(e["td3-dynamic"], e["td3"]) == [(5, 5), (5, 10), (10, 10)]
+    assert readings(e["td3-static"], e["td3"]) == [(10, 5), (10, 10)]
+    write(archive, [item(read_at=[5, 7])])  # 5: the records' reading already; 7: one they cannot show
+    e = entries(archive)
+    assert readings(e["td3-dynamic"], e["td3"]) == [(5, 5), (5, 10), (7, None), (10, 10)]
+    assert compare(e["td3-dynamic"], e["td3"], looks=looks(e["td3-dynamic"], e["td3"])).level == stats.shared_level(4)
 
 
 def test_an_entry_pooled_from_two_archives_counts_the_readings_of_both(archive, tmp_path_factory):
@@ -64,7 +95,7 @@ def test_an_entry_pooled_from_two_archives_counts_the_readings_of_both(archive, 
     write(archive, [item(read_at=[5])])
     write(other, [item(read_at=[10])])
     pooled = {e.method: e for e in build(archive / "students", other / "students")}
-    assert len(pooled["td3-dynamic"].seeds) == 15 and looks(pooled["td3-dynamic"]) == 3
+    assert len(pooled["td3-dynamic"].seeds) == 15 and looks(pooled["td3-dynamic"], pooled["td3"]) == 3
 
 
 def test_a_comparison_decided_at_one_look_can_be_undecided_at_three(archive):
@@ -83,7 +114,7 @@ def test_the_page_reads_the_looks_and_says_so(archive):
     assert said["td3-dynamic"].looks == 3 and said["td3-dynamic"].verdict == "undecided"
     assert said["td3-static"].looks == 1 and said["td3-static"].verdict == "behind"
     text = "\n".join(comparisons_markdown(pairs))
-    assert "| undecided (read 3 times (looks.json): every interval at 98.3%; at these means and spreads: about" in text
+    assert "| undecided (read 3 times: every interval at 98.3%; at these means and spreads: about" in text
     assert "on 1 of 2 comparisons" in text
 
 

@@ -157,6 +157,8 @@ def resamples(level: float = LEVEL) -> int:
     """How many bootstrap resamples an interval at ``level`` draws: RESAMPLES, or enough that
     ``TAIL_RESAMPLES`` of them fall beyond each end (at 98.75%, four readings' level, 2,000
     would leave 12 a tail, and the interval's ends would move with the seed)."""
+    if not 0 < level < 1:
+        raise ValueError(f"level: a confidence level between 0 and 1, got {level}")
     tail = (1 - level) / 2
     return max(RESAMPLES, math.ceil(round(TAIL_RESAMPLES / tail, 6)))
 
@@ -170,7 +172,8 @@ def _bootstrap(samples: list[np.ndarray], statistic, level: float = LEVEL):
     if short:
         raise ValueError("a stratified bootstrap needs at least 2 runs per task and method")
     result = stats.bootstrap(samples, statistic, n_resamples=resamples(level), confidence_level=level,
-                             method="percentile", vectorized=True, paired=False, rng=SEED)
+                             method="percentile", vectorized=True, paired=False, rng=SEED,
+                             batch=RESAMPLES)  # (a higher level's resamples in batches: memory stays 95%'s)
     return result.confidence_interval.low, result.confidence_interval.high
 
 

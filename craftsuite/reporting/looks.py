@@ -14,7 +14,9 @@ The readings come from two places:
   its plan, and reads its page after each part. So the runs of both sides, taken commit by
   commit in the order those sessions began, give the seeds (distilled, scratch) after each
   part; every such state before today's, with runs on both sides, is a reading. Two commits
-  with no reading between them count twice: conservative again;
+  with no reading between them count twice: conservative again. A commit and the same one
+  marked ``-dirty`` are one part (archiving a part's first runs dirties the tree for the
+  rest); runs that name no commit make a part per session that finished them;
 * ``looks.json``, beside an archive's ``students/`` (``results/<suite>/looks.json``), for a
   reading the records cannot show (a page read part way through a part), a list of items
   such as
@@ -102,19 +104,30 @@ def looks(entry, baseline) -> int:
 def _parts(entry, baseline) -> list[tuple[int, int]]:
     """The seeds (distilled, scratch) after each commit's runs of either side, in the order
     those sessions began, where both sides had runs: each a state the page was read at."""
-    finished = {}  # commit -> [when its first session began, distilled runs, scratch runs]
+    finished = {}  # part -> [when its first session began, distilled runs, scratch runs]
     for side, runs in enumerate((entry.runs, baseline.runs)):
         for run in runs:
-            session = _finishing_session(run)  # (no commit named: one part of its own)
-            part = finished.setdefault(session.get("commit"), [session.get("at") or "", 0, 0])
-            part[0] = min(part[0], session.get("at") or "")
+            session = _finishing_session(run)
+            at = session.get("at") or ""
+            part = finished.setdefault(_part(session), [at, 0, 0])
+            part[0] = min(part[0], at)
             part[1 + side] += 1
     states, x, y = [], 0, 0
     for _, dx, dy in sorted(finished.values()):
         x, y = x + dx, y + dy
-        if x and y and (x, y) not in states:
+        if x and y:
             states.append((x, y))
     return states
+
+
+def _part(session: dict) -> tuple:
+    """The part of the campaign a run's finishing session belongs to: its commit, as the
+    first 7 digits (records name 8, 10 or 40) and without ``-dirty`` (archiving a part's
+    first runs changes tracked files under ``results/``, so the rest of the same part can
+    name the commit dirty); a session naming no commit is a part of its own, by when it
+    began (none of those either: the runs' only part)."""
+    commit = session.get("commit")
+    return ("commit", commit.removesuffix("-dirty")[:7]) if commit else ("began", session.get("at") or "")
 
 
 def _finishing_session(run: Path) -> dict:

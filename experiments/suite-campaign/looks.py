@@ -20,9 +20,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from craftsuite import stats
-from craftsuite.reporting.board import SMALLEST_DIFFERENCE, build
+from craftsuite.reporting.board import SMALLEST_DIFFERENCE
 from craftsuite.reporting.looks import readings
 from craftsuite.reporting.pages import comparisons
+from craftsuite.reporting.sources import read_runs
 
 SUITES = ("standard", "hard")  # each suite's archive: results/<suite>
 
@@ -40,7 +41,7 @@ def reading(d: stats.Estimate) -> str:
 
 def main() -> None:
     for suite in SUITES:
-        board = build(Path("results", suite, "students"))
+        board = read_runs(Path("results", suite), suite_cells=True).board  # as the page reads it
         for entry, base, c in comparisons([board]):
             if c is None or c.looks == 1:
                 continue

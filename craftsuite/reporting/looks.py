@@ -16,7 +16,7 @@ The readings come from two places:
   part; every such state before today's, with runs on both sides, is a reading. Two commits
   with no reading between them count twice: conservative again. A commit and the same one
   marked ``-dirty`` are one part (archiving a part's first runs dirties the tree for the
-  rest); runs that name no commit make a part per session that finished them;
+  rest); runs that name no commit are one part between them;
 * ``looks.json``, beside an archive's ``students/`` (``results/<suite>/looks.json``), for a
   reading the records cannot show (a page read part way through a part), a list of items
   such as
@@ -124,10 +124,12 @@ def _part(session: dict) -> tuple:
     """The part of the campaign a run's finishing session belongs to: its commit, as the
     first 7 digits (records name 8, 10 or 40) and without ``-dirty`` (archiving a part's
     first runs changes tracked files under ``results/``, so the rest of the same part can
-    name the commit dirty); a session naming no commit is a part of its own, by when it
-    began (none of those either: the runs' only part)."""
+    name the commit dirty; runs on a tree changed before they began would merge into the
+    commit's part too, which a campaign avoids by committing each plan before its runs).
+    Runs that name no commit (trained outside a checkout) are one part: their records stamp
+    each run, not each session, so nothing tells their sessions apart."""
     commit = session.get("commit")
-    return ("commit", commit.removesuffix("-dirty")[:7]) if commit else ("began", session.get("at") or "")
+    return commit.removesuffix("-dirty")[:7] if commit else None
 
 
 def _finishing_session(run: Path) -> dict:

@@ -41,7 +41,10 @@ def reading(d: stats.Estimate) -> str:
 
 def main() -> None:
     for suite in SUITES:
-        board = read_runs(Path("results", suite), suite_cells=True).board  # as the page reads it
+        try:
+            board = read_runs(Path("results", suite), suite_cells=True).board  # as the page reads it
+        except FileNotFoundError:
+            raise SystemExit(f"no archive at {Path('results', suite)}: run this from the project's root") from None
         for entry, base, c in comparisons([board]):
             if c is None or c.looks == 1:
                 continue

@@ -120,7 +120,7 @@ def _parts(entry, baseline) -> list[tuple[int, int]]:
     return states
 
 
-def _part(session: dict) -> tuple:
+def _part(session: dict) -> str | None:
     """The part of the campaign a run's finishing session belongs to: its commit, as the
     first 7 digits (records name 8, 10 or 40) and without ``-dirty`` (archiving a part's
     first runs changes tracked files under ``results/``, so the rest of the same part can
@@ -133,11 +133,11 @@ def _part(session: dict) -> tuple:
 
 
 def _finishing_session(run: Path) -> dict:
-    """The last session in a run's ``config.json`` provenance (empty: it names none)."""
-    try:
-        sessions = json.loads((Path(run) / "config.json").read_text()).get("provenance") or []
-    except (OSError, ValueError, AttributeError):
-        return {}
+    """The last session in a run's ``config.json`` provenance (empty: it names none). The
+    board read the record already, so ``read_config`` does not refuse it here."""
+    from ..runs import read_config
+
+    sessions = read_config(run).get("provenance") or []
     last = sessions[-1] if sessions else {}
     return last if isinstance(last, dict) else {}
 

@@ -195,20 +195,32 @@ def probability_of_improvement(x_per_task: list, y_per_task: list, level: float 
     """P(X > Y): the probability that a run of method X scores higher than a run of Y on
     the same task (ties count half: the Mann-Whitney U over the pairs), averaged over the
     tasks, with a stratified-bootstrap interval at ``level`` (X's and Y's runs resampled per
-    task)."""
+    task); not a number where a run's value is not (not measured in the metric)."""
     if len(x_per_task) != len(y_per_task) or not x_per_task:
         raise ValueError("probability of improvement: give both methods' runs on the same, non-empty list of tasks")
     samples = [np.asarray(s, dtype=float) for pair in zip(x_per_task, y_per_task) for s in pair]
+    if not all(np.isfinite(s).all() for s in samples):  # a run not measured in the metric: as difference()
+        return Estimate(math.nan)
 
-    def statistic(*xs, axis=-1):  # the Mann-Whitney U over n x m pairs, counted directly (no p-values)
-        def p_greater(x, y):
-            x, y = np.moveaxis(x, axis, -1)[..., :, None], np.moveaxis(y, axis, -1)[..., None, :]
-            return ((x > y) + 0.5 * (x == y)).mean(axis=(-2, -1))
-
-        return np.mean([p_greater(x, y) for x, y in zip(xs[::2], xs[1::2])], axis=0)
+    def statistic(*xs, axis=-1):
+        return np.mean([p_greater(x, y, axis) for x, y in zip(xs[::2], xs[1::2])], axis=0)
 
     low, high = _bootstrap(samples, statistic, level)
     return Estimate(float(statistic(*samples)), float(low), float(high))
+
+
+def p_greater(x, y, axis: int = -1) -> np.ndarray:
+    """P(X > Y) + P(X = Y) / 2 over every pair of a run of ``x`` and a run of ``y`` along
+    ``axis`` (the Mann-Whitney U over n x m): from the midranks of both together, U = (the
+    ranks of x summed) - n(n+1)/2, in n log n per resample where counting the pairs takes n x m
+    (2,000 resamples of 150 seeds a side: 0.05 s against 2.8 s). The ranks are multiples of
+    a half and their sums exact, so U / nm is the pair count's own float."""
+    from scipy.stats import rankdata
+
+    x, y = np.moveaxis(np.asarray(x), axis, -1), np.moveaxis(np.asarray(y), axis, -1)
+    n, m = x.shape[-1], y.shape[-1]
+    ranks = rankdata(np.concatenate((x, y), axis=-1), axis=-1)
+    return (ranks[..., :n].sum(axis=-1) - n * (n + 1) / 2) / (n * m)
 
 
 def performance_profile(per_task: list, taus) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -129,3 +129,18 @@ def test_an_interval_read_at_a_higher_level_keeps_as_many_resamples_beyond_each_
     assert np.std(ends, axis=0).max() < 0.009
     with pytest.raises(ValueError, match="between 0 and 1"):
         stats.resamples(1.0)
+
+
+def test_the_probability_of_improvement_from_ranks_is_the_count_over_every_pair():
+    """The midrank form of P(X > Y) + P(X = Y) / 2 gives the count over every n x m pair to the
+    bit, with ties (success comes in twentieths), unequal sides and a batch of resamples."""
+    rng = np.random.default_rng(5)
+    for n, m in ((5, 5), (10, 20), (150, 150), (3, 1)):
+        x, y = rng.integers(0, 21, (40, n)) / 20, rng.integers(0, 21, (40, m)) / 20
+        pairs = ((x[:, :, None] > y[:, None, :]) + 0.5 * (x[:, :, None] == y[:, None, :])).mean(axis=(1, 2))
+        assert np.array_equal(stats.p_greater(x, y), pairs)
+        assert np.array_equal(stats.p_greater(x.T, y.T, axis=0), pairs)
+    assert stats.p_greater([1.0, 1.0], [0.0, 1.0]) == 0.75
+    # a run with no value in the metric has no place in the order: no probability, as no difference
+    e = stats.probability_of_improvement([np.array([1.0, math.nan, 0.5])], [np.array([0.0, 1.0, 0.5])])
+    assert math.isnan(e.value) and not e.has_interval

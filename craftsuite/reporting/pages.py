@@ -256,7 +256,7 @@ def _comparison_text(entry: Entry, baseline: Entry, c: Comparison | None) -> str
     if c is None:
         return f"`{entry.label}` not compared: {entry.budget:,} transitions against {baseline.budget:,}"
     return (f"`{entry.label}` {_fmt(c.difference, signed=True)}, P(> `{baseline.label}`) {_fmt(c.improvement)}: "
-            f"**{c.verdict}**" + _notes([_looks_text(c)]))
+            f"**{c.verdict}**" + _notes([c.note, _looks_text(c)]))
 
 
 def _looks_text(c: Comparison) -> str:
@@ -377,7 +377,7 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
 def _cells(c: Comparison, entry: Entry, base: Entry) -> str:
     """A comparison's difference, probability and verdict, as three cells of a table row."""
     return (f"{_fmt(c.difference, signed=True)} | {_fmt(c.improvement)} | "
-            f"{c.verdict}" + _notes([_looks_text(c), _seeds_to_decide(c, entry, base)]))
+            f"{c.verdict}" + _notes([c.note, _looks_text(c), _seeds_to_decide(c, entry, base)]))
 
 
 def _tally_text(pairs, metric: str = "success") -> str:

@@ -12,7 +12,6 @@ import numpy as np
 
 from .. import stats
 from ..files import atomic_path
-from ..runs import read_csv
 from .board import THRESHOLD, Aggregate, Board, aggregates
 
 
@@ -21,12 +20,17 @@ def file_part(label: str) -> str:
     return re.sub(r"[^\w.]+", "-", label).strip("-")
 
 
+def _pairs(values_at) -> tuple[np.ndarray, np.ndarray]:
+    """(step, value) pairs, a list or a (k, 2) array, as their steps and their values."""
+    pairs = np.asarray(values_at, dtype=float).reshape(-1, 2)
+    return pairs[:, 0], pairs[:, 1]
+
+
 def _curve(values_at, grid):
     """Step function of (step, value) pairs sampled on ``grid`` (NaN before the first)."""
-    if not values_at:  # a run never evaluated: no value anywhere (as ``smoothed`` without episodes)
+    if len(values_at) == 0:  # a run never evaluated: no value anywhere (as ``smoothed`` without episodes)
         return np.full(len(grid), np.nan)
-    steps = np.array([s for s, _ in values_at], dtype=float)
-    vals = np.array([v for _, v in values_at], dtype=float)
+    steps, vals = _pairs(values_at)
     idx = np.searchsorted(steps, grid, side="right") - 1
     return np.where(idx >= 0, vals[np.maximum(idx, 0)], np.nan)
 
@@ -63,11 +67,11 @@ def draw_curves(board: Board) -> list[Drawn]:
     from matplotlib.figure import Figure  # not pyplot: no global backend switch in the caller's session
     from matplotlib.ticker import EngFormatter
 
-    runs: dict[tuple, list[tuple[str, list, list, int]]] = {}
+    runs: dict[tuple, list[tuple[str, np.ndarray, np.ndarray, int]]] = {}
     for e in board:
-        for run in e.runs:
+        for curves in e.curves:
             runs.setdefault((e.task, e.world_label, e.regime), []).append(
-                (e.label, read_csv(run / "episodes.csv"), read_csv(run / "evals.csv"), e.budget))
+                (e.label, curves.episodes, curves.evals, e.budget))
     several = len(board.regimes) > 1  # then each regime's curves are a figure of their own
     drawn = []
     for (task, world, regime), group in sorted(runs.items()):
@@ -79,9 +83,9 @@ def draw_curves(board: Board) -> list[Drawn]:
             mine = [g for g in group if g[0] == method]
             color = None
             for ax, style, series in (
-                (axes[0], "-", [smoothed([(int(e["step"]), float(e["return"])) for e in g[1]], grid) for g in mine]),
-                (axes[1], "-", [_curve([(int(e["step"]), float(e["success"])) for e in g[2]], grid) for g in mine]),
-                (axes[1], "--", [smoothed([(int(e["step"]), int(e["success"])) for e in g[1]], grid) for g in mine]),
+                (axes[0], "-", [smoothed(g[1][:, [0, 1]], grid) for g in mine]),
+                (axes[1], "-", [_curve(g[2], grid) for g in mine]),
+                (axes[1], "--", [smoothed(g[1][:, [0, 2]], grid) for g in mine]),
             ):
                 data = np.array(series)
                 if data.size == 0:
@@ -99,7 +103,7 @@ def draw_curves(board: Board) -> list[Drawn]:
                     ax.fill_between(grid, lo, hi, color=color, alpha=0.2)
             # the share of seeds that have reached 80% greedy success by each point: censored runs
             # (never reached) stay in the denominator, as in a survival curve
-            firsts = [next((int(e["step"]) for e in g[2] if float(e["success"]) >= THRESHOLD), None) for g in mine]
+            firsts = [next((step for step, success in g[2] if success >= THRESHOLD), None) for g in mine]
             share = [np.mean([f is not None and f <= x for f in firsts]) for x in grid]
             axes[2].step(grid, share, where="post", color=color, label=f"{method} ({len(mine)} seeds)")
         fig.suptitle(f"{task} ({world}, {regime} regime)")  # a world with settings is too long for a panel's title
@@ -121,17 +125,17 @@ def draw_curves(board: Board) -> list[Drawn]:
 
 def smoothed(values_at, grid, window: float = 0.1):
     """Mean return of the episodes that ended in the last ``window`` of the budget before each grid point."""
-    if not values_at:
+    grid = np.asarray(grid, dtype=float)
+    if len(values_at) == 0:
         return np.full(len(grid), np.nan)
-    steps = np.array([s for s, _ in values_at], dtype=float)
-    vals = np.array([v for _, v in values_at], dtype=float)
-    width = window * grid[-1]
-    out = np.full(len(grid), np.nan)
-    for i, g in enumerate(grid):
-        sel = (steps <= g) & (steps > g - width)
-        if sel.any():
-            out[i] = vals[sel].mean()
-    return out
+    steps, vals = _pairs(values_at)
+    order = np.argsort(steps, kind="stable")
+    steps, total = steps[order], np.concatenate(([0.0], np.cumsum(vals[order])))
+    # the episodes in (g - width, g]: those up to g less those up to g - width
+    upto, before = np.searchsorted(steps, grid, side="right"), np.searchsorted(steps, grid - window * grid[-1], "right")
+    count = upto - before
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(count > 0, (total[upto] - total[before]) / count, np.nan)
 
 
 @dataclass

@@ -30,7 +30,7 @@ def reading(entry, baseline, looks: int = 1) -> str:
     """The page's verdict on ``entry`` against ``baseline`` read ``looks`` times."""
     c = compare(entry, baseline, looks=looks)
     return (f"{c.difference.value:+.2f} [{c.difference.low:+.2f}, {c.difference.high:+.2f}], "
-            f"P {c.improvement.value:.2f} [{c.improvement.low:.2f}, {c.improvement.high:.2f}]: {c.verdict}")
+            f"P {c.improvement.value:.2f} [{c.improvement.low:.2f}, {c.improvement.high:.2f}]: {c.said}")
 
 
 def cells(board, budget: dict) -> dict:

@@ -110,7 +110,7 @@ def main(argv=None) -> int:
             c = compare(found[a], found[b], metric)
             d = c.difference
             print(f"{a} against {b}, {words}: {d.value:+.2f} [{d.low:+.2f}, {d.high:+.2f}], "
-                  f"P(> {b}) {c.improvement.value:.2f}: {c.verdict}")
+                  f"P(> {b}) {c.improvement.value:.2f}: {c.said}")
     return 0
 
 

@@ -352,7 +352,7 @@ def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_pa
     assert said("FirstTool").verdict == "no difference of 0.2 or more" and not said("FirstTool").trivial
     assert said("TwoToolsHome").verdict == "undecided" and not said("TwoToolsHome").decided
     assert said("TwoToolsHome").seeds_to_decide > 5 and said("ToolHome").seeds_to_decide is None
-    assert said("BlindCraftsman").verdict.endswith("(every seed of both at 0)") and said("BlindCraftsman").trivial
+    assert said("BlindCraftsman").said.endswith("(every seed of both at 0)") and said("BlindCraftsman").trivial
     assert said("DungeonQuest").verdict == "too few seeds"
     assert said("Reach").improvement.low == 0.0 and said("Reach").verdict == "undecided"
     text = "\n".join(comparisons_markdown(comparisons([board])))
@@ -415,7 +415,7 @@ def test_a_comparison_trivial_in_final_success_can_be_decided_in_auc(tmp_path):
                  task="ToolHome")
     e = {x.method: x for x in build(tmp_path)}
     in_success, in_auc = compare(e["td3-dynamic"], e["td3"]), compare(e["td3-dynamic"], e["td3"], "auc")
-    assert in_success.trivial and in_success.verdict.endswith("(every seed of both at 1)")
+    assert in_success.trivial and in_success.said.endswith("(every seed of both at 1)")
     assert in_auc.verdict == "ahead" and not in_auc.trivial and in_auc.difference.low > 0.2
     pairs = comparisons([build(tmp_path)])
     [row] = [x for x in comparisons_markdown(pairs) if x.startswith("| ToolHome")]
@@ -432,12 +432,18 @@ def test_a_comparison_trivial_in_final_success_can_be_decided_in_auc(tmp_path):
     e = {(x.task, x.method): x for x in build(tmp_path)}
     never = compare(e["Reach", "td3-dynamic"], e["Reach", "td3"], "auc")
     assert never.trivial
-    assert never.verdict == "no difference of 0.2 or more (every seed of both at 0 at every evaluation)"
+    assert never.said == "no difference of 0.2 or more (every seed of both at 0 at every evaluation)"
     # the rung's own section says both readings (a leaderboard of one directory has no table of them)
     board_text = leaderboard_markdown(build(tmp_path)).split("\n")
     reach, toolhome = [x for x in board_text if x.startswith("Against scratch, AUC")]  # easiest rung first
     assert toolhome.endswith(": **ahead**.") and "`td3-dynamic` +" in toolhome
-    assert reach.endswith("(every seed of both at 0 at every evaluation)**.")
+    assert reach.endswith(": **no difference of 0.2 or more** (every seed of both at 0 at every evaluation).")
+    # read twice, a trivial row says what it rests on and how often it was read in one parenthesis
+    from craftsuite.reporting.pages import _cells
+
+    twice = compare(e["Reach", "td3-dynamic"], e["Reach", "td3"], looks=2)
+    assert _cells(twice, e["Reach", "td3-dynamic"], e["Reach", "td3"]).endswith(
+        "| no difference of 0.2 or more (every seed of both at 0; read 2 times: every interval at 97.5%)")
 
 
 def test_the_probability_of_improvement_alone_does_not_decide(tmp_path):

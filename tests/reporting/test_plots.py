@@ -33,3 +33,33 @@ def test_a_profile_per_world_with_an_aggregate(tmp_path):
     [profile] = plot_profiles(build(root), tmp_path)
     assert profile.world_label == "Cont, one-step regime"
     assert profile.path.name == "profile-Cont-one-step.png" and profile.path.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_the_curves_drawn_are_the_logs_read_once_and_their_window_means():
+    """An entry carries each run's logs as ``run_metrics`` read them (the page draws from
+    them, reading no log twice), and the smoothed return is the mean over each point's
+    window of the budget, in any order the episodes come."""
+    import numpy as np
+
+    from craftsuite.reporting.plots import _curve, smoothed
+
+    grid = np.array([100.0, 200.0, 300.0, 400.0])  # window: 10% of 400, so (g - 40, g]
+    episodes = [(380, 4.0), (95, 1.0), (50, 9.0), (390, 2.0), (250, 5.0)]
+    assert np.allclose(smoothed(episodes, grid), [1.0, np.nan, np.nan, 3.0], equal_nan=True)
+    assert np.array_equal(smoothed(np.array(episodes), grid), smoothed(episodes, grid), equal_nan=True)
+    assert np.isnan(smoothed([], grid)).all() and np.isnan(_curve(np.empty((0, 2)), grid)).all()
+    assert np.array_equal(_curve([(150, 0.5), (300, 1.0)], grid), [np.nan, 0.5, 1.0, 1.0], equal_nan=True)
+
+
+def test_an_entry_keeps_its_runs_logs_in_seed_order(runs):
+    import numpy as np
+
+    from craftsuite.runs import read_csv
+
+    for e in build(runs):
+        assert len(e.curves) == len(e.runs) == len(e.seeds)
+        for run, curves in zip(e.runs, e.curves):
+            episodes, evals = read_csv(run / "episodes.csv"), read_csv(run / "evals.csv")
+            assert curves.episodes.tolist() == [[float(r["step"]), float(r["return"]), float(r["success"])]
+                                                for r in episodes]
+            assert np.array_equal(curves.evals, [[float(r["step"]), float(r["success"])] for r in evals])

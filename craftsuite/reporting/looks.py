@@ -10,10 +10,11 @@ The results page reads such a comparison at ``stats.shared_level(k)`` for its k 
 The readings come from two places:
 
 * the runs' own records. Each run's ``config.json`` names the commit of the session that
-  finished it (the last of its ``provenance``: ``Entry.finished_by``); a campaign runs each part at the commit of
-  its plan, and reads its page after each part. So the runs of both sides, taken commit by
-  commit in the order those sessions began, give the seeds (distilled, scratch) after each
-  part; every such state before today's, with runs on both sides, is a reading. Two commits
+  finished it (the last of its ``provenance``, which the board keeps as
+  ``Entry.finished_by``); a campaign runs each part at the commit of its plan, and reads its
+  page after each part. So the runs of both sides, taken commit by commit in the order those
+  sessions began, give the seeds (distilled, scratch) after each part; every such state
+  before today's, with runs on both sides, is a reading. Two commits
   with no reading between them count twice: conservative again. A commit and the same one
   marked ``-dirty`` are one part (archiving a part's first runs dirties the tree for the
   rest); runs that name no commit are one part between them;

@@ -20,7 +20,7 @@ def file_part(label: str) -> str:
     return re.sub(r"[^\w.]+", "-", label).strip("-")
 
 
-def _pairs(values_at) -> tuple[np.ndarray, np.ndarray]:
+def _steps_and_values(values_at) -> tuple[np.ndarray, np.ndarray]:
     """(step, value) pairs, a list or a (k, 2) array, as their steps and their values."""
     pairs = np.asarray(values_at, dtype=float).reshape(-1, 2)
     return pairs[:, 0], pairs[:, 1]
@@ -30,7 +30,7 @@ def _curve(values_at, grid):
     """Step function of (step, value) pairs sampled on ``grid`` (NaN before the first)."""
     if len(values_at) == 0:  # a run never evaluated: no value anywhere (as ``smoothed`` without episodes)
         return np.full(len(grid), np.nan)
-    steps, vals = _pairs(values_at)
+    steps, vals = _steps_and_values(values_at)
     idx = np.searchsorted(steps, grid, side="right") - 1
     return np.where(idx >= 0, vals[np.maximum(idx, 0)], np.nan)
 
@@ -128,7 +128,7 @@ def smoothed(values_at, grid, window: float = 0.1):
     grid = np.asarray(grid, dtype=float)
     if len(values_at) == 0:
         return np.full(len(grid), np.nan)
-    steps, vals = _pairs(values_at)
+    steps, vals = _steps_and_values(values_at)
     order = np.argsort(steps, kind="stable")
     steps, total = steps[order], np.concatenate(([0.0], np.cumsum(vals[order])))
     # the episodes in (g - width, g]: those up to g less those up to g - width

@@ -35,10 +35,9 @@ def test_a_profile_per_world_with_an_aggregate(tmp_path):
     assert profile.path.name == "profile-Cont-one-step.png" and profile.path.read_bytes()[:4] == b"\x89PNG"
 
 
-def test_the_curves_drawn_are_the_logs_read_once_and_their_window_means():
-    """An entry carries each run's logs as ``run_metrics`` read them (the page draws from
-    them, reading no log twice), and the smoothed return is the mean over each point's
-    window of the budget, in any order the episodes come."""
+def test_a_smoothed_curve_is_the_mean_over_each_points_window():
+    """The smoothed return is the mean over each point's window of the budget, in any order
+    the episodes come, from a list of pairs or an array alike."""
     import numpy as np
 
     from craftsuite.reporting.plots import _curve, smoothed

@@ -39,7 +39,7 @@ docs: $(STAMP)
 	$(PY) -m craftsuite leaderboard results/paper --reproduction docs/reproduction.md
 
 # Each benchmark prints its figures beside their targets and rewrites its own section of
-# docs/performance.md (about 25 minutes on 2 cores; run it on an idle machine)
+# docs/performance.md (about 30 minutes on 2 cores; run it on an idle machine)
 bench: $(STAMP)
 	$(PY) benchmarks/automata.py --flloat-timeout 30
 	$(PY) benchmarks/grid_steps.py --steps 100000
@@ -51,6 +51,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/teachers.py --quick
 	$(PY) benchmarks/interval_coverage.py
 	$(PY) benchmarks/verdict_error.py
+	$(PY) benchmarks/results_page.py
 	$(PY) benchmarks/code_size.py
 
 clean:

@@ -23,16 +23,17 @@ from craftsuite.files import atomic_write
 ROOT = Path(__file__).resolve().parents[1]
 PAGE = ROOT / "docs" / "performance.md"
 
-# The page's order: the package's own speed first (automata, worlds, training), then its statistics.
+# The page's order: the package's own speed first (automata, worlds, training), then its statistics
+# and the cost of reporting them.
 SECTIONS = ("automata", "grid_steps", "cont_steps", "vector_envs", "student_throughput", "crm_memory",
-            "engine_equivalence", "teachers", "interval_coverage", "verdict_error", "code_size")
+            "engine_equivalence", "teachers", "interval_coverage", "verdict_error", "results_page", "code_size")
 
 HEADER = """\
 # Performance
 
 How fast CraftSuite's parts are, and how well its statistics keep their level, each beside
 its target or an outside reference. **This page is written by the benchmark scripts**: each
-script in `benchmarks/` replaces its own section (`make bench` runs them all, about 25
+script in `benchmarks/` replaces its own section (`make bench` runs them all, about 30
 minutes on 2 cores); edit the scripts, not this page. Each section names the command, date,
 commit and machine that made it. Timings depend on what else the machine was doing: the
 load average at the start of each run is given with its machine, and figures taken beside

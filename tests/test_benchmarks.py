@@ -84,6 +84,7 @@ TINY = {"automata": ["--tasks", "Reach", "--flloat-timeout", "5"], "code_size": 
         "cont_steps": ["--steps", "100", "--no-render"],
         "crm_memory": ["--steps", "300"], "engine_equivalence": [], "grid_steps": ["--steps", "200"],
         "interval_coverage": ["--trials", "20"], "verdict_error": ["--trials", "4"],
+        "results_page": ["results/shaping-in-mujoco/standard", "--reference", "HEAD"],
         "student_throughput": ["--seconds", "0.2", "--members", "2"],
         "teachers": ["--tasks", "Reach", "--max-steps", "300"],
         "vector_envs": ["--envs", "2", "--steps", "20"]}
@@ -122,3 +123,25 @@ def test_a_description_keeps_its_list_items(page_module):
     title, about = page_module.describe("Title.\n\nUsage: x\n\nFirst, two:\n* one,\n  wrapped;\n* two.\n")
     assert title == "Title"
     assert about == "First, two:\n* one, wrapped;\n* two."
+
+
+@pytest.mark.parametrize("argv, problem", [
+    (["results/standard", "--reference", "no-such-commit"], "--reference no-such-commit: not a commit"),
+    (["results/no-such-archive"], "results/no-such-archive: not an archive"),
+    (["results/standard", "--repeat", "0"], "--repeat 0: give at least 1"),
+])
+def test_the_page_build_benchmark_refuses_bad_input_in_one_line_before_building(page_module, argv, problem,
+                                                                                tmp_path, monkeypatch, capsys):
+    page = tmp_path / "performance.md"
+    monkeypatch.setattr(sys, "argv", ["results_page.py", *argv, "--page", str(page)])
+    import results_page
+
+    try:
+        with pytest.raises(SystemExit) as stop:
+            results_page.main()
+    finally:
+        sys.modules.pop("results_page", None)
+    assert stop.value.code == 2
+    last = capsys.readouterr().err.strip().splitlines()[-1]
+    assert problem in last and ("give" in last)
+    assert not page.exists()

@@ -70,16 +70,33 @@ def machine() -> str:
             f"Python {platform.python_version()}{load}")
 
 
+def git(*args: str, text: bool = True) -> str | bytes:
+    """``git ARGS`` in the checkout: what it printed, or a ValueError holding git's last line."""
+    done = subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=text)
+    if done.returncode:
+        said = done.stderr if text else done.stderr.decode(errors="replace")
+        raise ValueError((said.strip().splitlines() or ["git failed"])[-1])
+    return done.stdout
+
+
+def at_reference(commit_: str, *args: str, text: bool = True) -> str | bytes:
+    """``git ARGS`` about a benchmark's ``--reference``; a failure is one line naming the
+    reference and the fix."""
+    try:
+        return git(*args, text=text)
+    except ValueError as err:
+        raise ValueError(f"--reference {commit_}: not readable from this checkout's git history ({err}); "
+                         "give a commit that `git log` lists") from None
+
+
 def commit() -> str:
     """The short commit of the working tree, marked when files differ from it."""
-    def git(*args):
-        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
-
-    head = git("rev-parse", "--short", "HEAD")
-    if not head:
+    try:
+        head = git("rev-parse", "--short", "HEAD").strip()
+        status = git("status", "--porcelain")
+    except (ValueError, OSError):
         return "unknown (not a git checkout)"
-    changed = [line for line in git("status", "--porcelain").splitlines()
-               if not line.endswith(PAGE.relative_to(ROOT).as_posix())]
+    changed = [line for line in status.splitlines() if not line.endswith(PAGE.relative_to(ROOT).as_posix())]
     return f"`{head}`" + (" with uncommitted changes" if changed else "")
 
 

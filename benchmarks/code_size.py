@@ -13,11 +13,10 @@ learners' code (``agents/`` and ``population/``) should be smaller for it.
 from __future__ import annotations
 
 import argparse
-import subprocess
 from collections import Counter
 from pathlib import Path
 
-from _page import ROOT, Report, add_page_argument  # benchmarks/ is on sys.path as a script
+from _page import ROOT, Report, add_page_argument, at_reference  # benchmarks/ is on sys.path as a script
 
 REFERENCE = "85ab46c"
 
@@ -36,13 +35,10 @@ def lines_now() -> tuple[Counter, int]:
 
 
 def lines_at(commit: str) -> tuple[Counter, int]:
-    def git(*args):
-        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True, check=True).stdout
-
     areas, tests = Counter(), 0
-    for path in git("ls-tree", "-r", "--name-only", commit, "craftsuite", "tests").splitlines():
+    for path in at_reference(commit, "ls-tree", "-r", "--name-only", commit, "craftsuite", "tests").splitlines():
         if path.endswith(".py"):
-            n = len(git("show", f"{commit}:{path}").splitlines())
+            n = len(at_reference(commit, "show", f"{commit}:{path}").splitlines())
             if path.startswith("tests/"):
                 tests += n
             else:
@@ -57,10 +53,8 @@ def main():
     args = parser.parse_args()
     try:
         then, tests_then = lines_at(args.reference)
-    except subprocess.CalledProcessError as err:
-        parser.error(f"--reference {args.reference}: not a commit of this checkout's git history "
-                     f"({err.stderr.strip().splitlines()[-1] if err.stderr.strip() else 'git failed'}); "
-                     "give one that `git log` lists")
+    except ValueError as err:
+        parser.error(str(err))
     now, tests_now = lines_now()
     report = Report()
     report(f"| area | lines now | lines at `{args.reference}` | change |")

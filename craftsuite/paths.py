@@ -9,10 +9,12 @@ from __future__ import annotations
 from pathlib import Path
 
 _PACKAGE = Path(__file__).resolve().parent
+# the data the package reads beside its code: a copy of the package is these and craftsuite/
+DATA_DIRS = ("tasks", "assets")
 
 
 def data_dir(name: str) -> Path:
-    """The directory of ``tasks`` or ``assets``, installed or in the checkout."""
+    """The directory of ``tasks`` or ``assets`` (``DATA_DIRS``), installed or in the checkout."""
     for candidate in (_PACKAGE / "_data" / name, _PACKAGE.parent / name):
         if candidate.is_dir():
             return candidate

@@ -126,16 +126,20 @@ def test_a_description_keeps_its_list_items(page_module):
 
 
 @pytest.mark.parametrize("argv, problem", [
-    (["results/standard", "--reference", "no-such-commit"], "--reference no-such-commit: not a commit"),
+    (["results/shaping-in-mujoco/standard", "--reference", "no-such-commit"],
+     "--reference no-such-commit: not readable from this checkout's git history"),
     (["results/no-such-archive"], "results/no-such-archive: not an archive"),
-    (["results/standard", "--repeat", "0"], "--repeat 0: give at least 1"),
+    (["results/shaping-in-mujoco/standard", "--repeat", "0"], "--repeat 0: give at least 1"),
 ])
 def test_the_page_build_benchmark_refuses_bad_input_in_one_line_before_building(page_module, argv, problem,
                                                                                 tmp_path, monkeypatch, capsys):
-    page = tmp_path / "performance.md"
-    monkeypatch.setattr(sys, "argv", ["results_page.py", *argv, "--page", str(page)])
+    monkeypatch.setattr(sys, "argv", ["results_page.py", *argv, "--page", str(tmp_path / "performance.md")])
     import results_page
 
+    def no_build(*args):
+        raise AssertionError("a build started before the input was checked")
+
+    monkeypatch.setattr(results_page, "build", no_build)
     try:
         with pytest.raises(SystemExit) as stop:
             results_page.main()
@@ -143,5 +147,16 @@ def test_the_page_build_benchmark_refuses_bad_input_in_one_line_before_building(
         sys.modules.pop("results_page", None)
     assert stop.value.code == 2
     last = capsys.readouterr().err.strip().splitlines()[-1]
-    assert problem in last and ("give" in last)
-    assert not page.exists()
+    assert problem in last and "give" in last
+
+
+def test_the_page_build_benchmark_counts_an_inserted_line_once(page_module, monkeypatch):
+    import results_page
+
+    try:
+        page = [f"line {i}" for i in range(5)]
+        assert results_page.lines_differing(page, page) == 0
+        assert results_page.lines_differing(page, page[:2] + ["new"] + page[2:]) == 1
+        assert results_page.lines_differing(page, page[:2] + ["changed"] + page[3:]) == 1
+    finally:
+        sys.modules.pop("results_page", None)

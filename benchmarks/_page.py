@@ -79,13 +79,13 @@ def git(*args: str, text: bool = True) -> str | bytes:
     return done.stdout
 
 
-def at_reference(commit_: str, *args: str, text: bool = True) -> str | bytes:
+def at_reference(reference: str, *args: str, text: bool = True) -> str | bytes:
     """``git ARGS`` about a benchmark's ``--reference``; a failure is one line naming the
     reference and the fix."""
     try:
         return git(*args, text=text)
     except ValueError as err:
-        raise ValueError(f"--reference {commit_}: not readable from this checkout's git history ({err}); "
+        raise ValueError(f"--reference {reference}: not readable from this checkout's git history ({err}); "
                          "give a commit that `git log` lists") from None
 
 

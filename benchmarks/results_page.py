@@ -79,7 +79,8 @@ def package_at(commit: str, into: Path) -> Path:
     """The package's files at ``commit`` (from git), unpacked into ``into``."""
     packed = at_reference(commit, "archive", commit, "craftsuite", *DATA_DIRS, text=False)
     with tarfile.open(fileobj=io.BytesIO(packed)) as tar:
-        tar.extractall(into, filter="data")
+        # extraction filters came with Python 3.11.4; the package allows any 3.11 (and git's own archive is trusted)
+        tar.extractall(into, **({"filter": "data"} if hasattr(tarfile, "data_filter") else {}))
     return into
 
 
@@ -122,7 +123,10 @@ def main():
     runs = sum(len(archived(a, "students")[0]) for a in archives)
     with tempfile.TemporaryDirectory() as scratch:
         scratch = Path(scratch)
-        reference = package_at(args.reference, scratch / "reference")
+        try:  # a commit from before one of the package's directories existed, say
+            reference = package_at(args.reference, scratch / "reference")
+        except ValueError as err:
+            parser.error(str(err))
         pages = {"now": scratch / "page-now", "reference": scratch / "page-reference"}
         for where in pages.values():
             where.mkdir()

@@ -150,7 +150,7 @@ def test_the_page_build_benchmark_refuses_bad_input_in_one_line_before_building(
     assert problem in last and "give" in last
 
 
-def test_the_page_build_benchmark_counts_an_inserted_line_once(page_module, monkeypatch):
+def test_the_page_build_benchmark_counts_an_inserted_line_once(page_module):
     import results_page
 
     try:

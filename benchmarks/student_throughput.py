@@ -1,7 +1,7 @@
 """Student throughput of the population engine: transitions and gradient updates per second per core.
 
-Usage: python benchmarks/student_throughput.py [--seconds 10] [--members 5 10] [--only TEXT] [--device cpu]
-       [--page PATH | --no-page]
+Usage: python benchmarks/student_throughput.py [--seconds 10] [--members 5 10] [--at-once 2] [--only TEXT]
+       [--device cpu] [--page PATH | --no-page]
 
 One process, one torch thread, Blind Craftsman: TD3 in the MuJoCo world and on the
 kinematic board, DQN on the 10x10 grid. Each row (``craftsuite.population``): the suites'
@@ -11,9 +11,14 @@ engines were compared with), collecting from one vector env, counted over all me
 after the warm-up of random actions (``learning_starts``). The rows named after the learner
 regime add the standard and hard suites' regime (``craftsuite.regimes``: n-step targets,
 wider networks) to those settings: what the suites train now. Each row trains for about
-``--seconds``. The reference column is each row's target. Under the table, the standard
-and hard suites' student time projected from the learner-regime rows at the suite's seeds
-per population (or the nearest population size measured), from a whole run on CPU only. With
+``--seconds``. The reference column is each row's target. The learner-regime rows are also
+measured ``--at-once`` times at once (default 2, a campaign's process per core here), each
+its own process, timed over the same window after every one's warm-up: the rate of each
+process while the others run, which is what a campaign on these cores gets (processes can
+slow one another through shared caches and memory, by an amount that differs between
+machines). Under the table, the standard and hard suites' student time projected from those
+rates at the suite's seeds per population (or the nearest population size measured), from a
+whole run on CPU only. With
 ``--device cuda --members 20`` it measures a GPU population; ``--only n-step-wide`` keeps the
 rows whose label holds that text.
 """
@@ -21,6 +26,8 @@ rows whose label holds that text.
 from __future__ import annotations
 
 import argparse
+import multiprocessing
+import os
 import time
 
 import craftsuite  # noqa: F401
@@ -52,9 +59,10 @@ LEARNER_ROWS = [
 
 
 def measure_population(method, env_id, n_envs, settings, env_kwargs, members: int, seconds: float,
-                       device: str = "cpu") -> tuple[float, float]:
+                       device: str = "cpu", ready=None) -> tuple[float, float]:
     """The engine's hot path (``population.train._loop`` without its logs): act, step the
-    vector env, store, learn."""
+    vector env, store, learn. ``ready`` (if given) is called between the warm-up and the timed
+    window: processes measured together wait there for one another."""
     from craftsuite.ids import parse_id, world_kind
     from craftsuite.methods import METHODS
     from craftsuite.population import Population
@@ -78,6 +86,8 @@ def measure_population(method, env_id, n_envs, settings, env_kwargs, members: in
 
     while pop.num_timesteps <= pop.learning_starts + 1_000:  # the warm-up, then some learning
         step()
+    if ready is not None:
+        ready()
     transitions, updates, start = pop.num_timesteps, pop.learner.n_updates, time.perf_counter()
     while time.perf_counter() - start < seconds:
         for _ in range(50):
@@ -85,6 +95,33 @@ def measure_population(method, env_id, n_envs, settings, env_kwargs, members: in
     total = time.perf_counter() - start
     envs.close()
     return members * (pop.num_timesteps - transitions) / total, members * (pop.learner.n_updates - updates) / total
+
+
+def _measure_in_process(row: tuple, members: int, seconds: float, device: str, start, results) -> None:
+    import torch
+
+    torch.set_num_threads(1)
+    results.put(measure_population(*row, members, seconds, device, ready=start.wait))
+
+
+def measure_at_once(row: tuple, members: int, seconds: float, device: str, processes: int) -> list[float]:
+    """Transitions/s of each of ``processes`` processes training the same population at once
+    (``row``: method, env id, n_envs, settings, env keywords), timed together once all have
+    warmed up; fresh processes, so none inherits this one's state."""
+    context = multiprocessing.get_context("spawn")
+    start, results = context.Barrier(processes), context.Queue()
+    workers = [context.Process(target=_measure_in_process, args=(row, members, seconds, device, start, results))
+               for _ in range(processes)]
+    for worker in workers:
+        worker.start()
+    try:
+        rates = [results.get(timeout=seconds + 600)[0] for _ in workers]
+    finally:
+        for worker in workers:
+            worker.join(timeout=60)
+            if worker.is_alive():
+                worker.terminate()
+    return sorted(rates)
 
 
 def _kind(method: str, env_id: str) -> tuple[str, bool]:
@@ -96,11 +133,11 @@ def _kind(method: str, env_id: str) -> tuple[str, bool]:
     return parse_id(env_id)[1].rstrip("0123456789"), METHODS[method].crm
 
 
-def suite_projection(name: str, rates: dict, cores: int = 2) -> str:
+def suite_projection(name: str, rates: dict, cores: int) -> str:
     """The suite's student transitions over the learner-regime rates just measured (``rates``:
-    transitions/s by population size, then by world kind and CRM), at the population size
-    nearest the suite's seeds, on ``cores`` cores: a projection (teachers, evaluations and the
-    tail of the last runs left out)."""
+    each process's transitions/s with ``cores`` processes at once, by population size, then by
+    world kind and CRM), at the population size nearest the suite's seeds, on ``cores`` cores:
+    a projection (teachers, evaluations and the tail of the last runs left out)."""
     from craftsuite.ids import parse_id
     from craftsuite.methods import METHODS
     from craftsuite.task_registry import resolve_task
@@ -116,12 +153,11 @@ def suite_projection(name: str, rates: dict, cores: int = 2) -> str:
         kind = (parse_id(c.env_id)[1].rstrip("0123456789"), METHODS[c.method].crm)
         seconds += c.steps / rates[members].get(kind, rates[members].get((kind[0], False), float("nan")))
     total = sum(c.steps for c in configs)
+    rate = f"at each process's rate with {cores} at once" if cores > 1 else "at the rate of one process alone"
     return (f"The `{name}` suite's students ({len(configs)} runs, {total:,} transitions, {suite.regime} regime) "
-            f"at these rates on {cores} cores: {seconds / cores / 3600:.1f} h ({suite.seeds_text()}, each cell a "
-            f"population, projected from the populations of {' and '.join(map(str, sorted(used)))}; from one "
-            "process alone, teachers and evaluations not "
-            "counted; on 2 cores two grid populations kept about these rates, two MuJoCo populations about half "
-            "each).")
+            f"at these rates on {cores} core{'s' if cores > 1 else ''}: {seconds / cores / 3600:.1f} h "
+            f"({suite.seeds_text()}, each cell a population, projected from the populations of {' and '.join(map(str, sorted(used)))}, {rate}; "
+            "teachers and evaluations not counted).")
 
 
 def main():
@@ -129,6 +165,9 @@ def main():
     parser.add_argument("--seconds", type=float, default=10.0)
     parser.add_argument("--members", type=int, nargs="+", default=[5, 10],
                         help="population sizes (default: 5, a suite cell's seeds, and 10)")
+    parser.add_argument("--at-once", type=int, default=min(2, os.cpu_count() or 1), metavar="N",
+                        help="also measure the learner-regime rows as N processes at once, and project the suites "
+                             "on N cores from those rates (default: 2, this project's cores; 1: alone only)")
     parser.add_argument("--device", default="cpu", help="the population's torch device (default: cpu)")
     parser.add_argument("--only", metavar="TEXT", help="only the rows whose label holds TEXT (e.g. n-step-wide)")
     add_page_argument(parser)
@@ -137,26 +176,38 @@ def main():
     if not rows:
         parser.error(f"--only {args.only!r}: no row's label holds it; the labels: "
                      + "; ".join(row[0] for row in POPULATION_ROWS + LEARNER_ROWS))
+    if args.at_once < 1:
+        parser.error(f"--at-once {args.at_once}: give a number of processes, 1 or more (1 measures each row alone)")
+    if args.at_once > (os.cpu_count() or 1):
+        parser.error(f"--at-once {args.at_once}: this machine has {os.cpu_count()} cores, and processes sharing a "
+                     "core would measure the sharing; give at most that many")
     if args.only is not None and not args.no_page:  # a part of the table would replace the whole section
         parser.error("--only measures some rows, and the page's section holds them all: add --no-page")
     import torch
 
     torch.set_num_threads(1)
     report = Report()
-    report("| student | engine | transitions/s | updates/s (all members) | reference transitions/s |")
-    report("|---|---|---|---|---|")
-    rates = {}  # transitions/s of the learner-regime rows, by members, then (world kind, crm): the projection's
+    at_once = args.at_once
+    report(f"| student | engine | transitions/s | updates/s (all members) | transitions/s of each of {at_once} "
+           "at once | reference transitions/s |")
+    report("|---|---|---|---|---|---|")
+    rates = {}  # each process's transitions/s with the others at once, of the learner-regime rows, by members,
+    # then (world kind, crm): the projection's
     for label, method, env_id, n_envs, settings, env_kwargs, target in rows:
         for members in args.members:
-            tps, ups = measure_population(method, env_id, n_envs, settings, env_kwargs, members, args.seconds,
-                                          args.device)
-            report(f"| {label} | population of {members} ({args.device}) | {tps:,.0f} | {ups:,.0f} | {target} |")
+            row = (method, env_id, n_envs, settings, env_kwargs)
+            tps, ups = measure_population(*row, members, args.seconds, args.device)
+            together = ""
             if settings in (TD3_WIDE, DQN_WIDE):
-                rates.setdefault(members, {})[_kind(method, env_id)] = tps
+                each = measure_at_once(row, members, args.seconds, args.device, at_once) if at_once > 1 else [tps]
+                rates.setdefault(members, {})[_kind(method, env_id)] = sum(each) / len(each)
+                together = ", ".join(f"{r:,.0f}" for r in each) if at_once > 1 else ""
+            report(f"| {label} | population of {members} ({args.device}) | {tps:,.0f} | {ups:,.0f} | {together} "
+                   f"| {target} |")
     report("")
-    # the projection is for this project's 2 cores: it needs every learner-regime row, measured on CPU
+    # the projection needs every learner-regime row, measured on CPU
     for suite in ("standard", "hard") if args.only is None and args.device == "cpu" else ():
-        report(suite_projection(suite, rates))
+        report(suite_projection(suite, rates, at_once))
         report("")
     report.save(__file__, __doc__, args)
 

@@ -160,3 +160,48 @@ def test_the_page_build_benchmark_counts_an_inserted_line_once(page_module):
         assert results_page.lines_differing(page, page[:2] + ["changed"] + page[3:]) == 1
     finally:
         sys.modules.pop("results_page", None)
+
+
+@pytest.mark.parametrize("argv, problem", [
+    (["--at-once", "0"], "--at-once 0: give a number of processes, 1 or more"),
+    (["--at-once", "4096"], "--at-once 4096: this machine has"),
+])
+def test_the_throughput_benchmark_refuses_a_bad_process_count_before_measuring(page_module, argv, problem, tmp_path,
+                                                                               monkeypatch, capsys):
+    monkeypatch.setattr(sys, "argv", ["student_throughput.py", *argv, "--page", str(tmp_path / "performance.md")])
+    import student_throughput
+
+    def no_measure(*args, **kwargs):
+        raise AssertionError("a measurement started before the input was checked")
+
+    monkeypatch.setattr(student_throughput, "measure_population", no_measure)
+    try:
+        with pytest.raises(SystemExit) as stop:
+            student_throughput.main()
+    finally:
+        sys.modules.pop("student_throughput", None)
+    assert stop.value.code == 2
+    last = capsys.readouterr().err.strip().splitlines()[-1]
+    assert problem in last and "give" in last
+    assert not (tmp_path / "performance.md").exists()
+
+
+def test_the_suite_projection_runs_at_the_rates_of_processes_at_once(page_module):
+    import student_throughput
+
+    try:
+        kinds = [("Cont", False), ("Grid", False), ("Grid", True)]
+        alone = {10: {kind: 1000.0 for kind in kinds}}
+        shared = {10: {kind: 500.0 for kind in kinds}}  # each of two processes at half the rate
+
+        def hours(text):
+            return float(text.split(" h (")[0].rsplit(": ", 1)[1])
+
+        one, two = student_throughput.suite_projection("hard", alone, 1), student_throughput.suite_projection(
+            "hard", shared, 2)
+        assert "on 1 core:" in one and "one process alone" in one
+        assert "on 2 cores:" in two and "with 2 at once" in two
+        # two cores at half speed each take as long as one core at full speed
+        assert hours(two) == pytest.approx(hours(one), rel=0.01)
+    finally:
+        sys.modules.pop("student_throughput", None)

@@ -553,7 +553,7 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
     for runs in directories:
         suite, board, name = runs.suite, runs.board, runs.name
         lines += [f"## {name}" + (f": {suite['description']}" if suite.get("description") else ""), "",
-                  f"Runs in `{runs.path.as_posix()}`." + _suite_scope(suite), ""]
+                  f"Runs in `{runs.path.as_posix()}`." + _suite_scope(suite, runs.sessions), ""]
         lines += [session_line(s, to_the_minute=True) for s in runs.sessions]
         lines += wall_time_lines(runs.sessions) + training_time_lines(_every(board))
         found = facts[runs.path]
@@ -736,9 +736,15 @@ def teachers_markdown(root: Path) -> list[str]:
             "|---|---|---|---|---|---|", *[row for _, row in sorted(rows)], *problems, ""]
 
 
-def _suite_scope(suite: dict) -> str:
+def _suite_scope(suite: dict, sessions: list[dict]) -> str:
     """What the last transfer into a directory asked for (``suite.json``: the suite as run,
-    with any command-line overrides), e.g. `` As run: rungs tagged easy, medium; worlds Cont; ...``."""
+    with any command-line overrides), e.g. `` As last run: rungs tagged easy, medium; worlds Cont;
+    ...``. A directory several transfers ran into (an archive gathering a campaign's parts) says
+    so instead: the last one's scope is not the directory's, and the sessions listed after this
+    line name each one's."""
+    transfers = sum(1 for s in sessions if not s.get("command", "").startswith("craftsuite archive"))
+    if transfers > 1:
+        return f" Gathered from {transfers} sessions that trained, each listed below with its command."
     parts = []
     if suite.get("tags") or suite.get("tasks"):
         parts.append("rungs " + "; ".join(filter(None, [

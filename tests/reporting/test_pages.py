@@ -286,3 +286,14 @@ def test_one_suite_directory_s_leaderboard_sets_them_apart_too_unless_it_ran_at_
     assert main(["leaderboard", str(root)]) == 0
     text = (root / "leaderboard.md").read_text()
     assert "At budgets the suite" not in text and "| dqn | 3 | 0.90" in text and "(a)" not in text
+
+
+def test_the_scope_line_names_the_last_transfer_only_where_it_was_the_only_one():
+    from craftsuite.reporting.pages import _suite_scope
+
+    suite = {"tasks": ["DungeonQuest"], "worlds": ["Cont"], "methods": ["td3"], "seeds": 10}
+    transfer = {"command": "craftsuite transfer --suite hard --tasks DungeonQuest"}
+    archive = {"command": "craftsuite archive runs/hard --suite hard"}
+    assert _suite_scope(suite, [transfer, archive]).startswith(" As last run: rungs DungeonQuest; worlds Cont;")
+    gathered = _suite_scope(suite, [transfer, archive, {"command": "python: craftsuite.suite_runner.transfer()"}])
+    assert gathered == " Gathered from 2 sessions that trained, each listed below with its command."

@@ -156,7 +156,8 @@ def suite_projection(name: str, rates: dict, cores: int) -> str:
     rate = f"at each process's rate with {cores} at once" if cores > 1 else "at the rate of one process alone"
     return (f"The `{name}` suite's students ({len(configs)} runs, {total:,} transitions, {suite.regime} regime) "
             f"at these rates on {cores} core{'s' if cores > 1 else ''}: {seconds / cores / 3600:.1f} h "
-            f"({suite.seeds_text()}, each cell a population, projected from the populations of {' and '.join(map(str, sorted(used)))}, {rate}; "
+            f"({suite.seeds_text()}, each cell a population, projected from the populations of "
+            f"{' and '.join(map(str, sorted(used)))}, {rate}; "
             "teachers and evaluations not counted).")
 
 

@@ -125,6 +125,29 @@ def test_a_description_keeps_its_list_items(page_module):
     assert about == "First, two:\n* one, wrapped;\n* two."
 
 
+def refusal(name: str, argv: list, work: str, tmp_path, monkeypatch, capsys) -> str:
+    """The one line benchmark ``name`` prints refusing ``argv``, after checking that it exits with
+    argparse's code, before calling its ``work`` (replaced by a function that fails the test) and
+    before writing its page."""
+    page = tmp_path / "performance.md"
+    monkeypatch.setattr(sys, "argv", [f"{name}.py", *argv, "--page", str(page)])
+    import importlib
+
+    module = importlib.import_module(name)
+
+    def no_work(*args, **kwargs):
+        raise AssertionError(f"{work} started before the input was checked")
+
+    monkeypatch.setattr(module, work, no_work)
+    try:
+        with pytest.raises(SystemExit) as stop:
+            module.main()
+    finally:
+        sys.modules.pop(name, None)
+    assert stop.value.code == 2 and not page.exists()
+    return capsys.readouterr().err.strip().splitlines()[-1]
+
+
 @pytest.mark.parametrize("argv, problem", [
     (["results/shaping-in-mujoco/standard", "--reference", "no-such-commit"],
      "--reference no-such-commit: not readable from this checkout's git history"),
@@ -133,20 +156,7 @@ def test_a_description_keeps_its_list_items(page_module):
 ])
 def test_the_page_build_benchmark_refuses_bad_input_in_one_line_before_building(page_module, argv, problem,
                                                                                 tmp_path, monkeypatch, capsys):
-    monkeypatch.setattr(sys, "argv", ["results_page.py", *argv, "--page", str(tmp_path / "performance.md")])
-    import results_page
-
-    def no_build(*args):
-        raise AssertionError("a build started before the input was checked")
-
-    monkeypatch.setattr(results_page, "build", no_build)
-    try:
-        with pytest.raises(SystemExit) as stop:
-            results_page.main()
-    finally:
-        sys.modules.pop("results_page", None)
-    assert stop.value.code == 2
-    last = capsys.readouterr().err.strip().splitlines()[-1]
+    last = refusal("results_page", argv, "build", tmp_path, monkeypatch, capsys)
     assert problem in last and "give" in last
 
 
@@ -168,22 +178,8 @@ def test_the_page_build_benchmark_counts_an_inserted_line_once(page_module):
 ])
 def test_the_throughput_benchmark_refuses_a_bad_process_count_before_measuring(page_module, argv, problem, tmp_path,
                                                                                monkeypatch, capsys):
-    monkeypatch.setattr(sys, "argv", ["student_throughput.py", *argv, "--page", str(tmp_path / "performance.md")])
-    import student_throughput
-
-    def no_measure(*args, **kwargs):
-        raise AssertionError("a measurement started before the input was checked")
-
-    monkeypatch.setattr(student_throughput, "measure_population", no_measure)
-    try:
-        with pytest.raises(SystemExit) as stop:
-            student_throughput.main()
-    finally:
-        sys.modules.pop("student_throughput", None)
-    assert stop.value.code == 2
-    last = capsys.readouterr().err.strip().splitlines()[-1]
+    last = refusal("student_throughput", argv, "measure_population", tmp_path, monkeypatch, capsys)
     assert problem in last and "give" in last
-    assert not (tmp_path / "performance.md").exists()
 
 
 def test_the_suite_projection_runs_at_the_rates_of_processes_at_once(page_module):

@@ -11,16 +11,15 @@ engines were compared with), collecting from one vector env, counted over all me
 after the warm-up of random actions (``learning_starts``). The rows named after the learner
 regime add the standard and hard suites' regime (``craftsuite.regimes``: n-step targets,
 wider networks) to those settings: what the suites train now. Each row trains for about
-``--seconds``. The reference column is each row's target. The learner-regime rows are also
-measured ``--at-once`` times at once (default 2, a campaign's process per core here), each
-its own process, timed over the same window after every one's warm-up: the rate of each
-process while the others run, which is what a campaign on these cores gets (processes can
-slow one another through shared caches and memory, by an amount that differs between
-machines). Under the table, the standard and hard suites' student time projected from those
-rates at the suite's seeds per population (or the nearest population size measured), from a
-whole run on CPU only. With
-``--device cuda --members 20`` it measures a GPU population; ``--only n-step-wide`` keeps the
-rows whose label holds that text.
+``--seconds``. The reference column is each row's target. On CPU the learner-regime rows are
+also measured as ``--at-once`` processes at once (default 2, a campaign's process per core
+here, or the machine's cores if fewer), each a fresh process, timed over the same window after
+every one's warm-up: the rate of each process while the others run, which is what a campaign
+on these cores gets (processes can slow one another through shared caches and memory, by an
+amount that differs between machines). Under the table, the standard and hard suites' student
+time projected from those rates at the suite's seeds per population (or the nearest population
+size measured), from a whole run on CPU only. With ``--device cuda --members 20`` it measures a
+GPU population; ``--only n-step-wide`` keeps the rows whose label holds that text.
 """
 
 from __future__ import annotations
@@ -28,6 +27,7 @@ from __future__ import annotations
 import argparse
 import multiprocessing
 import os
+import queue
 import time
 
 import craftsuite  # noqa: F401
@@ -97,30 +97,45 @@ def measure_population(method, env_id, n_envs, settings, env_kwargs, members: in
     return members * (pop.num_timesteps - transitions) / total, members * (pop.learner.n_updates - updates) / total
 
 
-def _measure_in_process(row: tuple, members: int, seconds: float, device: str, start, results) -> None:
+def _measure_in_process(row: tuple, members: int, seconds: float, start, results) -> None:
     import torch
 
-    torch.set_num_threads(1)
-    results.put(measure_population(*row, members, seconds, device, ready=start.wait))
+    torch.set_num_threads(1)  # a spawned process starts with torch's default, one thread per core
+    results.put(measure_population(*row, members, seconds, "cpu", ready=start.wait))
 
 
-def measure_at_once(row: tuple, members: int, seconds: float, device: str, processes: int) -> list[float]:
-    """Transitions/s of each of ``processes`` processes training the same population at once
-    (``row``: method, env id, n_envs, settings, env keywords), timed together once all have
-    warmed up; fresh processes, so none inherits this one's state."""
+def measure_at_once(row: tuple, members: int, seconds: float, processes: int) -> list[float]:
+    """Transitions/s of each of ``processes`` processes on CPU training the same population at
+    once (``row``: method, env id, n_envs, settings, env keywords), timed together once all have
+    warmed up; fresh processes, so none inherits this one's state.
+
+    Raises:
+        RuntimeError: a process that died (its traceback is printed above), after the others
+            are stopped.
+    """
     context = multiprocessing.get_context("spawn")
     start, results = context.Barrier(processes), context.Queue()
-    workers = [context.Process(target=_measure_in_process, args=(row, members, seconds, device, start, results))
+    workers = [context.Process(target=_measure_in_process, args=(row, members, seconds, start, results))
                for _ in range(processes)]
     for worker in workers:
         worker.start()
+    rates = []
     try:
-        rates = [results.get(timeout=seconds + 600)[0] for _ in workers]
+        while len(rates) < processes:
+            try:
+                rates.append(results.get(timeout=1)[0])
+            except queue.Empty:
+                dead = [w.exitcode for w in workers if w.exitcode not in (None, 0)]
+                if dead:  # the others would wait at the barrier for it forever
+                    start.abort()
+                    raise RuntimeError(f"a process measuring {row[0]} in {row[1]} with {processes} at once died "
+                                       f"(exit code {dead[0]}; its traceback is above)") from None
     finally:
         for worker in workers:
             worker.join(timeout=60)
             if worker.is_alive():
                 worker.terminate()
+                worker.join()
     return sorted(rates)
 
 
@@ -166,9 +181,10 @@ def main():
     parser.add_argument("--seconds", type=float, default=10.0)
     parser.add_argument("--members", type=int, nargs="+", default=[5, 10],
                         help="population sizes (default: 5, a suite cell's seeds, and 10)")
-    parser.add_argument("--at-once", type=int, default=min(2, os.cpu_count() or 1), metavar="N",
-                        help="also measure the learner-regime rows as N processes at once, and project the suites "
-                             "on N cores from those rates (default: 2, this project's cores; 1: alone only)")
+    parser.add_argument("--at-once", type=int, metavar="N",
+                        help="on CPU, also measure the learner-regime rows as N processes at once, and project the "
+                             "suites on N cores from those rates (default: 2, this project's cores, or the machine's "
+                             "if fewer; 1: alone only)")
     parser.add_argument("--device", default="cpu", help="the population's torch device (default: cpu)")
     parser.add_argument("--only", metavar="TEXT", help="only the rows whose label holds TEXT (e.g. n-step-wide)")
     add_page_argument(parser)
@@ -177,11 +193,17 @@ def main():
     if not rows:
         parser.error(f"--only {args.only!r}: no row's label holds it; the labels: "
                      + "; ".join(row[0] for row in POPULATION_ROWS + LEARNER_ROWS))
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    if args.at_once is None:
+        args.at_once = min(2, cores) if args.device == "cpu" else 1
     if args.at_once < 1:
         parser.error(f"--at-once {args.at_once}: give a number of processes, 1 or more (1 measures each row alone)")
-    if args.at_once > (os.cpu_count() or 1):
-        parser.error(f"--at-once {args.at_once}: this machine has {os.cpu_count()} cores, and processes sharing a "
-                     "core would measure the sharing; give at most that many")
+    if args.at_once > 1 and args.device != "cpu":
+        parser.error(f"--at-once {args.at_once} with --device {args.device}: processes at once are measured on CPU "
+                     "cores only; give --at-once 1 or --device cpu")
+    if args.at_once > cores:
+        parser.error(f"--at-once {args.at_once}: this process may use {cores} cores, and processes sharing a core "
+                     "would measure the sharing; give at most that many")
     if args.only is not None and not args.no_page:  # a part of the table would replace the whole section
         parser.error("--only measures some rows, and the page's section holds them all: add --no-page")
     import torch
@@ -189,22 +211,24 @@ def main():
     torch.set_num_threads(1)
     report = Report()
     at_once = args.at_once
-    report(f"| student | engine | transitions/s | updates/s (all members) | transitions/s of each of {at_once} "
-           "at once | reference transitions/s |")
-    report("|---|---|---|---|---|---|")
-    rates = {}  # each process's transitions/s with the others at once, of the learner-regime rows, by members,
-    # then (world kind, crm): the projection's
+    together = f" transitions/s of each of {at_once} at once |" if at_once > 1 else ""
+    report(f"| student | engine | transitions/s | updates/s (all members) |{together} reference transitions/s |")
+    report("|---|---|---|---|" + ("---|" if at_once > 1 else "") + "---|")
+    # the projection's rates: each process's transitions/s with the others at once (alone where
+    # at_once is 1), of the learner-regime rows, by members, then (world kind, crm)
+    rates = {}
     for label, method, env_id, n_envs, settings, env_kwargs, target in rows:
         for members in args.members:
             row = (method, env_id, n_envs, settings, env_kwargs)
             tps, ups = measure_population(*row, members, args.seconds, args.device)
-            together = ""
+            each = [tps]
             if settings in (TD3_WIDE, DQN_WIDE):
-                each = measure_at_once(row, members, args.seconds, args.device, at_once) if at_once > 1 else [tps]
+                if at_once > 1:
+                    each = measure_at_once(row, members, args.seconds, at_once)
                 rates.setdefault(members, {})[_kind(method, env_id)] = sum(each) / len(each)
-                together = ", ".join(f"{r:,.0f}" for r in each) if at_once > 1 else ""
-            report(f"| {label} | population of {members} ({args.device}) | {tps:,.0f} | {ups:,.0f} | {together} "
-                   f"| {target} |")
+            shown = (f" {', '.join(f'{r:,.0f}' for r in each)} |" if len(each) > 1 else " |") if at_once > 1 else ""
+            report(f"| {label} | population of {members} ({args.device}) | {tps:,.0f} | {ups:,.0f} |{shown} "
+                   f"{target} |")
     report("")
     # the projection needs every learner-regime row, measured on CPU
     for suite in ("standard", "hard") if args.only is None and args.device == "cpu" else ():

@@ -5,6 +5,7 @@ from __future__ import annotations
 import datetime
 import re
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -174,7 +175,8 @@ def test_the_page_build_benchmark_counts_an_inserted_line_once(page_module):
 
 @pytest.mark.parametrize("argv, problem", [
     (["--at-once", "0"], "--at-once 0: give a number of processes, 1 or more"),
-    (["--at-once", "4096"], "--at-once 4096: this machine has"),
+    (["--at-once", "4096"], "--at-once 4096: this process may use"),
+    (["--at-once", "2", "--device", "cuda"], "--at-once 2 with --device cuda: processes at once are measured on CPU"),
 ])
 def test_the_throughput_benchmark_refuses_a_bad_process_count_before_measuring(page_module, argv, problem, tmp_path,
                                                                                monkeypatch, capsys):
@@ -199,5 +201,19 @@ def test_the_suite_projection_runs_at_the_rates_of_processes_at_once(page_module
         assert "on 2 cores:" in two and "with 2 at once" in two
         # two cores at half speed each take as long as one core at full speed
         assert hours(two) == pytest.approx(hours(one), rel=0.01)
+    finally:
+        sys.modules.pop("student_throughput", None)
+
+
+def test_a_process_measured_at_once_that_dies_stops_the_others_and_says_so(page_module):
+    import student_throughput
+
+    try:
+        row = ("dqn", "CraftSuite/NoSuchTask-Grid10-v0", 1, {}, {})  # its envs cannot be made
+        started = time.perf_counter()
+        with pytest.raises(RuntimeError, match="a process measuring dqn in CraftSuite/NoSuchTask-Grid10-v0 with 2 "
+                                               "at once died"):
+            student_throughput.measure_at_once(row, 1, 0.1, 2)
+        assert time.perf_counter() - started < 120  # not the barrier's forever
     finally:
         sys.modules.pop("student_throughput", None)

@@ -273,9 +273,9 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
     assert (tmp_path / "docs" / "images" / "results-out" / "curves-Reach-Cont.png").is_file()
     transfer(tiny, tmp_path / "out", workers=2, video=False, progress=False, log=lambda *_: None)  # all reused
     assert len(read(tmp_path / "out")) == 2
-    # two sessions ran into the directory: the last one's scope is no longer the directory's
+    # the same transfer again: its scope is still the directory's
     text = write_results_page([tmp_path / "out"], tmp_path / "docs" / "results.md").read_text()
-    assert "As last run" not in text and "Gathered from 2 sessions that trained" in text
+    assert "As last run: rungs tagged calibration" in text and "Gathered from" not in text
 
     def killed(*args, **kwargs):
         raise KeyboardInterrupt

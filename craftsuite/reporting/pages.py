@@ -739,12 +739,13 @@ def teachers_markdown(root: Path) -> list[str]:
 def _suite_scope(suite: dict, sessions: list[dict]) -> str:
     """What the last transfer into a directory asked for (``suite.json``: the suite as run,
     with any command-line overrides), e.g. `` As last run: rungs tagged easy, medium; worlds Cont;
-    ...``. A directory several transfers ran into (an archive gathering a campaign's parts) says
-    so instead: the last one's scope is not the directory's, and the sessions listed after this
-    line name each one's."""
-    transfers = sum(1 for s in sessions if not s.get("command", "").startswith("craftsuite archive"))
-    if transfers > 1:
-        return f" Gathered from {transfers} sessions that trained, each listed below with its command."
+    ...``. A directory that transfers of different commands ran into (an archive gathering a
+    campaign's parts) says so instead: the last one's scope is not the directory's, and the
+    sessions listed after this line name each one's. Sessions that only archived runs
+    (``craftsuite archive``, which records what it kept) are not transfers."""
+    transfers = {s.get("command") for s in sessions if "archived" not in s}
+    if len(transfers) > 1:
+        return f" Gathered from {len(transfers)} different transfers, each listed below with its command."
     parts = []
     if suite.get("tags") or suite.get("tasks"):
         parts.append("rungs " + "; ".join(filter(None, [

@@ -293,7 +293,9 @@ def test_the_scope_line_names_the_last_transfer_only_where_it_was_the_only_one()
 
     suite = {"tasks": ["DungeonQuest"], "worlds": ["Cont"], "methods": ["td3"], "seeds": 10}
     transfer = {"command": "craftsuite transfer --suite hard --tasks DungeonQuest"}
-    archive = {"command": "craftsuite archive runs/hard --suite hard"}
-    assert _suite_scope(suite, [transfer, archive]).startswith(" As last run: rungs DungeonQuest; worlds Cont;")
+    archive = {"command": "craftsuite --debug archive runs/hard --suite hard", "archived": {"students": 5}}
+    # the same command again (a resumed or fully reused run) leaves the scope the directory's
+    once = _suite_scope(suite, [transfer, archive, transfer, archive])
+    assert once.startswith(" As last run: rungs DungeonQuest; worlds Cont;")
     gathered = _suite_scope(suite, [transfer, archive, {"command": "python: craftsuite.suite_runner.transfer()"}])
-    assert gathered == " Gathered from 2 sessions that trained, each listed below with its command."
+    assert gathered == " Gathered from 2 different transfers, each listed below with its command."

@@ -221,13 +221,13 @@ def main():
         for members in args.members:
             row = (method, env_id, n_envs, settings, env_kwargs)
             tps, ups = measure_population(*row, members, args.seconds, args.device)
-            each = [tps]
+            together = ""  # the at-once column's cell: only the learner-regime rows are measured at once
             if settings in (TD3_WIDE, DQN_WIDE):
-                if at_once > 1:
-                    each = measure_at_once(row, members, args.seconds, at_once)
+                each = measure_at_once(row, members, args.seconds, at_once) if at_once > 1 else [tps]
                 rates.setdefault(members, {})[_kind(method, env_id)] = sum(each) / len(each)
-            shown = (f" {', '.join(f'{r:,.0f}' for r in each)} |" if len(each) > 1 else " |") if at_once > 1 else ""
-            report(f"| {label} | population of {members} ({args.device}) | {tps:,.0f} | {ups:,.0f} |{shown} "
+                together = ", ".join(f"{r:,.0f}" for r in each) if at_once > 1 else ""
+            column = f" {together} |" if at_once > 1 else ""
+            report(f"| {label} | population of {members} ({args.device}) | {tps:,.0f} | {ups:,.0f} |{column} "
                    f"{target} |")
     report("")
     # the projection needs every learner-regime row, measured on CPU

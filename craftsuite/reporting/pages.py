@@ -44,6 +44,7 @@ from .looks import looks
 from .plots import draw_curves, draw_profiles, file_part, save_figures
 from .sources import read_runs, session_line
 from .timing import rates, training_time_lines, wall_time_lines
+from .to_decide import asks, needed, seeds_now, to_decide_markdown
 
 # The authors' shipped continuous results, one run each, mean episode reward over the last
 # 5% of 2e6 steps (not the same metric window as ours, nor our MuJoCo world).
@@ -305,7 +306,7 @@ def decided_by_regime(pairs) -> dict[str, dict[str, int]]:
         mine = tally.setdefault(entry.regime, {**dict.fromkeys(("comparisons", "ahead", "behind", "no difference",
                                                                 "trivial"), 0), "seeds to decide": []})
         mine["comparisons"] += 1
-        need = None if c is None else _needed(c, entry, base)
+        need = None if c is None else needed(c, entry, base)
         if need is not None:
             mine["seeds to decide"].append(need)
         if c is not None and c.decided:
@@ -318,21 +319,10 @@ def _decided(t: dict[str, int]) -> int:
     return t["ahead"] + t["behind"] + t["no difference"]
 
 
-def _now(entry: Entry, base: Entry) -> int:
-    return min(len(entry.values["success"]), len(base.values["success"]))
-
-
-def _needed(c: Comparison, entry: Entry, base: Entry) -> int | None:
-    """An undecided comparison's seeds a side to decide it, where more than it has (the page's
-    clipped intervals and the bootstrap differ from the model: a figure at or below today's
-    seeds is not said)."""
-    return c.seeds_to_decide if c.seeds_to_decide is not None and c.seeds_to_decide > _now(entry, base) else None
-
-
 def _seeds_to_decide(c: Comparison, entry: Entry, base: Entry) -> str:
-    need = _needed(c, entry, base)
+    need = needed(c, entry, base)
     return "" if need is None else f"at these means and spreads: about {need} seeds a side, against " \
-        f"{_now(entry, base)}"
+        f"{seeds_now(entry, base)}"
 
 
 def comparisons_markdown(pairs, auc=None) -> list[str]:
@@ -545,6 +535,9 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
         lines += ["## Distilled against scratch", "",
                   "Each distilled method against its algorithm from scratch on each rung, in final greedy success "
                   "and in AUC (the rows come from the leaderboards below).", "", *compared]
+        cheapest = to_decide_markdown(asks(pairs, auc, [_every(runs.board) for runs in directories]))
+        if cheapest:
+            lines += ["### What the undecided would ask", "", *cheapest]
     if len(directories) > 1:
         if any(agg.iqm for agg in ladder):
             lines += ["## Across the ladder", "", "Every directory below together, per world and learner regime "

@@ -254,6 +254,7 @@ def test_a_suite_s_runs_at_a_budget_it_no_longer_asks_for_are_set_apart_not_pool
     assert "- Distilled against scratch, final greedy success: `n-step-wide` 1 comparison: ahead on 1, behind on " \
            "0, no difference of 0.2 or more on 0 (0 of them only because every seed of both sat at 0 or at 1), " \
            "undecided on 0." in short
+    assert "### What the undecided would ask" not in text  # every comparison decided: nothing asked
     assert ": standard: Grid10 1 of 6 (KeySwordDragon), Cont 0 of 6." in short
     asked = len(suite.student_configs(root / "teachers"))
     assert f"- Archived of each suite as defined now: standard 0 of {asked:,} runs (" in short
@@ -265,6 +266,17 @@ def test_a_suite_s_runs_at_a_budget_it_no_longer_asks_for_are_set_apart_not_pool
             (run / "result.json").unlink()
     text = write_results_page([root], tmp_path / "results.md").read_text()
     assert "### At budgets the suite no longer" in text and "No run finished yet; unfinished: dqn seed 0" in text
+
+
+def test_the_results_page_lists_what_each_undecided_comparison_would_ask(tmp_path):
+    spread = [1.0, 0.0, 0.5, 0.0, 1.0, 0.5]
+    for seed in range(5):
+        fake_run(tmp_path, "td3", seed, [(1000, spread[seed])], [(950, 1.0)], task="ToolHome")
+        fake_run(tmp_path, "td3-dynamic", seed, [(1000, spread[seed + 1])], [(950, 1.0)], task="ToolHome")
+    text = write_results_page([tmp_path], tmp_path / "results.md").read_text()
+    asked = text[text.index("### What the undecided would ask"):]
+    assert asked.index("| ToolHome | Cont | one-step | `td3-dynamic` − `td3` | final greedy success | 1,000 | 5 / 5 |") \
+        < asked.index("\n## ")  # inside the comparisons' section, before the next
 
 
 def test_one_suite_directory_s_leaderboard_sets_them_apart_too_unless_it_ran_at_one_budget(tmp_path, capsys):

@@ -1,0 +1,93 @@
+"""What an undecided comparison asks before it is decided: the seeds a side at which the
+page's interval rules would decide it if its means and spreads held (``stats.seeds_to_resolve``,
+a planning figure), the runs that adds to each side, and what those runs cost in transitions
+and in hours of one process at the rate the archive measured. Listed quickest first, so a
+campaign's next part can be chosen by its cost (and fixed before any of its runs is read)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .board import COMPARED, Board, Comparison, Entry, rung_order
+from .timing import rates
+
+
+def seeds_now(entry: Entry, base: Entry) -> int:
+    """The seeds a side a comparison is read at: the smaller side's."""
+    return min(len(entry.values["success"]), len(base.values["success"]))
+
+
+def needed(c: Comparison, entry: Entry, base: Entry) -> int | None:
+    """An undecided comparison's seeds a side to decide it, where more than it has (the page's
+    clipped intervals and the bootstrap differ from the model: a figure at or below today's
+    seeds is not said)."""
+    need = c.seeds_to_decide
+    return need if need is not None and need > seeds_now(entry, base) else None
+
+
+@dataclass(frozen=True)
+class Ask:
+    """One undecided comparison, in one metric, and what deciding it would cost."""
+
+    entry: Entry
+    base: Entry
+    metric: str  # one of ``board.COMPARED``
+    seeds: int  # a side
+    runs: tuple[int, int]  # to add: (distilled, scratch)
+    hours: float | None  # of one process at the measured rate (None: no rate for its world)
+
+    @property
+    def transitions(self) -> int:
+        return sum(self.runs) * self.entry.budget
+
+
+def asks(pairs, auc, boards: list[Board]) -> list[Ask]:
+    """Every comparison of ``pairs`` (read in final greedy success) and ``auc`` (the same
+    pairs in AUC) that is undecided with a figure to say, quickest first: by the hours at
+    the rates ``boards``' runs recorded for their world and learner regime, then (and where
+    no rate is known, after the rest) by transitions."""
+    every = Board([e for board in boards for e in board])
+    measured: dict[str, dict[str, float]] = {}
+    found = []
+    for metric, read in (("success", pairs), ("auc", auc)):
+        for entry, base, c in read:
+            need = None if c is None else needed(c, entry, base)
+            if need is None:
+                continue
+            runs = (max(0, need - len(entry.values[metric])), max(0, need - len(base.values[metric])))
+            if entry.regime not in measured:
+                measured[entry.regime] = rates(every, entry.regime)
+            rate = measured[entry.regime].get(entry.world)
+            hours = sum(runs) * entry.budget / rate / 3600 if rate else None
+            found.append(Ask(entry, base, metric, need, runs, hours))
+    # the hours first: the learner regimes' and worlds' rates differ several times over
+    return sorted(found, key=lambda a: (a.hours is None, a.hours or 0.0, a.transitions, rung_order(a.entry.task),
+                                        a.entry.world_label, a.metric))
+
+
+def to_decide_markdown(found: list[Ask]) -> list[str]:
+    """``asks`` as a table with a line on how to read it (nothing where none is undecided)."""
+    if not found:
+        return []
+    rows = [f"| {a.entry.task} | {a.entry.world_label} | {a.entry.regime} | `{a.entry.label}` − `{a.base.label}` "
+            f"| {COMPARED[a.metric]} | {a.entry.budget:,} | {len(a.entry.values[a.metric])} / "
+            f"{len(a.base.values[a.metric])} | {a.seeds} | {a.runs[0]} + {a.runs[1]} | {_millions(a.transitions)} "
+            f"| {'?' if a.hours is None else f'{a.hours:.1f}'} |" for a in found]
+    return ["| rung | world | learner regime | distilled − scratch | metric | transitions per run "
+            "| seeds now (distilled / scratch) | seeds a side asked | runs to add (distilled + scratch) "
+            "| transitions to add | hours of one process |",
+            "|---|---|---|---|---|---|---|---|---|---|---|", *rows, "",
+            "Each undecided comparison with the seeds a side its next reading would need if its means and spreads "
+            "held (the planning figure of the table above), quickest first: the runs that adds to each side, their "
+            "transitions, and their hours in one population process at the rate this archive's runs of that world "
+            "and learner regime recorded on a CPU (two processes on two cores each keep most of it: "
+            "docs/performance.md). A spread read from a handful of seeds is itself uncertain, so a figure can move "
+            "a long way as seeds are added; fix the seeds of a part before reading any of them.", ""]
+
+
+def _millions(transitions: int) -> str:
+    """``2.2M``, ``450k``: a count of transitions as a campaign plans it."""
+    if transitions >= 1_000_000:
+        return f"{transitions / 1e6:.1f}M"
+    return f"{math.ceil(transitions / 1000):,}k"

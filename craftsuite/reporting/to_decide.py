@@ -6,7 +6,6 @@ campaign's next part can be chosen by its cost (and fixed before any of its runs
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from .board import COMPARED, Board, Comparison, Entry, rung_order
@@ -15,7 +14,7 @@ from .timing import rates
 
 def seeds_now(entry: Entry, base: Entry) -> int:
     """The seeds a side a comparison is read at: the smaller side's."""
-    return min(len(entry.values["success"]), len(base.values["success"]))
+    return min(len(entry.seeds), len(base.seeds))
 
 
 def needed(c: Comparison, entry: Entry, base: Entry) -> int | None:
@@ -39,6 +38,7 @@ class Ask:
 
     @property
     def transitions(self) -> int:
+        """Of the runs to add (both sides run at one budget: only such pairs are compared)."""
         return sum(self.runs) * self.entry.budget
 
 
@@ -48,16 +48,15 @@ def asks(pairs, auc, boards: list[Board]) -> list[Ask]:
     the rates ``boards``' runs recorded for their world and learner regime, then (and where
     no rate is known, after the rest) by transitions."""
     every = Board([e for board in boards for e in board])
-    measured: dict[str, dict[str, float]] = {}
+    # per learner regime, per world's name (a world's variants, such as another layout, share its rate)
+    measured = {regime: rates(every, regime) for regime in {entry.regime for entry, *_ in pairs}}
     found = []
     for metric, read in (("success", pairs), ("auc", auc)):
         for entry, base, c in read:
             need = None if c is None else needed(c, entry, base)
             if need is None:
                 continue
-            runs = (max(0, need - len(entry.values[metric])), max(0, need - len(base.values[metric])))
-            if entry.regime not in measured:
-                measured[entry.regime] = rates(every, entry.regime)
+            runs = (max(0, need - len(entry.seeds)), max(0, need - len(base.seeds)))
             rate = measured[entry.regime].get(entry.world)
             hours = sum(runs) * entry.budget / rate / 3600 if rate else None
             found.append(Ask(entry, base, metric, need, runs, hours))
@@ -71,8 +70,8 @@ def to_decide_markdown(found: list[Ask]) -> list[str]:
     if not found:
         return []
     rows = [f"| {a.entry.task} | {a.entry.world_label} | {a.entry.regime} | `{a.entry.label}` − `{a.base.label}` "
-            f"| {COMPARED[a.metric]} | {a.entry.budget:,} | {len(a.entry.values[a.metric])} / "
-            f"{len(a.base.values[a.metric])} | {a.seeds} | {a.runs[0]} + {a.runs[1]} | {_millions(a.transitions)} "
+            f"| {COMPARED[a.metric]} | {a.entry.budget:,} | {len(a.entry.seeds)} / {len(a.base.seeds)} | {a.seeds} "
+            f"| {a.runs[0]} + {a.runs[1]} | {a.transitions:,} "
             f"| {'?' if a.hours is None else f'{a.hours:.1f}'} |" for a in found]
     return ["| rung | world | learner regime | distilled − scratch | metric | transitions per run "
             "| seeds now (distilled / scratch) | seeds a side asked | runs to add (distilled + scratch) "
@@ -83,11 +82,6 @@ def to_decide_markdown(found: list[Ask]) -> list[str]:
             "transitions, and their hours in one population process at the rate this archive's runs of that world "
             "and learner regime recorded on a CPU (two processes on two cores each keep most of it: "
             "docs/performance.md). A spread read from a handful of seeds is itself uncertain, so a figure can move "
-            "a long way as seeds are added; fix the seeds of a part before reading any of them.", ""]
+            "a long way as seeds are added; fix the seeds of a part before reading any of them. A comparison "
+            "undecided in both metrics has a row for each, of the same runs: the larger figure covers both.", ""]
 
-
-def _millions(transitions: int) -> str:
-    """``2.2M``, ``450k``: a count of transitions as a campaign plans it."""
-    if transitions >= 1_000_000:
-        return f"{transitions / 1e6:.1f}M"
-    return f"{math.ceil(transitions / 1000):,}k"

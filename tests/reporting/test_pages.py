@@ -274,6 +274,7 @@ def test_the_results_page_lists_what_each_undecided_comparison_would_ask(tmp_pat
         fake_run(tmp_path, "td3", seed, [(1000, spread[seed])], [(950, 1.0)], task="ToolHome")
         fake_run(tmp_path, "td3-dynamic", seed, [(1000, spread[seed + 1])], [(950, 1.0)], task="ToolHome")
     text = write_results_page([tmp_path], tmp_path / "results.md").read_text()
+    assert text.index("## Distilled against scratch") < text.index("### What the undecided would ask")
     asked = text[text.index("### What the undecided would ask"):]
     assert asked.index("| ToolHome | Cont | one-step | `td3-dynamic` − `td3` | final greedy success | 1,000 | 5 / 5 |") \
         < asked.index("\n## ")  # inside the comparisons' section, before the next

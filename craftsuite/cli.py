@@ -659,8 +659,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--ray", metavar="ADDRESS", help="run the students on Ray ('local' starts one here)")
     p.add_argument("--no-video", action="store_true", help="skip the rollout video of the best student")
     p.add_argument("--archive", metavar="DIR", help="the results archive: runs found in DIR/<suite> are not trained "
-                   "again, and every finished run's records are kept there (default: results, for the suites that "
-                   "keep their runs: all but quick)")
+                   "again, and every finished run's records are kept there as its population finishes (default: results, "
+                   "for the suites that keep their runs: all but quick)")
     p.add_argument("--no-archive", action="store_true", help="neither read nor write a results archive")
     p.add_argument("--engine", choices=ENGINES, help="what trains the teachers and students: population (each "
                    "cell's seeds in one process); sb3 (one SB3 agent per run, as CraftSuite trained before) only "

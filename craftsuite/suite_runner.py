@@ -97,7 +97,7 @@ def _carried(task: str) -> str | dict:
 def run_students(configs: list[StudentConfig], root, workers: int | None = None, ray: str | None = None,
                  progress: bool = True, teachers: dict[str, TeacherConfig] | None = None, teacher_root=None,
                  log=print, device: str = "cpu", pool: WorkerPool | None = None,
-                 members: int | None = None) -> list[Path]:
+                 members: int | None = None, finished=None) -> list[Path]:
     """Run students in parallel (processes or Ray) with one progress bar over all their
     transitions: one job per population (the seeds of a cell, ``cells``); a finished run of
     the sb3 engine is reused, an unfinished one refused (``training.finished_sb3_run``).
@@ -106,7 +106,11 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
     students start at once. ``device`` is the populations' torch device. ``pool``: the
     pool to run them in (``transfer`` makes it before it writes anything), closed here;
     else one of ``workers`` processes or on ``ray``. Reused and resumed runs are announced
-    (``log``) before the bar starts, which counts their earlier steps as done before."""
+    (``log``) before the bar starts, which counts their earlier steps as done before.
+    ``finished(kind, paths)``, if given, is called as each teacher (``"teachers"``) and each
+    population (``"students"``) finishes, with its run directories: ``transfer`` archives them
+    then, so a process stopped later (a campaign's cut-off, a lost machine) loses only what
+    was still training."""
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     teachers = teachers or {}
@@ -153,12 +157,27 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                                        device if t.engine == "population" else "cpu"): task
                        for task, t in teachers.items()}
             futures = {id(job): (job, submit(job)) for job in ready}
+            reported = set()  # the populations handed to ``finished``
+
+            def check_populations():
+                for key, (_, future) in futures.items():
+                    if not future.done():
+                        continue
+                    if future.exception() is not None:
+                        raise future.exception()  # a worker's error, at once rather than at the end
+                    if finished is not None and key not in reported:
+                        reported.add(key)
+                        result = future.result()
+                        finished("students", [Path(p) for p in (result if isinstance(result, list) else [result])])
+
             while pending or not all(f.done() for _, f in futures.values()):
                 time.sleep(0.5)
                 poll()
                 for future in [f for f in pending if f.done()]:
                     task = pending.pop(future)
                     path = Path(future.result())  # re-raises a teacher's error
+                    if finished is not None:
+                        finished("teachers", [path])
                     result = read_result(path)
                     reached = "reached" if result["reached_target"] else "did NOT reach"
                     (bar.write if progress else log)(
@@ -166,9 +185,8 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                         f"({reached} {teachers[task].target_success:.0%}) -> {path}")
                     for job in waiting.pop(task):
                         futures[id(job)] = (job, submit(job))
-                for _, future in futures.values():
-                    if future.done() and future.exception() is not None:
-                        raise future.exception()  # a worker's error, at once rather than at the end
+                check_populations()
+            check_populations()  # those that finished after the loop's last look
             paths = {}
             for job, future in futures.values():
                 result = future.result()
@@ -246,7 +264,8 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     ``command``: how this run was asked for, as ``provenance.json`` records it (the CLI
     passes its command line); by default, this Python call. ``archive``: a results archive (``craftsuite.archive``; e.g.
     ``results``): the runs it holds under ``<archive>/<suite>`` are not trained again, and
-    every run that finishes here is kept there, even if a later one fails.
+    every run that finishes here is kept there as its population (or teacher) finishes, so a
+    later failure, or a kill that leaves no time to clean up, loses only what was training.
 
     Bad input (a budget too small to train, a device this machine lacks, an output
     directory or archive that cannot be one, a Ray cluster out of reach, an sb3 run
@@ -294,14 +313,20 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     except BaseException:
         pool.close(abort=True)
         raise
+    def keep_finished(kind: str, paths: list[Path]) -> None:  # each population as it finishes
+        try:
+            keep_all(out, kept, {kind: {p.name for p in paths}}, suite=dataclasses.asdict(suite), log=log)
+        except Exception as err:  # the runs train on; the end of the session tries again
+            log(f"results archive {kept}: not updated ({type(err).__name__}: {err})")
+
     try:
         students = run_students(configs, out / "students", progress=progress, teachers=teachers,
                                 teacher_root=out / "teachers", log=log, device=device or "cpu", pool=pool,
-                                members=members)
+                                members=members, finished=keep_finished if kept is not None else None)
     except BaseException:
         pool.close(abort=True)  # (run_students closes it too, but not if it failed before its jobs; twice is harmless)
         raise
-    finally:  # what finished is kept, whatever stopped the rest
+    finally:  # what finished is kept, whatever stopped the rest (each population was, as it finished)
         if kept is not None:
             try:  # (the session is on record in out since it started)
                 keep_all(out, kept, names, suite=dataclasses.asdict(suite), log=log)  # as run: pages read its settings

@@ -242,3 +242,36 @@ def test_a_transfer_on_the_sb3_engine_reuses_the_finished_runs_its_archive_holds
             (store / "students" / run.name / "result.json").read_text())  # reused as archived
         assert not (run / "model.zip").exists()
     assert result.leaderboard.is_file() and "Reach" in result.leaderboard.read_text()
+
+
+def test_a_transfer_archives_each_population_as_it_finishes(tmp_path, monkeypatch):
+    """A population's runs are in the archive, with the session that trained them, as soon as
+    it finishes: a campaign's process stopped later (a kill leaves no time to clean up)
+    loses only the populations still training."""
+    import craftsuite.suite_runner as suite_runner
+    from craftsuite.provenance import read
+
+    monkeypatch.setattr(suite_runner, "WorkerPool", _InProcessPool)
+    suite = dataclasses.replace(SUITES["quick"], tasks=("Reach",), seeds=1)
+    store = tmp_path / "results" / suite.name
+    held = {}
+
+    class Killed(Exception):
+        pass
+
+    def one_population_then_killed(configs, root, finished=None, **kwargs):
+        first = configs[0]
+        _finished_record(root, first, {"kind": "student", "steps": first.steps, "task": first.task,
+                                       "method": first.method, "seed": first.seed, "model": "model.zip"})
+        finished("students", [root / first.run_name()])
+        held.update(runs=sorted(p.name for p in (store / "students").iterdir()), sessions=read(store),
+                    first=first.run_name())
+        raise Killed  # before the other population finishes, and before the session ends
+
+    monkeypatch.setattr(suite_runner, "run_students", one_population_then_killed)
+    with pytest.raises(Killed):
+        suite_runner.transfer(suite, tmp_path / "out", video=False, progress=False, log=lambda *_: None,
+                              archive=tmp_path / "results")
+    assert held["runs"] == [held["first"]]
+    [session] = held["sessions"]  # the session that trained it is named beside it, its time still open
+    assert session["seconds"] is None and session["command"].startswith("python: craftsuite.suite_runner.transfer")

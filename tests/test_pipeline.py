@@ -287,6 +287,48 @@ def test_transfer_trains_teachers_in_the_pool_and_writes_board_page_and_provenan
     assert text.count("min on ") == 2 and text.count("did not finish on ") == 1
 
 
+class _StaggeredPool:
+    """Populations that "finish" one after another: the first at once, each next one a
+    second later (its result.json written then), as workers of unequal cells do."""
+
+    def __init__(self):
+        self.timers = []
+
+    def submit(self, job, configs, root, *_):
+        import threading
+        from concurrent.futures import Future
+
+        future, runs = Future(), [Path(root) / StudentConfig(**c).run_name() for c in configs]
+
+        def finish():
+            for run in runs:
+                run.mkdir(parents=True, exist_ok=True)
+                (run / "result.json").write_text("{}")
+            future.set_result([str(run) for run in runs])
+
+        timer = threading.Timer(1.0 * len(self.timers), finish)  # the first at once
+        self.timers.append(timer)
+        timer.start()
+        return future
+
+    def close(self, abort=False):
+        for timer in self.timers:
+            timer.cancel()
+
+
+def test_run_students_hands_over_each_population_as_it_finishes(tmp_path):
+    configs = [StudentConfig(method="dqn", world="Grid7", seed=s, steps=300) for s in (0, 1)]
+    handed = []
+
+    def finished(kind, paths):  # with whether the other population had finished by then
+        handed.append((kind, [p.name for p in paths], sorted(r.parent.name for r in tmp_path.glob("*/result.json"))))
+
+    run_students(configs, tmp_path, pool=_StaggeredPool(), progress=False, members=1, finished=finished)
+    first, second = (c.run_name() for c in configs)
+    assert handed == [("students", [first], [first]),  # handed over while the second still trained
+                      ("students", [second], sorted([first, second]))]
+
+
 @pytest.mark.slow  # starts a Ray instance
 def test_students_on_a_local_ray_instance(tmp_path):
     pytest.importorskip("ray")

@@ -215,7 +215,7 @@ def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict |
     archive's ``provenance.json`` by session id). A run that cannot be kept (a record whose
     success cannot be re-read) is named through ``log``; the others are kept all the same.
     Returns how many of each kind were kept."""
-    from .provenance import FILE, read
+    from .provenance import merge, read
 
     out, archive = Path(out), Path(archive)
     kept = {}
@@ -233,15 +233,9 @@ def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict |
         kept[kind] = count
     if suite is not None:
         atomic_write(archive / "suite.json", json.dumps(suite, indent=2) + "\n")
-    sessions = read(archive)
-    known = {s.get("id") for s in sessions}
-    for session in read(out):
-        if session.get("id") in known:
-            sessions = [session if s.get("id") == session["id"] else s for s in sessions]
-        else:
-            sessions.append(session)
+    sessions = read(out)
     if sessions:
-        atomic_write(archive / FILE, json.dumps(sessions, indent=2) + "\n")
+        merge(archive, sessions)
     return kept
 
 

@@ -8,6 +8,8 @@ The results page (``reporting.pages.write_results_page``) prints the sessions be
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import json
 import os
 import platform
@@ -97,16 +99,37 @@ def start_session(command: list[str] | str | None = None) -> dict:
 def record_session(out, session: dict, seconds: float | None) -> Path:
     """Record a session (``start_session``) in ``out/provenance.json``: appended, or, if it
     is there already (its id), updated. ``seconds`` None: not finished."""
+    return merge(out, [{**session, "seconds": None if seconds is None else round(seconds, 1)}])
+
+
+def merge(out, sessions: list[dict]) -> Path:
+    """Sessions into ``out/provenance.json``, each by its id: one already there is replaced
+    (the last of that id), a new one appended. The record is read and rewritten under a
+    lock on ``out``, so that processes writing into one directory at once (a campaign's
+    processes archiving into one archive) never write back a record without another's session."""
     path = Path(out) / FILE
-    sessions = read(out)
-    entry = {**session, "seconds": None if seconds is None else round(seconds, 1)}
-    same = [i for i, s in enumerate(sessions) if s.get("id") == session["id"]]
-    if same:
-        sessions[same[-1]] = entry
-    else:
-        sessions.append(entry)
-    atomic_write(path, json.dumps(sessions, indent=2) + "\n")
+    with _locked(out):
+        found = read(out)
+        for session in sessions:
+            same = [i for i, s in enumerate(found) if s.get("id") == session.get("id")]
+            if same:
+                found[same[-1]] = session
+            else:
+                found.append(session)
+        atomic_write(path, json.dumps(found, indent=2) + "\n")
     return path
+
+
+@contextlib.contextmanager
+def _locked(directory):
+    """An exclusive advisory lock (``flock``) on the directory itself, held for the block: no
+    lock file to leave behind in an archive kept under version control."""
+    fd = os.open(directory, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # (closing drops the lock)
 
 
 def read(out) -> list[dict]:

@@ -143,3 +143,31 @@ def test_a_copied_tree_names_its_commit_from_the_environment(tmp_path, monkeypat
     assert provenance.git_commit() == "5009c5b0aa"
     monkeypatch.delenv(provenance.COMMIT_VARIABLE)
     assert provenance.git_commit() is None
+
+
+def test_sessions_written_at_once_into_one_directory_are_all_kept(tmp_path, monkeypatch):
+    """A campaign's processes archive into one archive at once: each merge reads, adds and
+    rewrites the record, and none may write back a record that lacks another's session."""
+    import threading
+    import time
+
+    real = provenance.read
+
+    def slow_read(out):  # widens the window between reading the record and writing it back
+        found = real(out)
+        time.sleep(0.01)
+        return found
+
+    monkeypatch.setattr(provenance, "read", slow_read)
+
+    def write(n):
+        for i in range(5):
+            record_session(tmp_path, start_session(command=f"writer {n} session {i}"), 1.0)
+
+    writers = [threading.Thread(target=write, args=(n,)) for n in range(6)]
+    for w in writers:
+        w.start()
+    for w in writers:
+        w.join()
+    assert sorted(s["command"] for s in real(tmp_path)) == sorted(f"writer {n} session {i}" for n in range(6)
+                                                                  for i in range(5))

@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+TIME_LIMIT_STATUS = 3  # the exit status of a transfer its --time-limit stopped: runs are left to resume
+
 
 def _task(argument: str) -> str:
     """A task argument's task name: a known task's, or a spec file's (``*.toml``, read and
@@ -330,7 +332,7 @@ def _transfer(args) -> int:
     from .ids import CONT, KINEMATIC, world_kind
     from .methods import resolve_method
     from .provenance import command_line
-    from .suite_runner import transfer
+    from .suite_runner import TimeLimitReached, transfer
     from .suites import SUITES
 
     if args.suite not in SUITES:
@@ -385,8 +387,13 @@ def _transfer(args) -> int:
     if suite.archived and not own and archive is None and not args.no_archive:
         print(f"({'rungs, worlds or methods' if beyond else 'settings'} beyond the suite's: no results archive "
               "unless --archive DIR is given)")
-    result = transfer(suite, out, workers=args.workers, ray=args.ray, video=not args.no_video, command=command_line(),
-                      device=args.device, archive=archive, members=args.members)
+    try:
+        result = transfer(suite, out, workers=args.workers, ray=args.ray, video=not args.no_video,
+                          command=command_line(), device=args.device, archive=archive, members=args.members,
+                          time_limit=None if args.time_limit is None else args.time_limit * 60)
+    except TimeLimitReached as stopped:
+        print(f"{stopped}" + (f"; the finished runs are kept in {archive}" if archive else ""))
+        return TIME_LIMIT_STATUS
     print(f"leaderboard: {result.leaderboard} (and .csv)")
     for plot in result.plots:
         print(f"learning curves: {plot}")
@@ -658,9 +665,13 @@ def build_parser() -> argparse.ArgumentParser:
                    "should use it better (experiments/fresh-seeds)")
     p.add_argument("--ray", metavar="ADDRESS", help="run the students on Ray ('local' starts one here)")
     p.add_argument("--no-video", action="store_true", help="skip the rollout video of the best student")
+    p.add_argument("--time-limit", type=_positive_float, metavar="MINUTES",
+                   help="stop training after this many minutes (a campaign's part, a machine held for a while): the "
+                   "runs still training are stopped and resume from their checkpoints when the same command runs "
+                   f"again, the finished ones are kept; exits with status {TIME_LIMIT_STATUS} when it stopped any")
     p.add_argument("--archive", metavar="DIR", help="the results archive: runs found in DIR/<suite> are not trained "
-                   "again, and every finished run's records are kept there as its population finishes (default: results, "
-                   "for the suites that keep their runs: all but quick)")
+                   "again, and every finished run's records are kept there as its population finishes (default: "
+                   "results, for the suites that keep their runs: all but quick)")
     p.add_argument("--no-archive", action="store_true", help="neither read nor write a results archive")
     p.add_argument("--engine", choices=ENGINES, help="what trains the teachers and students: population (each "
                    "cell's seeds in one process); sb3 (one SB3 agent per run, as CraftSuite trained before) only "

@@ -36,6 +36,11 @@ from .task_registry import carried, resolve_task
 from .worker_pool import WorkerPool
 
 
+class TimeLimitReached(Exception):
+    """A transfer's time limit passed with runs still training: they were stopped, each to
+    resume from its newest checkpoint when asked for again, and the finished ones are kept."""
+
+
 def _population_job(configs: list[dict], root: str, task: str | dict | None = None, device: str = "cpu") -> list[str]:
     """The seeds of one cell in a worker process, as one population (``craftsuite.population``)."""
     _start_worker(task)
@@ -97,7 +102,7 @@ def _carried(task: str) -> str | dict:
 def run_students(configs: list[StudentConfig], root, workers: int | None = None, ray: str | None = None,
                  progress: bool = True, teachers: dict[str, TeacherConfig] | None = None, teacher_root=None,
                  log=print, device: str = "cpu", pool: WorkerPool | None = None,
-                 members: int | None = None, finished=None) -> list[Path]:
+                 members: int | None = None, finished=None, deadline: float | None = None) -> list[Path]:
     """Run students in parallel (processes or Ray) with one progress bar over all their
     transitions: one job per population (the seeds of a cell, ``cells``); a finished run of
     the sb3 engine is reused, an unfinished one refused (``training.finished_sb3_run``).
@@ -110,7 +115,8 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
     ``finished(kind, paths)``, if given, is called as each teacher (``"teachers"``) and each
     population (``"students"``) finishes, with its run directories: ``transfer`` archives them
     then, so a process stopped later (a campaign's cut-off, a lost machine) loses only what
-    was still training."""
+    was still training. ``deadline`` (a ``time.monotonic()`` value): once it passes, the runs
+    still training are stopped and ``TimeLimitReached`` says how many."""
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     teachers = teachers or {}
@@ -186,6 +192,11 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                     for job in waiting.pop(task):
                         futures[id(job)] = (job, submit(job))
                 check_populations()
+                if deadline is not None and time.monotonic() >= deadline:
+                    left = [c for c, run in runs if not (run / "result.json").exists()]
+                    raise TimeLimitReached(
+                        f"time limit reached with {len(left)} of {len(configs)} student runs still training: they "
+                        "were stopped, and resume from their newest checkpoints when the same command runs again")
             check_populations()  # those that finished after the loop's last look
             paths = {}
             for job, future in futures.values():
@@ -255,7 +266,7 @@ class TransferResult:
 
 def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None = None, video: bool = True,
              progress: bool = True, log=print, command: list[str] | None = None, device: str | None = None,
-             archive=None, members: int | None = None) -> TransferResult:
+             archive=None, members: int | None = None, time_limit: float | None = None) -> TransferResult:
     """The suite end to end: teachers and distillation, students, leaderboard, plots, video.
 
     ``device``: the torch device of the population engine's students (``cpu``, the
@@ -266,6 +277,9 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     ``results``): the runs it holds under ``<archive>/<suite>`` are not trained again, and
     every run that finishes here is kept there as its population (or teacher) finishes, so a
     later failure, or a kill that leaves no time to clean up, loses only what was training.
+    ``time_limit``: seconds from the start after which the runs still training are stopped
+    (``TimeLimitReached``; they resume when the same transfer runs again), the session
+    recorded with the time it ran.
 
     Bad input (a budget too small to train, a device this machine lacks, an output
     directory or archive that cannot be one, a Ray cluster out of reach, an sb3 run
@@ -282,6 +296,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     if command is None:
         command = f"python: craftsuite.suite_runner.transfer(suite {suite.name!r}, out {str(out)!r})"
     session, clock = start_session(command), time.perf_counter()
+    deadline = None if time_limit is None else time.monotonic() + time_limit
     out = Path(out)
     configs = suite.student_configs(out / "teachers")
     teachers = suite.teachers()
@@ -313,6 +328,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     except BaseException:
         pool.close(abort=True)
         raise
+
     def keep_finished(kind: str, paths: list[Path]) -> None:  # each population as it finishes
         try:
             keep_all(out, kept, {kind: {p.name for p in paths}}, suite=dataclasses.asdict(suite), log=log)
@@ -322,7 +338,12 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     try:
         students = run_students(configs, out / "students", progress=progress, teachers=teachers,
                                 teacher_root=out / "teachers", log=log, device=device or "cpu", pool=pool,
-                                members=members, finished=keep_finished if kept is not None else None)
+                                members=members, finished=keep_finished if kept is not None else None,
+                                deadline=deadline)
+    except TimeLimitReached:
+        pool.close(abort=True)
+        record_session(out, session, time.perf_counter() - clock)  # it ran its time: not a kill
+        raise
     except BaseException:
         pool.close(abort=True)  # (run_students closes it too, but not if it failed before its jobs; twice is harmless)
         raise

@@ -275,3 +275,37 @@ def test_a_transfer_archives_each_population_as_it_finishes(tmp_path, monkeypatc
     assert held["runs"] == [held["first"]]
     [session] = held["sessions"]  # the session that trained it is named beside it, its time still open
     assert session["seconds"] is None and session["command"].startswith("python: craftsuite.suite_runner.transfer")
+
+
+def test_a_transfer_stopped_by_its_time_limit_keeps_what_finished_and_records_its_time(tmp_path, monkeypatch,
+                                                                                        capsys):
+    import time
+
+    import craftsuite.suite_runner as suite_runner
+    from craftsuite.cli import TIME_LIMIT_STATUS
+    from craftsuite.provenance import read
+
+    monkeypatch.setattr(suite_runner, "WorkerPool", _InProcessPool)
+    given = {}
+
+    def one_population_then_the_limit(configs, root, finished=None, deadline=None, **kwargs):
+        given["left"] = deadline - time.monotonic()
+        first = configs[0]
+        _finished_record(root, first, {"kind": "student", "steps": first.steps, "task": first.task,
+                                       "method": first.method, "seed": first.seed, "model": "model.zip"})
+        finished("students", [root / first.run_name()])
+        raise suite_runner.TimeLimitReached("time limit reached with 1 of 2 student runs still training")
+
+    monkeypatch.setattr(suite_runner, "run_students", one_population_then_the_limit)
+    monkeypatch.chdir(tmp_path)
+    status = main(["transfer", "--suite", "standard", "--worlds", "Grid10", "--tasks", "Reach", "--methods", "dqn",
+                   "--seeds", "2", "--members", "1", "--no-video", "--time-limit", "1.5", "--out", "runs"])
+    assert status == TIME_LIMIT_STATUS and 80 < given["left"] <= 90  # 1.5 minutes, from the transfer's start
+    said = capsys.readouterr().out
+    assert "time limit reached with 1 of 2 student runs still training; the finished runs are kept in results" in said
+    assert len(list((tmp_path / "results" / "standard" / "students").iterdir())) == 1
+    [session] = read(tmp_path / "results" / "standard")  # ended, not killed: it ran its time
+    assert session["seconds"] is not None
+    with pytest.raises(SystemExit):
+        main(["transfer", "--suite", "quick", "--time-limit", "0"])
+    assert "--time-limit: must be a number above 0, got 0" in capsys.readouterr().err

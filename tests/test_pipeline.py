@@ -292,7 +292,7 @@ class _StaggeredPool:
     second later (its result.json written then), as workers of unequal cells do."""
 
     def __init__(self):
-        self.timers = []
+        self.timers, self.aborted = [], False
 
     def submit(self, job, configs, root, *_):
         import threading
@@ -312,6 +312,7 @@ class _StaggeredPool:
         return future
 
     def close(self, abort=False):
+        self.aborted = self.aborted or abort
         for timer in self.timers:
             timer.cancel()
 
@@ -327,6 +328,18 @@ def test_run_students_hands_over_each_population_as_it_finishes(tmp_path):
     first, second = (c.run_name() for c in configs)
     assert handed == [("students", [first], [first]),  # handed over while the second still trained
                       ("students", [second], sorted([first, second]))]
+
+
+def test_a_deadline_stops_the_populations_still_training_and_says_how_many(tmp_path):
+    from craftsuite.suite_runner import TimeLimitReached
+
+    configs = [StudentConfig(method="dqn", world="Grid7", seed=s, steps=300) for s in (0, 1, 2)]
+    handed, pool = [], _StaggeredPool()
+    with pytest.raises(TimeLimitReached, match="time limit reached with 2 of 3 student runs still training"):
+        run_students(configs, tmp_path, pool=pool, progress=False, members=1, deadline=time.monotonic() + 0.5,
+                     finished=lambda kind, paths: handed.append([p.name for p in paths]))
+    assert handed == [[configs[0].run_name()]]  # the one that finished in time, handed over
+    assert pool.aborted and not (tmp_path / configs[1].run_name() / "result.json").exists()  # the others stopped
 
 
 @pytest.mark.slow  # starts a Ray instance

@@ -276,8 +276,8 @@ def test_the_results_page_lists_what_each_undecided_comparison_would_ask(tmp_pat
     text = write_results_page([tmp_path], tmp_path / "results.md").read_text()
     assert text.index("## Distilled against scratch") < text.index("### What the undecided would ask")
     asked = text[text.index("### What the undecided would ask"):]
-    assert asked.index("| ToolHome | Cont | one-step | `td3-dynamic` − `td3` | final greedy success | 1,000 | 5 / 5 |") \
-        < asked.index("\n## ")  # inside the comparisons' section, before the next
+    row = "| ToolHome | Cont | one-step | `td3-dynamic` − `td3` | final greedy success | 1,000 | 5 / 5 |"
+    assert asked.index(row) < asked.index("\n## ")  # inside the comparisons' section, before the next
 
 
 def test_one_suite_directory_s_leaderboard_sets_them_apart_too_unless_it_ran_at_one_budget(tmp_path, capsys):

@@ -392,7 +392,8 @@ def _transfer(args) -> int:
                           command=command_line(), device=args.device, archive=archive, members=args.members,
                           time_limit=None if args.time_limit is None else args.time_limit * 60)
     except TimeLimitReached as stopped:
-        print(f"{stopped}" + (f"; the finished runs are kept in {archive}" if archive else ""))
+        print(f"{stopped}; the finished runs are in {out}" + (f" and kept in {Path(archive) / suite.name}"
+                                                             if archive else ""))
         return TIME_LIMIT_STATUS
     print(f"leaderboard: {result.leaderboard} (and .csv)")
     for plot in result.plots:

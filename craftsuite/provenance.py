@@ -105,7 +105,7 @@ def record_session(out, session: dict, seconds: float | None) -> Path:
 def merge(out, sessions: list[dict]) -> Path:
     """Sessions into ``out/provenance.json``, each by its id: one already there is replaced
     (the last of that id), a new one appended. The record is read and rewritten under a
-    lock on ``out``, so that processes writing into one directory at once (a campaign's
+    lock (``_locked``), so that processes writing into one directory at once (a campaign's
     processes archiving into one archive) never write back a record without another's session."""
     path = Path(out) / FILE
     with _locked(out):
@@ -120,11 +120,16 @@ def merge(out, sessions: list[dict]) -> Path:
     return path
 
 
+LOCK = ".provenance.lock"  # beside the record; ignored by git
+
+
 @contextlib.contextmanager
 def _locked(directory):
-    """An exclusive advisory lock (``flock``) on the directory itself, held for the block: no
-    lock file to leave behind in an archive kept under version control."""
-    fd = os.open(directory, os.O_RDONLY)
+    """An exclusive advisory lock (``flock``) held for the block, on a lock file of its own
+    in ``directory`` (made if missing): a file opened for writing, which ``flock`` on a
+    network file system also takes (there it is a POSIX lock, which needs one)."""
+    Path(directory).mkdir(parents=True, exist_ok=True)
+    fd = os.open(Path(directory) / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
     try:
         fcntl.flock(fd, fcntl.LOCK_EX)
         yield

@@ -194,9 +194,12 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                 check_populations()
                 if deadline is not None and time.monotonic() >= deadline:
                     left = [c for c, run in runs if not (run / "result.json").exists()]
-                    raise TimeLimitReached(
-                        f"time limit reached with {len(left)} of {len(configs)} student runs still training: they "
-                        "were stopped, and resume from their newest checkpoints when the same command runs again")
+                    if left or pending:  # (all finished in the last look: not stopped, done)
+                        teaching = f" and {len(pending)} teacher{'s' * (len(pending) > 1)}" if pending else ""
+                        raise TimeLimitReached(
+                            f"time limit reached with {len(left)} of {len(configs)} student runs unfinished"
+                            f"{teaching}: those training were stopped, and each resumes from its newest checkpoint "
+                            "when the same command runs again")
             check_populations()  # those that finished after the loop's last look
             paths = {}
             for job, future in futures.values():

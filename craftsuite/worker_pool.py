@@ -129,8 +129,11 @@ class WorkerPool:
                 self._stopping.set()  # before the pids are read: a worker that reports later exits itself
             self.pool.shutdown(wait=not abort, cancel_futures=True)
             if abort:  # shutdown alone would still let each running job finish (hours, in a suite)
-                for process in self._workers():
+                workers = self._workers()
+                for process in workers:
                     process.terminate()
+                for process in workers:  # gone, their runs' locks with them, before the caller goes on
+                    process.join(timeout=30)
         elif self.started:
             self.ray.shutdown()
 

@@ -294,7 +294,7 @@ def test_a_transfer_stopped_by_its_time_limit_keeps_what_finished_and_records_it
         _finished_record(root, first, {"kind": "student", "steps": first.steps, "task": first.task,
                                        "method": first.method, "seed": first.seed, "model": "model.zip"})
         finished("students", [root / first.run_name()])
-        raise suite_runner.TimeLimitReached("time limit reached with 1 of 2 student runs still training")
+        raise suite_runner.TimeLimitReached("time limit reached with 1 of 2 student runs unfinished")
 
     monkeypatch.setattr(suite_runner, "run_students", one_population_then_the_limit)
     monkeypatch.chdir(tmp_path)
@@ -302,7 +302,8 @@ def test_a_transfer_stopped_by_its_time_limit_keeps_what_finished_and_records_it
                    "--seeds", "2", "--members", "1", "--no-video", "--time-limit", "1.5", "--out", "runs"])
     assert status == TIME_LIMIT_STATUS and 80 < given["left"] <= 90  # 1.5 minutes, from the transfer's start
     said = capsys.readouterr().out
-    assert "time limit reached with 1 of 2 student runs still training; the finished runs are kept in results" in said
+    assert ("time limit reached with 1 of 2 student runs unfinished; the finished runs are in runs and kept in "
+            "results/standard") in said
     assert len(list((tmp_path / "results" / "standard" / "students").iterdir())) == 1
     [session] = read(tmp_path / "results" / "standard")  # ended, not killed: it ran its time
     assert session["seconds"] is not None

@@ -335,11 +335,15 @@ def test_a_deadline_stops_the_populations_still_training_and_says_how_many(tmp_p
 
     configs = [StudentConfig(method="dqn", world="Grid7", seed=s, steps=300) for s in (0, 1, 2)]
     handed, pool = [], _StaggeredPool()
-    with pytest.raises(TimeLimitReached, match="time limit reached with 2 of 3 student runs still training"):
+    with pytest.raises(TimeLimitReached, match="with 2 of 3 student runs unfinished: those training were stopped"):
         run_students(configs, tmp_path, pool=pool, progress=False, members=1, deadline=time.monotonic() + 0.5,
                      finished=lambda kind, paths: handed.append([p.name for p in paths]))
     assert handed == [[configs[0].run_name()]]  # the one that finished in time, handed over
     assert pool.aborted and not (tmp_path / configs[1].run_name() / "result.json").exists()  # the others stopped
+    # a deadline that passes as the last population finishes stops nothing: the runs are done
+    [path] = run_students(configs[:1], tmp_path / "again", pool=_StaggeredPool(), progress=False,
+                          deadline=time.monotonic() - 1)
+    assert (path / "result.json").is_file()
 
 
 @pytest.mark.slow  # starts a Ray instance

@@ -173,8 +173,7 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                         raise future.exception()  # a worker's error, at once rather than at the end
                     if finished is not None and key not in reported:
                         reported.add(key)
-                        result = future.result()
-                        finished("students", [Path(p) for p in (result if isinstance(result, list) else [result])])
+                        finished("students", [Path(p) for p in _job_runs(future.result())])
 
             while pending or not all(f.done() for _, f in futures.values()):
                 time.sleep(0.5)
@@ -203,8 +202,7 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
             check_populations()  # those that finished after the loop's last look
             paths = {}
             for job, future in futures.values():
-                result = future.result()
-                for c, path in zip(job, result if isinstance(result, list) else [result]):
+                for c, path in zip(job, _job_runs(future.result())):
                     paths[c.run_name()] = path
         except BaseException:
             workers_.close(abort=True)
@@ -212,6 +210,11 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
         workers_.close()
         poll()
     return [Path(paths[c.run_name()]) for c in configs]
+
+
+def _job_runs(result) -> list:
+    """A job's run directories: a population's list, or a reused sb3 run's one path."""
+    return result if isinstance(result, list) else [result]
 
 
 def _announce(log, kind: str, runs: list[tuple[Path, int]], root) -> dict[Path, int]:

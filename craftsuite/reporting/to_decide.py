@@ -84,4 +84,3 @@ def to_decide_markdown(found: list[Ask]) -> list[str]:
             "docs/performance.md). A spread read from a handful of seeds is itself uncertain, so a figure can move "
             "a long way as seeds are added; fix the seeds of a part before reading any of them. A comparison "
             "undecided in both metrics has a row for each, of the same runs: the larger figure covers both.", ""]
-

@@ -385,10 +385,11 @@ def verdict(entry: Entry, baseline: Entry, metric: str) -> str:
 
     ``steps_to_80``, the transfer target: whether ``entry`` reaches 80% greedy success in
     at most half the transitions of ``baseline``, read on the medians over all seeds
-    (``stats.Reached.overall``), with the figures that say so: ``met (...)`` or ``not met
-    (...)``. Where the baseline's median is never within a budget at least ``entry``'s,
-    reaching 80% at all meets the target, and the text says that the baseline never got
-    there (all that is known of its time is that it exceeds its budget).
+    (``stats.Reached.overall``), with the figures that say so: ``met (...)``, ``not met
+    (...)`` or ``not known (...)``. Where the baseline's median is never within its budget,
+    all that is known of its time is that it exceeds that budget, so half of it exceeds half
+    the budget: reaching 80% within half the baseline's budget meets the target (the text
+    says the baseline never got there), reaching it later says nothing either way.
 
     A metric with an interval (``METRICS``: ``auc``, ``return``, ...): ``ahead``,
     ``behind``, ``no difference measured`` (the intervals overlap), ``neither learned``
@@ -419,14 +420,15 @@ def _transfer_target(entry: Entry, baseline: Entry) -> str:
     def text(steps: float, e: Entry) -> str:
         return f"{steps:,.0f}" if math.isfinite(steps) else f"never in {e.budget:,}"
 
-    figures = f"{text(mine, entry)} against {text(theirs, baseline)}"
+    half = f"half of it {theirs / 2:,.0f}" if math.isfinite(theirs) else f"half of it above {baseline.budget / 2:,.0f}"
+    figures = f"{text(mine, entry)} against {text(theirs, baseline)}; {half}"
     if not math.isfinite(mine):
         return f"not met ({figures})"
-    if math.isfinite(theirs) and mine <= theirs / 2:
-        return f"met ({figures})"
-    if not math.isfinite(theirs) and baseline.budget >= entry.budget:
+    if math.isfinite(theirs):
+        return f"{'met' if mine <= theirs / 2 else 'not met'} ({figures})"
+    if mine <= baseline.budget / 2:
         return f"met: scratch never got there ({figures})"
-    return f"not met ({figures})"
+    return f"not known: scratch never got there, so half its need is above half its budget by an unknown amount ({figures})"
 
 
 # the smallest difference a comparison must be able to see, in final greedy success and in

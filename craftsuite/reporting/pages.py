@@ -73,7 +73,8 @@ AGGREGATE_LEGEND = (
     "95% stratified-bootstrap intervals (each task's runs resampled on their own, 2,000 resamples), and the "
     "probability that a run of the method beats a run of {baseline} on the same task (ties count half; 0.5: no "
     "difference), averaged over tasks. With few seeds these intervals run narrow (an IQM interval over 4 tasks x "
-    "5 seeds covered 89% of simulated cases, not 95%): read an overlap as no difference.")
+    "5 seeds covered 89% of simulated cases, not 95%: docs/decisions.md): intervals that overlap show the two not "
+    "told apart, not that they are alike (that takes the interval of their difference).")
 
 
 def _fmt(estimate: stats.Estimate, digits: int = 2, signed: bool = False) -> str:
@@ -83,6 +84,18 @@ def _fmt(estimate: stats.Estimate, digits: int = 2, signed: bool = False) -> str
     if not estimate.has_interval:
         return f"{estimate.value:{sign}.{digits}f}"
     return f"{estimate.value:{sign}.{digits}f} [{estimate.low:{sign}.{digits}f}, {estimate.high:{sign}.{digits}f}]"
+
+
+def _difference_text(estimate: stats.Estimate) -> str:
+    """A difference with its interval, to as many decimals (up to 4) as keep a bound that lies
+    either side of the smallest difference from printing as it: the verdicts read the bounds
+    unrounded, so "+0.20" could stand for an interval inside the band or one reaching past it."""
+    digits = 2
+    bounds = (estimate.low, estimate.high) if estimate.has_interval else ()
+    while digits < 4 and any(abs(b) != SMALLEST_DIFFERENCE and round(abs(b), digits) == SMALLEST_DIFFERENCE
+                             for b in bounds):
+        digits += 1
+    return _fmt(estimate, digits, signed=True)
 
 
 def ranked(rows: list[Entry]) -> list[Entry]:
@@ -256,7 +269,7 @@ def _comparison_text(entry: Entry, baseline: Entry, c: Comparison | None) -> str
     """One pair of ``in_metric`` in words (None: the two ran at other budgets)."""
     if c is None:
         return f"`{entry.label}` not compared: {entry.budget:,} transitions against {baseline.budget:,}"
-    return (f"`{entry.label}` {_fmt(c.difference, signed=True)}, P(> `{baseline.label}`) {_fmt(c.improvement)}: "
+    return (f"`{entry.label}` {_difference_text(c.difference)}, P(> `{baseline.label}`) {_fmt(c.improvement)}: "
             f"**{c.verdict}**" + _notes([c.note, _looks_text(c)]))
 
 
@@ -366,7 +379,7 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
 
 def _cells(c: Comparison, entry: Entry, base: Entry) -> str:
     """A comparison's difference, probability and verdict, as three cells of a table row."""
-    return (f"{_fmt(c.difference, signed=True)} | {_fmt(c.improvement)} | "
+    return (f"{_difference_text(c.difference)} | {_fmt(c.improvement)} | "
             f"{c.verdict}" + _notes([c.note, _looks_text(c), _seeds_to_decide(c, entry, base)]))
 
 

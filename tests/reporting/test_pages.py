@@ -312,3 +312,15 @@ def test_the_scope_line_names_the_last_transfer_only_where_it_was_the_only_one()
     assert once.startswith(" As last run: rungs DungeonQuest; worlds Cont;")
     gathered = _suite_scope(suite, [transfer, archive, {"command": "python: craftsuite.suite_runner.transfer()"}])
     assert gathered == " Gathered from 2 different transfers, each listed below with its command."
+
+
+def test_a_difference_whose_bound_rounds_to_the_smallest_difference_prints_it_apart():
+    from craftsuite.reporting.pages import _difference_text
+    from craftsuite.stats import Estimate
+
+    # the verdict reads unrounded bounds: inside the band and just past it must not print alike
+    assert _difference_text(Estimate(0.10, 0.01, 0.1996)) == "+0.1000 [+0.0100, +0.1996]"
+    assert _difference_text(Estimate(0.04, -0.13, 0.2004)) == "+0.0400 [-0.1300, +0.2004]"
+    assert _difference_text(Estimate(0.04, -0.198, 0.15)) == "+0.040 [-0.198, +0.150]"
+    assert _difference_text(Estimate(0.10, 0.01, 0.17)) == "+0.10 [+0.01, +0.17]"  # far from it: two decimals
+    assert _difference_text(Estimate(-0.1, -0.2, 0.0)) == "-0.10 [-0.20, +0.00]"  # exactly on it reads as it is

@@ -428,7 +428,8 @@ def _transfer_target(entry: Entry, baseline: Entry) -> str:
         return f"{'met' if mine <= theirs / 2 else 'not met'} ({figures})"
     if mine <= baseline.budget / 2:
         return f"met: scratch never got there ({figures})"
-    return f"not known: scratch never got there, so half its need is above half its budget by an unknown amount ({figures})"
+    return (f"not known: scratch never got there, so half its need is above half its budget by an unknown amount "
+            f"({figures})")
 
 
 # the smallest difference a comparison must be able to see, in final greedy success and in

@@ -252,7 +252,8 @@ def test_each_task_says_whether_a_method_reaches_80_percent_in_half_of_scratchs_
         fake_run(never, "td3-dynamic", seed, evals["never"], [])
     line = next(row for row in leaderboard_markdown(build(never)).splitlines()
                 if row.startswith("Transfer target"))
-    assert "`td3-crm-edges` met: scratch never got there (500 against never in 1,000; half of it above 500)" in line  # never, 500, 500
+    # seeds: never, 500, 500
+    assert "`td3-crm-edges` met: scratch never got there (500 against never in 1,000; half of it above 500)" in line
     assert "`td3-dynamic` not met (never in 1,000 against never in 1,000; half of it above 500)" in line
     # reaching 80% after half the budget scratch never learned in says nothing either way
     small = tmp_path / "small"
@@ -289,7 +290,8 @@ def test_interval_verdicts_follow_the_intervals(tmp_path):
     assert verdict(*nothing, "auc") == "neither learned"
     assert verdict(*nothing, "return") == "too few seeds"  # two seeds each: no interval
     # the transfer target on the same entries: 80% at 500 against never
-    assert verdict(ahead, td3, "steps_to_80") == "met: scratch never got there (500 against never in 1,000; half of it above 500)"
+    assert verdict(ahead, td3, "steps_to_80") == ("met: scratch never got there (500 against never in 1,000; "
+                                                  "half of it above 500)")
 
 
 @pytest.mark.parametrize("name, text, problem", [

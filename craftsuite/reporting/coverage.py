@@ -18,7 +18,7 @@ class Coverage:
     """How much of a suite, as defined now, an archive holds."""
 
     suite: Suite
-    cells: dict  # (world, task) -> [runs archived, runs asked, transitions to train, methods not archived]
+    cells: dict  # (world, task) -> [runs archived, runs asked, transitions to train, {method: [archived, asked]}]
     hours: float | None  # the time still to train at the recorded rates, one population process (None: no rate)
     unknown: list[str]  # the worlds left to train that no rate covers (not in ``hours``)
     projection: str  # that time in words ("" without it)
@@ -46,13 +46,15 @@ def coverage(root: Path, suite_name: str, rates: dict[str, float] | None = None)
         return None
     cells: dict[tuple[str, str], list] = {}
     for config in suite.student_configs(Path(root) / "teachers"):
-        cell = cells.setdefault((config.world, config.task), [0, 0, 0, set()])
+        cell = cells.setdefault((config.world, config.task), [0, 0, 0, {}])
+        seeds = cell[3].setdefault(config.method, [0, 0])
         cell[1] += 1
+        seeds[1] += 1
         if (Path(root) / "students" / config.run_name() / "result.json").is_file():
             cell[0] += 1
+            seeds[0] += 1
         else:
             cell[2] += config.steps
-            cell[3].add(config.method)
     hours, unknown, projection = _projection(cells, rates or {})
     return Coverage(suite, cells, hours, unknown, projection)
 
@@ -69,11 +71,14 @@ def coverage_markdown(found: Coverage | None) -> list[str]:
              + (f" {found.projection}" if found.projection else ""), ""]
     if not left:
         return lines
-    lines += ["| world | rung | runs archived / asked | transitions to train | methods not yet archived |",
+    lines += ["| world | rung | runs archived / asked | transitions to train | methods short of seeds (archived of "
+              "asked, where some are) |",
               "|---|---|---|---|---|"]
     for (world, task), (done, total, todo, methods) in sorted(found.cells.items(),
                                                               key=lambda kv: (kv[0][0], rung_order(kv[0][1]))):
-        missing = ", ".join(f"`{m}`" for m in suite.methods if m in methods) or "none"
+        missing = ", ".join(f"`{m}`" + (f" ({done_m} of {asked_m})" if done_m else "")
+                            for m in suite.methods if m in methods
+                            for done_m, asked_m in [methods[m]] if done_m < asked_m) or "none"
         lines.append(f"| {world} | {task} | {done} / {total} | {todo / 1e6:,.1f}M | {missing} |")
     return [*lines, ""]
 

@@ -16,19 +16,20 @@ def test_archived_runs_are_counted_per_cell_and_the_rest_named(tmp_path):
     suite = SUITES["quick"]
     configs = suite.student_configs(tmp_path / "teachers")
     first = [c for c in configs if c.task == "Reach" and c.method == "td3"]
-    for config in first:
+    some = [c for c in configs if c.task == "FirstTool" and c.method == "td3"][:1]  # a method part-way
+    for config in first + some:
         _finish(tmp_path, config)
     (tmp_path / "students" / "student-Reach-Cont-td3-s9-0000000000").mkdir()  # unfinished: no result.json
     lines = coverage_markdown(coverage(tmp_path, "quick"))
-    left = sum(c.steps for c in configs) - sum(c.steps for c in first)
+    left = sum(c.steps for c in configs) - sum(c.steps for c in first + some)
     assert lines[0].startswith(f"The suite as defined now (one-step learner regime; {suite.seeds} seeds a cell) "
-                               f"asks for {len(configs)} student runs; {len(first)} of them are archived here, "
+                               f"asks for {len(configs)} student runs; {len(first) + 1} of them are archived here, "
                                f"and {left / 1e6:,.1f}M transitions are still to train.")
     reach = next(line for line in lines if "| Reach |" in line)
     assert f"| {len(first)} / {2 * suite.seeds} |" in reach and "`td3-dynamic-edges`" in reach
     assert "`td3`," not in reach
     tool = next(line for line in lines if "| FirstTool |" in line)
-    assert f"| 0 / {2 * suite.seeds} |" in tool and "`td3`, `td3-dynamic-edges`" in tool
+    assert f"| 1 / {2 * suite.seeds} |" in tool and f"`td3` (1 of {suite.seeds}), `td3-dynamic-edges` |" in tool
 
 
 def test_a_whole_suite_has_no_table_and_an_unknown_one_no_lines(tmp_path):

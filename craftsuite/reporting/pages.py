@@ -649,6 +649,7 @@ def summary_markdown(pairs, directories, facts, ladder: list[Aggregate] = (), au
         name = runs.name if names.count(runs.name) == 1 else f"{runs.name} (`{runs.path.as_posix()}`)"
         learned_parts.append(f"{name}: " + ", ".join(
             f"{r.world} {len(r.learned)} of {r.rungs}" + (f" ({', '.join(r.learned)})" if r.learned else "")
+            + (f", {len(r.absent)} not yet run ({', '.join(r.absent)})" if r.absent else "")
             for r in rows))
         left = (f" ({found.left / 1e6:,.1f}M transitions to train"
                 + (f", about {found.hours / 2:,.1f} h on 2 cores at the rates recorded" if found.hours else "")

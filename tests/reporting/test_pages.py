@@ -255,7 +255,9 @@ def test_a_suite_s_runs_at_a_budget_it_no_longer_asks_for_are_set_apart_not_pool
            "0, no difference of 0.2 or more on 0 (0 of them only because every seed of both sat at 0 or at 1), " \
            "undecided on 0." in short
     assert "### What the undecided would ask" not in text  # every comparison decided: nothing asked
-    assert ": standard: Grid10 1 of 6 (KeySwordDragon), Cont 0 of 6." in short
+    assert (": standard: Grid10 1 of 6 (KeySwordDragon), 5 not yet run (Reach, FirstWood, FirstTool, ToolHome, "
+            "TwoToolsHome), Cont 0 of 6, 6 not yet run (Reach, FirstWood, FirstTool, KeySwordDragon, ToolHome, "
+            "TwoToolsHome).") in short
     asked = len(suite.student_configs(root / "teachers"))
     assert f"- Archived of each suite as defined now: standard 0 of {asked:,} runs (" in short
     # the Grid10 runs recorded their time, no Cont run did: the projection says so

@@ -636,6 +636,7 @@ def summary_markdown(pairs, directories, facts, ladder: list[Aggregate] = (), au
     if pairs:
         auc = in_metric(pairs, "auc") if auc is None else auc
         lines.append(f"- Distilled against scratch, {COMPARED['success']}: {_verdicts_text(pairs)}.")
+        lines += _by_method_lines(pairs)
         lines.append(f"- Distilled against scratch, {COMPARED['auc']} (how soon a run learned; the same rules): "
                      f"{_verdicts_text(auc, 'auc')}.")
     lines += _distilled_across_the_ladder(ladder)
@@ -673,6 +674,22 @@ def _verdicts_text(pairs, metric: str = "success") -> str:
         f"({t['trivial']} of them only {_all_same(metric)}), undecided on "
         f"{t['comparisons'] - _decided(t)}" + _needed_range(t["seeds to decide"])
         for regime, t in decided_by_regime(pairs).items())
+
+
+def _by_method_lines(pairs) -> list[str]:
+    """The final-success tally again, per learner regime and distilled method: the paper's
+    method, the static values and the teacher's values on edges are different answers."""
+    methods = sorted({entry.method for entry, _, _ in pairs})
+    if len(methods) < 2:
+        return []
+    rows: dict[str, list[str]] = {}
+    for method in methods:
+        for regime, t in decided_by_regime([p for p in pairs if p[0].method == method]).items():
+            rows.setdefault(regime, []).append(
+                f"`{method}` {t['comparisons']}: ahead {t['ahead']}, behind {t['behind']}, no difference "
+                f"{t['no difference']} ({t['trivial']} only at all-0/all-1), undecided {t['comparisons'] - _decided(t)}")
+    return [f"  - per distilled method, `{regime}`: " + "; ".join(parts)
+            for regime, parts in sorted(rows.items(), key=lambda kv: regime_order(kv[0]))]
 
 
 def _distilled_across_the_ladder(ladder: list[Aggregate]) -> list[str]:

@@ -282,6 +282,21 @@ def test_the_results_page_lists_what_each_undecided_comparison_would_ask(tmp_pat
     assert asked.index(row) < asked.index("\n## ")  # inside the comparisons' section, before the next
 
 
+
+def test_the_short_answer_tallies_each_distilled_method_apart(tmp_path):
+    spread = [1.0, 0.0, 0.5, 0.0, 1.0, 0.5]
+    for seed in range(5):
+        fake_run(tmp_path, "td3", seed, [(1000, 0.1 * spread[seed])], [(950, 1.0)], task="ToolHome")
+        fake_run(tmp_path, "td3-dynamic", seed, [(1000, spread[seed + 1])], [(950, 1.0)], task="ToolHome")
+        fake_run(tmp_path, "td3-dynamic-edges", seed, [(1000, 0.9 + 0.01 * seed)], [(950, 1.0)], task="ToolHome")
+    text = write_results_page([tmp_path], tmp_path / "results.md").read_text()
+    short = text[text.index("## In short"):text.index("## Distilled against scratch")]
+    assert "`one-step` 2 comparisons: ahead on 1, behind on 0" in short
+    assert ("  - per distilled method, `one-step`: `td3-dynamic` 1: ahead 0, behind 0, no difference 0 (0 only at "
+            "all-0/all-1), undecided 1; `td3-dynamic-edges` 1: ahead 1, behind 0, no difference 0 (0 only at "
+            "all-0/all-1), undecided 0") in short
+
+
 def test_one_suite_directory_s_leaderboard_sets_them_apart_too_unless_it_ran_at_one_budget(tmp_path, capsys):
     from craftsuite.cli import main
 

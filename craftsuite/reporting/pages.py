@@ -687,7 +687,8 @@ def _by_method_lines(pairs) -> list[str]:
         for regime, t in decided_by_regime([p for p in pairs if p[0].method == method]).items():
             rows.setdefault(regime, []).append(
                 f"`{method}` {t['comparisons']}: ahead {t['ahead']}, behind {t['behind']}, no difference "
-                f"{t['no difference']} ({t['trivial']} only at all-0/all-1), undecided {t['comparisons'] - _decided(t)}")
+                f"{t['no difference']} ({t['trivial']} only at all-0/all-1), "
+                f"undecided {t['comparisons'] - _decided(t)}")
     return [f"  - per distilled method, `{regime}`: " + "; ".join(parts)
             for regime, parts in sorted(rows.items(), key=lambda kv: regime_order(kv[0]))]
 

@@ -362,11 +362,12 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
             f"*by less than {SMALLEST_DIFFERENCE:g}* added where the difference's interval lies within "
             f"±{SMALLEST_DIFFERENCE:g} as well); "
             f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g}. A comparison "
-            "read at fewer seeds (of either side) before they grew had more than one chance to be decided: read "
-            "k times (after the runs of each commit that added seeds to either side, as their config.json "
-            "records, two commits counted twice even where not read between; and at each reading "
-            "results/<suite>/looks.json names), every interval of it is at "
-            f"1 − {1 - stats.LEVEL:g}/k (Bonferroni), and its row says so. An undecided row says how many "
+            "read at fewer seeds (of either side) before they grew had more than one chance to be decided. Its "
+            "readings k are counted from the records: one after the runs of each commit that added seeds to "
+            "either side (as the runs' config.json records; two such commits count as two readings even where "
+            "nobody read between them), and one for each reading results/<suite>/looks.json names. Every "
+            f"interval of a comparison read k times is at 1 − {1 - stats.LEVEL:g}/k (Bonferroni), and its row "
+            "says so (\"read 3 times: every interval at 98.3%\"). An undecided row says how many "
             "seeds a side the interval rules would need to decide it at its next reading if its means and "
             "spreads held (a planning figure: a spread read from a handful of seeds is itself uncertain)."
             + _by_regime_text(pairs), "",
@@ -547,7 +548,8 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
     if compared:
         lines += ["## Distilled against scratch", "",
                   "Each distilled method against its algorithm from scratch on each rung, in final greedy success "
-                  "and in AUC (the rows come from the leaderboards below).", "", *compared]
+                  "and in AUC (the rows come from the leaderboards below; the rules a verdict follows, and what "
+                  "\"read k times\" means, come after the table).", "", *compared]
         cheapest = to_decide_markdown(asks(pairs, auc, [_every(runs.board) for runs in directories]))
         if cheapest:
             lines += ["### What the undecided would ask", "", *cheapest]

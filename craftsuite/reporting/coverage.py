@@ -22,6 +22,7 @@ class Coverage:
     hours: float | None  # the time still to train at the recorded rates, one population process (None: no rate)
     unknown: list[str]  # the worlds left to train that no rate covers (not in ``hours``)
     projection: str  # that time in words ("" without it)
+    held: int = 0  # finished student runs in the directory, of the suite's cells or not
 
     @property
     def archived(self) -> int:
@@ -56,7 +57,9 @@ def coverage(root: Path, suite_name: str, rates: dict[str, float] | None = None)
         else:
             cell[2] += config.steps
     hours, unknown, projection = _projection(cells, rates or {})
-    return Coverage(suite, cells, hours, unknown, projection)
+    students = Path(root) / "students"
+    held = sum((run / "result.json").is_file() for run in students.iterdir()) if students.is_dir() else 0
+    return Coverage(suite, cells, hours, unknown, projection, held)
 
 
 def coverage_markdown(found: Coverage | None) -> list[str]:
@@ -68,6 +71,9 @@ def coverage_markdown(found: Coverage | None) -> list[str]:
     lines = [f"The suite as defined now ({suite.regime} learner regime; {suite.seeds_text()}) asks for "
              f"{found.asked:,} student runs; {found.archived:,} of them are archived here"
              + (f", and {left / 1e6:,.1f}M transitions are still to train." if left else ", all of them.")
+             + (f" The directory holds {found.held:,} finished student runs in all: the others are seeds beyond "
+                "the suite's, other learner regimes, and budgets it no longer asks for."
+                if found.held > found.archived else "")
              + (f" {found.projection}" if found.projection else ""), ""]
     if not left:
         return lines

@@ -21,6 +21,13 @@ def test_archived_runs_are_counted_per_cell_and_the_rest_named(tmp_path):
         _finish(tmp_path, config)
     (tmp_path / "students" / "student-Reach-Cont-td3-s9-0000000000").mkdir()  # unfinished: no result.json
     lines = coverage_markdown(coverage(tmp_path, "quick"))
+    assert "in all" not in lines[0]  # every finished run is one of the suite's
+    extra = tmp_path / "students" / "student-Reach-Cont-td3-s99-0000000000"  # a seed beyond the suite's
+    extra.mkdir()
+    (extra / "result.json").write_text("{}")
+    lines = coverage_markdown(coverage(tmp_path, "quick"))
+    assert (f"The directory holds {len(first) + 2} finished student runs in all: the others are seeds beyond the "
+            "suite's") in lines[0]
     left = sum(c.steps for c in configs) - sum(c.steps for c in first + some)
     assert lines[0].startswith(f"The suite as defined now (one-step learner regime; {suite.seeds} seeds a cell) "
                                f"asks for {len(configs)} student runs; {len(first) + 1} of them are archived here, "

@@ -725,8 +725,9 @@ def superseded_markdown(board: Board | None, level: int = 3) -> list[str]:
     h = "#" * level
     lines = [f"{h} At budgets the suite no longer asks for", "",
              "Runs of the suite's learner regime at a budget other than the one it asks for now (their rung "
-             "re-calibrated since, or a candidate budget its calibration tried): kept, but not in the tables, "
-             "comparisons and counts above.", ""]
+             "re-calibrated since, or a candidate budget its calibration tried), on rungs whose cell at today's "
+             "budget has runs: kept apart from the suite's tables and comparisons above, and from its coverage; the "
+             "rungs-learned count reads them as well, naming the budget where one of them is the best.", ""]
     cells = {(e.task, e.world_label) for e in board} | {(u.task, u.world_label) for u in board.unfinished}
     for task, world in sorted(cells, key=lambda k: (rung_order(k[0]), k[1])):
         rows = ranked([e for e in board if (e.task, e.world_label) == (task, world)])

@@ -664,6 +664,12 @@ def summary_markdown(pairs, directories, facts, ladder: list[Aggregate] = (), au
                      f"{THRESHOLD:.0%}, in any learner regime or budget: each suite's table names them): "
                      + "; ".join(learned_parts) + ".")
         lines.append("- Archived of each suite as defined now: " + "; ".join(coverage_parts) + ".")
+    regimes = sorted({entry.regime for entry, _, _ in pairs}, key=regime_order)
+    if lines and regimes:
+        lines.append("- Read as: a *learner regime* is the rule every student of a table learns by (runs of two are "
+                     "never pooled): " + "; ".join(f"`{r}`, {describe(r)}" for r in regimes) + ". A world named with "
+                     "settings (`Grid10: layout_seed=1`) is the registered world with those settings; a method marked "
+                     "with a letter is one method at other settings, named under its table.")
     return ["## In short", "", *lines, ""] if lines else []
 
 
@@ -713,7 +719,8 @@ def _distilled_across_the_ladder(ladder: list[Aggregate]) -> list[str]:
     return ["- Distilled against scratch across the ladder: the probability that a distilled run's final greedy "
             "success beats a scratch run's on the same task (ties count half, so a task where both sit at 0 or at 1 "
             "pulls it toward 0.5), averaged over every task both ran, with its 95% stratified-bootstrap interval; "
-            "then the same in AUC (how soon a run learned; ties are rarer there):",
+            "then the same in AUC (how soon a run learned; ties are rarer there). Each method is read over the "
+            "tasks it ran, so two methods over different tasks are not compared with each other:",
             *rows]
 
 

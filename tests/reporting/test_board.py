@@ -493,7 +493,8 @@ def test_the_summary_says_how_many_seeds_the_undecided_comparisons_would_need(tm
     [pair] = pairs = comparisons([build(tmp_path)])
     need = pair[2].seeds_to_decide
     assert pair[2].verdict == "undecided" and need > 6
-    line, in_auc = [x for x in summary_markdown(pairs, [], {}) if x.startswith("- ")]
+    line, in_auc, terms = [x for x in summary_markdown(pairs, [], {}) if x.startswith("- ")]
+    assert terms.startswith("- Read as: a *learner regime*") and "`one-step`, one-step TD targets" in terms
     assert in_auc.startswith("- Distilled against scratch, AUC")  # one evaluation a run: AUC reads as success
     assert line.endswith(f"undecided on 1 (the interval rules would need about {need} seeds a side at the means and "
                          "spreads measured).")

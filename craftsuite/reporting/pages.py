@@ -148,7 +148,8 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
     regimes = board.regimes
     if len(regimes) > 1:  # each regime a leaderboard of its own: its runs are never pooled with another's
         aggs = aggregates(list(board)) if aggs is None else aggs
-        lines += [f"Runs of {len(regimes)} learner regimes, each apart.", ""]
+        lines += [f"Runs of {len(regimes)} learner regimes: each regime's runs have tables of their own below, "
+                  "never pooled with another's.", ""]
         for regime in regimes:
             part = leaderboard_markdown(board.of_regime(regime), title=f"{h} Learner regime `{regime}`",
                                         profiles=profiles, aggs=[a for a in aggs if a.regime == regime],
@@ -334,7 +335,7 @@ def _decided(t: dict[str, int]) -> int:
 
 def _seeds_to_decide(c: Comparison, entry: Entry, base: Entry) -> str:
     need = needed(c, entry, base)
-    return "" if need is None else f"at these means and spreads: about {need} seeds a side, against " \
+    return "" if need is None else f"at these means and spreads: about {need} seeds a side, where it has " \
         f"{seeds_now(entry, base)}"
 
 
@@ -447,7 +448,8 @@ def _against_baseline_markdown(agg: Aggregate) -> list[str]:
     if not rows:
         return []
     base = next(iter(rows.values())).baseline
-    which = "Each method that ran more tasks than the table's" if agg.iqm else "Each method"
+    which = ("Each method that ran tasks beyond the ones every method ran (the table above reads only those)"
+             if agg.iqm else "Each method")
     lines = [f"{which} against `{base}` on every task both ran: the probability that a run of the method beats a "
              f"run of `{base}` on the same task (ties count half), averaged over those tasks, with its 95% "
              "stratified-bootstrap interval (each row its own tasks: rows are not compared with each other):", "",
@@ -555,8 +557,9 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
             lines += ["### What the undecided would ask", "", *cheapest]
     if len(directories) > 1:
         if any(agg.iqm for agg in ladder):
-            lines += ["## Across the ladder", "", "Every directory below together, per world and learner regime "
-                      "(the sections below aggregate each directory alone):", "", *aggregates_markdown(ladder)]
+            lines += ["## Across the ladder", "", "The runs of all the directories below pooled, per world and "
+                      "learner regime (each directory's own section aggregates its runs alone):", "",
+                      *aggregates_markdown(ladder)]
     figures, videos = [], []  # (images directory, its figures), (video, its copy): written once all is drawn
     for runs in directories:
         suite, board, name = runs.suite, runs.board, runs.name

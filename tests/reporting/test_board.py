@@ -363,7 +363,7 @@ def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_pa
             "1 of them only") in text
     assert "| ToolHome | Cont | one-step | `td3-dynamic` − `td3` | 1,000 | -0.80 [" in text
     need = said("TwoToolsHome").seeds_to_decide
-    assert f"| undecided (at these means and spreads: about {need} seeds a side, against 5) |" in text
+    assert f"| undecided (at these means and spreads: about {need} seeds a side, where it has 5) |" in text
     assert "By learner regime" not in text  # one regime: the sentence above says it all
     # the best run: the highest final success, then the hardest rung, then the return
     run, entry, i = best_run(board)

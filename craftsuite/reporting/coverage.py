@@ -101,8 +101,8 @@ def _projection(cells: dict, rates: dict[str, float]) -> tuple[float | None, lis
     if not known:
         return None, unknown, ""
     hours = sum(known.values()) / 3600
-    words = ("At the rates its runs recorded on CPUs (one population process each, averaged over the methods and "
-             "population sizes that ran: "
+    words = ("At the rates this page's runs of its learner regime recorded on CPUs (one population process each, "
+             "averaged over the tasks, methods and population sizes that ran: "
              + ", ".join(f"{w} {rates[w]:,.0f} transitions/s" for w in sorted(known)) + f"), that is about "
              f"{hours:,.1f} h of one process, {hours / 2:,.1f} h on 2 cores with a population on each"
              + (f" ({', '.join(unknown)} not counted: no run of it recorded its whole time)" if unknown else "") + ".")

@@ -543,7 +543,10 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
     directories = [read_runs(d, suite_cells=True) for d in run_dirs]
     pairs = comparisons([runs.board for runs in directories])
     auc = in_metric(pairs, "auc")
-    facts = {runs.path: _suite_facts(runs) for runs in directories}
+    # one rate per learner regime and world, from every directory's runs: the coverage and the
+    # undecided comparisons' hours then project at the same figures
+    measured = rates(Board([e for runs in directories for e in _every(runs.board)]))
+    facts = {runs.path: _suite_facts(runs, measured) for runs in directories}
     ladder = aggregates([e for runs in directories for e in runs.board])
     lines += summary_markdown(pairs, directories, facts, ladder, auc)
     compared = comparisons_markdown(pairs, auc)
@@ -552,7 +555,7 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
                   "Each distilled method against its algorithm from scratch on each rung, in final greedy success "
                   "and in AUC (the rows come from the leaderboards below; the rules a verdict follows, and what "
                   "\"read k times\" means, come after the table).", "", *compared]
-        cheapest = to_decide_markdown(asks(pairs, auc, [_every(runs.board) for runs in directories]))
+        cheapest = to_decide_markdown(asks(pairs, auc, measured))
         if cheapest:
             lines += ["### What the undecided would ask", "", *cheapest]
     if len(directories) > 1:
@@ -613,13 +616,14 @@ def _every(board: Board) -> Board:
     return Board(board.entries + (board.apart.entries if board.apart else []))
 
 
-def _suite_facts(runs) -> tuple[list[Learned], Coverage] | None:
-    """For a directory of a suite of this version: the rungs learned and its coverage, both
-    read from every run (the suite's cells and those set apart); None for any other."""
+def _suite_facts(runs, measured: dict[str, dict[str, float]]) -> tuple[list[Learned], Coverage] | None:
+    """For a directory of a suite of this version: the rungs learned, read from every run
+    (the suite's cells and those set apart), and its coverage, projected at the ``measured``
+    rates of the suite's learner regime (``timing.rates``); None for any other."""
     if runs.name not in SUITES:
         return None
-    every = _every(runs.board)
-    return learned(every, runs.name), coverage(runs.path, runs.name, rates(every, SUITES[runs.name].regime))
+    regime = SUITES[runs.name].regime
+    return learned(_every(runs.board), runs.name), coverage(runs.path, runs.name, measured.get(regime, {}))
 
 
 def _needed_range(needs: list[int]) -> str:

@@ -86,17 +86,22 @@ def training_time_lines(board: Board) -> list[str]:
                "their last session's time only)" if partial else "")]
 
 
-def rates(board: Board, regime: str) -> dict[str, float]:
-    """Per world, the transitions per second one population process trained at on a CPU, as
-    the board's runs of ``regime`` recorded it: their transitions over their shares of the
-    wall time, from the runs whose share covers their whole training (``_timed``). An
-    average over the methods and population sizes that ran (a population of 10 runs more
-    transitions per process than one of 5)."""
-    steps: dict[str, float] = {}
-    seconds: dict[str, float] = {}
+def rates(board: Board) -> dict[str, dict[str, float]]:
+    """Per learner regime and world, the transitions per second one population process
+    trained at on a CPU, as the board's runs recorded it: their transitions over their shares
+    of the wall time, from the runs whose share covers their whole training (``_timed``). An
+    average over the tasks, methods and population sizes that ran (a population of 10 runs
+    more transitions per process than one of 5); a page reads one rate per regime and world
+    wherever it projects a time, so its figures agree."""
+    steps: dict[tuple[str, str], float] = {}
+    seconds: dict[tuple[str, str], float] = {}
     for entry, result, share, whole in _timed(board):
-        if entry.regime != regime or result.get("device") != "cpu" or not whole or share <= 0:
+        if result.get("device") != "cpu" or not whole or share <= 0:
             continue
-        steps[entry.world] = steps.get(entry.world, 0.0) + result["steps"]
-        seconds[entry.world] = seconds.get(entry.world, 0.0) + share
-    return {world: steps[world] / seconds[world] for world in steps}
+        key = entry.regime, entry.world
+        steps[key] = steps.get(key, 0.0) + result["steps"]
+        seconds[key] = seconds.get(key, 0.0) + share
+    out: dict[str, dict[str, float]] = {}
+    for (regime, world), n in steps.items():
+        out.setdefault(regime, {})[world] = n / seconds[regime, world]
+    return out

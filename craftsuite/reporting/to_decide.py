@@ -8,8 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .board import COMPARED, Board, Comparison, Entry, rung_order
-from .timing import rates
+from .board import COMPARED, Comparison, Entry, rung_order
 
 
 def seeds_now(entry: Entry, base: Entry) -> int:
@@ -42,14 +41,12 @@ class Ask:
         return sum(self.runs) * self.entry.budget
 
 
-def asks(pairs, auc, boards: list[Board]) -> list[Ask]:
+def asks(pairs, auc, measured: dict[str, dict[str, float]]) -> list[Ask]:
     """Every comparison of ``pairs`` (read in final greedy success) and ``auc`` (the same
     pairs in AUC) that is undecided with a figure to say, quickest first: by the hours at
-    the rates ``boards``' runs recorded for their world and learner regime, then (and where
-    no rate is known, after the rest) by transitions."""
-    every = Board([e for board in boards for e in board])
-    # per learner regime, per world's name (a world's variants, such as another layout, share its rate)
-    measured = {regime: rates(every, regime) for regime in {entry.regime for entry, *_ in pairs}}
+    the ``measured`` rates (``timing.rates``: per learner regime, per world's name, a world's
+    variants such as another layout sharing its rate), then (and where no rate is known,
+    after the rest) by transitions."""
     found = []
     for metric, read in (("success", pairs), ("auc", auc)):
         for entry, base, c in read:
@@ -57,7 +54,7 @@ def asks(pairs, auc, boards: list[Board]) -> list[Ask]:
             if need is None:
                 continue
             runs = (max(0, need - len(entry.seeds)), max(0, need - len(base.seeds)))
-            rate = measured[entry.regime].get(entry.world)
+            rate = measured.get(entry.regime, {}).get(entry.world)
             hours = sum(runs) * entry.budget / rate / 3600 if rate else None
             found.append(Ask(entry, base, metric, need, runs, hours))
     # the hours first: the learner regimes' and worlds' rates differ several times over

@@ -4,6 +4,7 @@ import json
 
 from craftsuite.reporting.board import build
 from craftsuite.reporting.pages import comparisons, in_metric
+from craftsuite.reporting.timing import rates
 from craftsuite.reporting.to_decide import asks, to_decide_markdown
 from .fakes import fake_run
 
@@ -34,7 +35,7 @@ def test_undecided_comparisons_are_listed_quickest_first_with_the_runs_each_side
                      task="FirstTool", world="Kinematic")
     board = build(tmp_path)
     pairs = comparisons([board])
-    found = asks(pairs, in_metric(pairs, "auc"), [board])
+    found = asks(pairs, in_metric(pairs, "auc"), rates(board))
     success = {a.entry.world: a for a in found if a.metric == "success"}
     assert [a.entry.world for a in found if a.metric == "success"] == ["Grid10", "Cont", "Kinematic"]
     grid, cont, kinematic = success["Grid10"], success["Cont"], success["Kinematic"]
@@ -56,4 +57,4 @@ def test_nothing_is_listed_where_every_comparison_is_decided(tmp_path):
         fake_run(tmp_path, "td3-dynamic", seed, [(1000, 1.0)], [(950, 1.0)], task="ToolHome")
     board = build(tmp_path)
     pairs = comparisons([board])
-    assert asks(pairs, in_metric(pairs, "auc"), [board]) == [] and to_decide_markdown([]) == []
+    assert asks(pairs, in_metric(pairs, "auc"), rates(board)) == [] and to_decide_markdown([]) == []

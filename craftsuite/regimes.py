@@ -30,7 +30,8 @@ class Regime:
 
 
 REGIMES = {r.name: r for r in (
-    Regime("one-step", "one-step TD targets (the suites' regime until the learner-regime experiment)"),
+    Regime("one-step", "one-step TD targets (the quick, transfer and paper suites' regime; the standard and "
+           "hard suites' until the learner-regime experiment)"),
     # experiments/learner-regime, wave 1: n = 3 beat one-step for TD3 in MuJoCo (IQM of AUC
     # from scratch 0.46 against 0.15) and for DQN on Grid10 (0.88 against 0.65); n = 5 did
     # not beat n = 3 for TD3

@@ -389,7 +389,7 @@ def verdict(entry: Entry, baseline: Entry, metric: str) -> str:
     (...)`` or ``not known (...)``. Where the baseline's median is never within its budget,
     all that is known of its time is that it exceeds that budget, so half of it exceeds half
     the budget: reaching 80% within half the baseline's budget meets the target (the text
-    says the baseline never got there), reaching it later says nothing either way.
+    says the baseline never got there), reaching it later, or never, says nothing either way.
 
     A metric with an interval (``METRICS``: ``auc``, ``return``, ...): ``ahead``,
     ``behind``, ``no difference measured`` (the intervals overlap), ``neither learned``
@@ -423,13 +423,15 @@ def _transfer_target(entry: Entry, baseline: Entry) -> str:
     half = f"half of it {theirs / 2:,.0f}" if math.isfinite(theirs) else f"half of it above {baseline.budget / 2:,.0f}"
     figures = f"{text(mine, entry)} against {text(theirs, baseline)}; {half}"
     if not math.isfinite(mine):
-        return f"not met ({figures})"
+        # never within its budget: short of the target only where scratch's half lay within it
+        if math.isfinite(theirs) and entry.budget >= theirs / 2:
+            return f"not met ({figures})"
+        return f"not known: neither got there within its budget ({figures})"
     if math.isfinite(theirs):
         return f"{'met' if mine <= theirs / 2 else 'not met'} ({figures})"
     if mine <= baseline.budget / 2:
         return f"met: scratch never got there ({figures})"
-    return (f"not known: scratch never got there, so half its need is above half its budget by an unknown amount "
-            f"({figures})")
+    return f"not known: scratch never got there in its budget, and this took more than half of it ({figures})"
 
 
 # the smallest difference a comparison must be able to see, in final greedy success and in

@@ -40,8 +40,9 @@ class Coverage:
 def coverage(root: Path, suite_name: str, rates: dict[str, float] | None = None) -> Coverage | None:
     """The archive directory ``root`` of the suite ``suite_name`` against the suite's runs;
     None for a name that is not a suite of this version (an archive of a removed or renamed
-    one). ``rates``: per world, the transitions per second of one population process
-    (``timing.rates``), from which the time still to train is projected."""
+    one). ``rates``: per world, the transitions per second of one population process (the
+    suite's learner regime's entry of ``timing.rates``), from which the time still to train
+    is projected."""
     suite = SUITES.get(suite_name)
     if suite is None:
         return None
@@ -71,14 +72,14 @@ def coverage_markdown(found: Coverage | None) -> list[str]:
     lines = [f"The suite as defined now ({suite.regime} learner regime; {suite.seeds_text()}) asks for "
              f"{found.asked:,} student runs; {found.archived:,} of them are archived here"
              + (f", and {left / 1e6:,.1f}M transitions are still to train." if left else ", all of them.")
-             + (f" The directory holds {found.held:,} finished student runs in all: the others are seeds beyond "
-                "the suite's, other learner regimes, and budgets it no longer asks for."
+             + (f" The directory holds {found.held:,} finished student runs in all: the others are runs the suite "
+                "does not ask for now (other seeds, learner regimes, budgets or settings)."
                 if found.held > found.archived else "")
              + (f" {found.projection}" if found.projection else ""), ""]
     if not left:
         return lines
     lines += ["| world | rung | runs archived / asked | transitions to train | methods short of seeds (archived of "
-              "asked, where some are) |",
+              "asked, where any are) |",
               "|---|---|---|---|---|"]
     for (world, task), (done, total, todo, methods) in sorted(found.cells.items(),
                                                               key=lambda kv: (kv[0][0], rung_order(kv[0][1]))):
@@ -90,7 +91,7 @@ def coverage_markdown(found: Coverage | None) -> list[str]:
 
 
 def _projection(cells: dict, rates: dict[str, float]) -> tuple[float | None, list[str], str]:
-    """The time still to train at the rates the archived runs recorded: in hours of one
+    """The time still to train at the rates the page's runs of the suite's regime recorded: in hours of one
     population process, the worlds left to train that no rate covers, and in words (None
     and "" where no world left to train has a rate)."""
     left: dict[str, float] = {}

@@ -73,8 +73,9 @@ AGGREGATE_LEGEND = (
     "95% stratified-bootstrap intervals (each task's runs resampled on their own, 2,000 resamples), and the "
     "probability that a run of the method beats a run of {baseline} on the same task (ties count half; 0.5: no "
     "difference), averaged over tasks. With few seeds these intervals run narrow (an IQM interval over 4 tasks x "
-    "5 seeds covered 89% of simulated cases, not 95%: docs/decisions.md): intervals that overlap show the two not "
-    "told apart, not that they are alike (that takes the interval of their difference).")
+    "5 seeds covered 89% of simulated cases, not 95%; docs/decisions.md), so two intervals apart are weaker "
+    "evidence than they look; and two that overlap show the methods not told apart, not that they are alike "
+    "(that takes the interval of their difference).")
 
 
 def _fmt(estimate: stats.Estimate, digits: int = 2, signed: bool = False) -> str:
@@ -335,8 +336,8 @@ def _decided(t: dict[str, int]) -> int:
 
 def _seeds_to_decide(c: Comparison, entry: Entry, base: Entry) -> str:
     need = needed(c, entry, base)
-    return "" if need is None else f"at these means and spreads: about {need} seeds a side, where it has " \
-        f"{seeds_now(entry, base)}"
+    return "" if need is None else (f"at these means and spreads: about {need} seeds a side, where the smaller side "
+                                    f"has {seeds_now(entry, base)}")
 
 
 def comparisons_markdown(pairs, auc=None) -> list[str]:
@@ -448,7 +449,8 @@ def _against_baseline_markdown(agg: Aggregate) -> list[str]:
     if not rows:
         return []
     base = next(iter(rows.values())).baseline
-    which = ("Each method that ran tasks beyond the ones every method ran (the table above reads only those)"
+    which = ("Each method that ran tasks beyond those every method ran (the table above reads only the tasks "
+             "every method ran)"
              if agg.iqm else "Each method")
     lines = [f"{which} against `{base}` on every task both ran: the probability that a run of the method beats a "
              f"run of `{base}` on the same task (ties count half), averaged over those tasks, with its 95% "
@@ -657,10 +659,8 @@ def summary_markdown(pairs, directories, facts, ladder: list[Aggregate] = (), au
         rows, found = facts[runs.path]
         # two directories of one suite: each named by its path
         name = runs.name if names.count(runs.name) == 1 else f"{runs.name} (`{runs.path.as_posix()}`)"
-        learned_parts.append(f"{name}: " + ", ".join(
-            f"{r.world} {len(r.learned)} of {r.rungs}" + (f" ({', '.join(r.learned)})" if r.learned else "")
-            + (f", {len(r.absent)} not yet run ({', '.join(r.absent)})" if r.absent else "")
-            for r in rows))
+        learned_parts.append(f"{name}: " + ", ".join(f"{r.world} {len(r.learned)} of {r.rungs}" + _rungs_named(r)
+                                                    for r in rows))
         left = (f" ({found.left / 1e6:,.1f}M transitions to train"
                 + (f", about {found.hours / 2:,.1f} h on 2 cores at the rates recorded" if found.hours else "")
                 + (f"; {', '.join(found.unknown)} not counted: no rate recorded" if found.hours and found.unknown
@@ -672,12 +672,18 @@ def summary_markdown(pairs, directories, facts, ladder: list[Aggregate] = (), au
                      + "; ".join(learned_parts) + ".")
         lines.append("- Archived of each suite as defined now: " + "; ".join(coverage_parts) + ".")
     regimes = sorted({entry.regime for entry, _, _ in pairs}, key=regime_order)
-    if lines and regimes:
-        lines.append("- Read as: a *learner regime* is the rule every student of a table learns by (runs of two are "
-                     "never pooled): " + "; ".join(f"`{r}`, {describe(r)}" for r in regimes) + ". A world named with "
-                     "settings (`Grid10: layout_seed=1`) is the registered world with those settings; a method marked "
-                     "with a letter is one method at other settings, named under its table.")
+    if lines and regimes:  # first: the terms the lines after it use
+        lines.insert(0, "- Read as: a *learner regime* is the rule every student of a table learns by (runs of two "
+                     "regimes are never pooled): " + "; ".join(f"`{r}`, {describe(r)}" for r in regimes)
+                     + ". A world named with settings (`Grid10: layout_seed=1`) is the registered world with those "
+                     "settings; a method marked with a letter is one method at other settings, named under its table.")
     return ["## In short", "", *lines, ""] if lines else []
+
+
+def _rungs_named(row: Learned) -> str:
+    """The rungs a world learned and those not yet run, in one parenthesis ("" where neither)."""
+    named = [", ".join(row.learned)] * bool(row.learned) + [f"not yet run: {', '.join(row.absent)}"] * bool(row.absent)
+    return f" ({'; '.join(named)})" if named else ""
 
 
 def _verdicts_text(pairs, metric: str = "success") -> str:
@@ -701,7 +707,8 @@ def _by_method_lines(pairs) -> list[str]:
     for method in methods:
         for regime, t in decided_by_regime([p for p in pairs if p[0].method == method]).items():
             rows.setdefault(regime, []).append(
-                f"`{method}` {t['comparisons']}: ahead {t['ahead']}, behind {t['behind']}, no difference "
+                f"`{method}` ({t['comparisons']} comparison{'s' if t['comparisons'] > 1 else ''}): ahead "
+                f"{t['ahead']}, behind {t['behind']}, no difference "
                 f"{t['no difference']} ({t['trivial']} only at all-0/all-1), "
                 f"undecided {t['comparisons'] - _decided(t)}")
     return [f"  - per distilled method, `{regime}`: " + "; ".join(parts)

@@ -76,8 +76,8 @@ def to_decide_markdown(found: list[Ask]) -> list[str]:
             "|---|---|---|---|---|---|---|---|---|---|---|", *rows, "",
             "Each undecided comparison with the seeds a side its next reading would need if its means and spreads "
             "held (the planning figure of the table above), quickest first: the runs that adds to each side, their "
-            "transitions, and their hours in one population process at the rate this archive's runs of that world "
-            "and learner regime recorded on a CPU (two processes on two cores each run at most of that rate: "
+            "transitions, and their hours in one population process at the rate this page's runs of that world "
+            "and learner regime recorded on a CPU (two processes on two cores each run somewhat below that rate: "
             "docs/performance.md). A spread read from a handful of seeds is itself uncertain, so a figure can move "
             "a long way as seeds are added; fix the seeds of a part before reading any of them. A comparison "
             "undecided in both metrics has a row for each, of the same runs: the larger figure covers both.", ""]

@@ -255,8 +255,8 @@ def test_a_suite_s_runs_at_a_budget_it_no_longer_asks_for_are_set_apart_not_pool
            "0, no difference of 0.2 or more on 0 (0 of them only because every seed of both sat at 0 or at 1), " \
            "undecided on 0." in short
     assert "### What the undecided would ask" not in text  # every comparison decided: nothing asked
-    assert (": standard: Grid10 1 of 6 (KeySwordDragon), 5 not yet run (Reach, FirstWood, FirstTool, ToolHome, "
-            "TwoToolsHome), Cont 0 of 6, 6 not yet run (Reach, FirstWood, FirstTool, KeySwordDragon, ToolHome, "
+    assert (": standard: Grid10 1 of 6 (KeySwordDragon; not yet run: Reach, FirstWood, FirstTool, ToolHome, "
+            "TwoToolsHome), Cont 0 of 6 (not yet run: Reach, FirstWood, FirstTool, KeySwordDragon, ToolHome, "
             "TwoToolsHome).") in short
     asked = len(suite.student_configs(root / "teachers"))
     assert f"- Archived of each suite as defined now: standard 0 of {asked:,} runs (" in short
@@ -292,9 +292,9 @@ def test_the_short_answer_tallies_each_distilled_method_apart(tmp_path):
     text = write_results_page([tmp_path], tmp_path / "results.md").read_text()
     short = text[text.index("## In short"):text.index("## Distilled against scratch")]
     assert "`one-step` 2 comparisons: ahead on 1, behind on 0" in short
-    assert ("  - per distilled method, `one-step`: `td3-dynamic` 1: ahead 0, behind 0, no difference 0 (0 only at "
-            "all-0/all-1), undecided 1; `td3-dynamic-edges` 1: ahead 1, behind 0, no difference 0 (0 only at "
-            "all-0/all-1), undecided 0") in short
+    assert ("  - per distilled method, `one-step`: `td3-dynamic` (1 comparison): ahead 0, behind 0, no difference 0 "
+            "(0 only at all-0/all-1), undecided 1; `td3-dynamic-edges` (1 comparison): ahead 1, behind 0, no "
+            "difference 0 (0 only at all-0/all-1), undecided 0") in short
 
 
 def test_one_suite_directory_s_leaderboard_sets_them_apart_too_unless_it_ran_at_one_budget(tmp_path, capsys):
@@ -341,3 +341,22 @@ def test_a_difference_whose_bound_rounds_to_the_smallest_difference_prints_it_ap
     assert _difference_text(Estimate(0.04, -0.198, 0.15)) == "+0.040 [-0.198, +0.150]"
     assert _difference_text(Estimate(0.10, 0.01, 0.17)) == "+0.10 [+0.01, +0.17]"  # far from it: two decimals
     assert _difference_text(Estimate(-0.1, -0.2, 0.0)) == "-0.10 [-0.20, +0.00]"  # exactly on it reads as it is
+
+
+def test_a_page_of_two_directories_projects_at_one_rate_per_regime_and_world(tmp_path):
+    """Each directory's coverage reads the rate of every directory's runs, not its own: the
+    page's projections then agree with each other and with its planning table."""
+    first, second = tmp_path / "a" / "standard", tmp_path / "b" / "standard"
+    _rebudgeted(first)
+    _rebudgeted(second)
+    steps = seconds = 0.0
+    for root, share in ((first, 10.0), (second, 30.0)):
+        for run in (root / "students").iterdir():
+            result = json.loads((run / "result.json").read_text())
+            (run / "result.json").write_text(json.dumps({**result, "seconds_share": share}))
+            steps, seconds = steps + result["steps"], seconds + share
+    text = write_results_page([first, second], tmp_path / "results.md").read_text()
+    pooled = f"Grid10 {steps / seconds:,.0f} transitions/s"
+    assert text.count(pooled) == 2  # the two directories' coverage sentences, at the pooled rate
+    alone = f"Grid10 {steps / 2 / (seconds * 0.25):,.0f} transitions/s"  # the first directory's own rate
+    assert alone not in text

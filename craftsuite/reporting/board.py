@@ -40,6 +40,7 @@ import numpy as np
 
 from .. import stats
 from ..completion import needs_reread
+from ..progress import progress_bar
 from ..record_format import RecordError, check_config, check_episodes, check_evals, check_result
 from ..runs import RunError, flatten, read_config, read_log, read_result, run_settings
 
@@ -47,6 +48,9 @@ from ..runs import RunError, flatten, read_config, read_log, read_result, run_se
 METRICS = {"success": (0.0, 1.0), "return": (-math.inf, math.inf), "train_success": (0.0, 1.0),
            "auc": (0.0, 1.0)}
 THRESHOLD = 0.8  # greedy success at which a run counts as having learned the task
+# boards of this many runs or more say how far their reading is (an archive of thousands of
+# runs reads for a minute or more; a transfer's own few runs in a second)
+PROGRESS_FROM = 200
 AGGREGATED = ("success", "auc")  # the metrics aggregated across tasks (rates: comparable across tasks)
 
 
@@ -292,7 +296,10 @@ def build(students_root, *more, apart=None) -> Board:
             if (run / "result.json").exists() and not (held / "result.json").exists():
                 found[run.name], run, held = run, held, run
             board.unreadable.append(f"{run}: the same run as {held}, counted once")
+    bar = progress_bar(len(found), f"reading {students_root}", unit="run",
+                       enabled=len(found) >= PROGRESS_FROM)
     for run in found.values():
+        bar.update()
         if not (run / "config.json").exists():
             if (run / "result.json").exists():  # a result of no known run
                 board.unreadable.append(f"{run / 'config.json'} is missing beside its result.json: "
@@ -319,6 +326,7 @@ def build(students_root, *more, apart=None) -> Board:
         key = (m["task"], world_label(m["world"], m["world_kwargs"]), m["method"], m["regime"],
                json.dumps(setting, sort_keys=True))
         (set_apart if away else groups).setdefault(key, []).append(({**m, "run": run}, setting))
+    bar.close()
     board.entries = _entries(groups)
     if apart is not None:
         elsewhere.entries = _entries(set_apart)

@@ -547,3 +547,16 @@ def test_a_baseline_in_two_directories_drops_its_task_and_names_no_other_method(
     [agg] = aggregates([*build(a), *build(b)])
     assert agg.baseline == "td3" and agg.tasks == ["BlindCraftsman"] and set(agg.improvement) == {"td3-dynamic"}
     assert agg.left_out == ["task Reach: the baseline td3 there has runs in more than one directory"]
+
+
+def test_a_board_of_many_runs_says_how_far_its_reading_is(tmp_path, monkeypatch, capsys):
+    from craftsuite.reporting import board as board_module
+
+    for seed in range(3):
+        fake_run(tmp_path, "td3", seed, [(1000, 0.5)], [(950, 1.0)])
+    build(tmp_path)
+    assert "reading" not in capsys.readouterr().err  # a few runs: read at once, nothing said
+    monkeypatch.setattr(board_module, "PROGRESS_FROM", 3)
+    build(tmp_path)
+    err = capsys.readouterr().err
+    assert f"reading {tmp_path}" in err and "3/3" in err

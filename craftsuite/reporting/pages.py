@@ -557,7 +557,8 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
                   "Each distilled method against its algorithm from scratch on each rung, in final greedy success "
                   "and in AUC (the rows come from the leaderboards below; the rules a verdict follows, and what "
                   "\"read k times\" means, come after the table).", "", *compared]
-        cheapest = to_decide_markdown(asks(pairs, auc, measured))
+        current = frozenset(SUITES[runs.name].regime for runs in directories if runs.name in SUITES)
+        cheapest = to_decide_markdown(asks(pairs, auc, measured, current), current)
         if cheapest:
             lines += ["### What the undecided would ask", "", *cheapest]
     if len(directories) > 1:

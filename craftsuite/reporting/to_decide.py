@@ -41,12 +41,13 @@ class Ask:
         return sum(self.runs) * self.entry.budget
 
 
-def asks(pairs, auc, measured: dict[str, dict[str, float]]) -> list[Ask]:
+def asks(pairs, auc, measured: dict[str, dict[str, float]], current: frozenset[str] = frozenset()) -> list[Ask]:
     """Every comparison of ``pairs`` (read in final greedy success) and ``auc`` (the same
-    pairs in AUC) that is undecided with a figure to say, quickest first: by the hours at
-    the ``measured`` rates (``timing.rates``: per learner regime, per world's name, a world's
-    variants such as another layout sharing its rate), then (and where no rate is known,
-    after the rest) by transitions."""
+    pairs in AUC) that is undecided with a figure to say: those of the ``current`` learner
+    regimes (the ones the page's suites run now, which a campaign adds seeds to) first, then
+    quickest first: by the hours at the ``measured`` rates (``timing.rates``: per learner
+    regime, per world's name, a world's variants such as another layout sharing its rate),
+    then (and where no rate is known, after the rest) by transitions."""
     found = []
     for metric, read in (("success", pairs), ("auc", auc)):
         for entry, base, c in read:
@@ -58,14 +59,19 @@ def asks(pairs, auc, measured: dict[str, dict[str, float]]) -> list[Ask]:
             hours = sum(runs) * entry.budget / rate / 3600 if rate else None
             found.append(Ask(entry, base, metric, need, runs, hours))
     # the hours first: the learner regimes' and worlds' rates differ several times over
-    return sorted(found, key=lambda a: (a.hours is None, a.hours or 0.0, a.transitions, rung_order(a.entry.task),
-                                        a.entry.world_label, a.metric))
+    return sorted(found, key=lambda a: (a.entry.regime not in current, a.hours is None, a.hours or 0.0,
+                                        a.transitions, rung_order(a.entry.task), a.entry.world_label, a.metric))
 
 
-def to_decide_markdown(found: list[Ask]) -> list[str]:
-    """``asks`` as a table with a line on how to read it (nothing where none is undecided)."""
+def to_decide_markdown(found: list[Ask], current: frozenset[str] = frozenset()) -> list[str]:
+    """``asks`` as a table with a line on how to read it (nothing where none is undecided);
+    ``current``: the learner regimes ``asks`` listed first."""
     if not found:
         return []
+    order = "quickest first"
+    if current:
+        names = ", ".join(f"`{r}`" for r in sorted(current))
+        order = f"those of the learner regime the suites run now ({names}) first, each group quickest first"
     rows = [f"| {a.entry.task} | {a.entry.world_label} | {a.entry.regime} | `{a.entry.label}` − `{a.base.label}` "
             f"| {COMPARED[a.metric]} | {a.entry.budget:,} | {len(a.entry.seeds)} / {len(a.base.seeds)} | {a.seeds} "
             f"| {a.runs[0]} + {a.runs[1]} | {a.transitions:,} "
@@ -75,7 +81,7 @@ def to_decide_markdown(found: list[Ask]) -> list[str]:
             "| transitions to add | hours of one process |",
             "|---|---|---|---|---|---|---|---|---|---|---|", *rows, "",
             "Each undecided comparison with the seeds a side its next reading would need if its means and spreads "
-            "held (the planning figure of the table above), quickest first: the runs that adds to each side, their "
+            "held (the planning figure of the table above), " + order + ": the runs that adds to each side, their "
             "transitions, and their hours in one population process at the rate this page's runs of that world "
             "and learner regime recorded on a CPU (two processes on two cores each run somewhat below that rate: "
             "docs/performance.md). A spread read from a handful of seeds is itself uncertain, so a figure can move "

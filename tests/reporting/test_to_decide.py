@@ -58,3 +58,24 @@ def test_nothing_is_listed_where_every_comparison_is_decided(tmp_path):
     board = build(tmp_path)
     pairs = comparisons([board])
     assert asks(pairs, in_metric(pairs, "auc"), rates(board)) == [] and to_decide_markdown([]) == []
+
+
+def test_the_comparisons_of_the_regime_the_suites_run_now_come_first(tmp_path):
+    from craftsuite.regimes import check_regime
+
+    wide = check_regime("n-step-wide").settings("td3")
+    for seed in range(5):
+        for method, shift in (("td3", 0), ("td3-dynamic", 1)):
+            # one-step: quick (1,000 transitions a second); n-step-wide: slow (1 a second)
+            _timed(fake_run(tmp_path, method, seed, [(1000, SPREAD[seed + shift])], [(950, 1.0)], task="ToolHome"),
+                   1.0)
+            _timed(fake_run(tmp_path, method, seed, [(1000, SPREAD[seed + shift])], [(950, 1.0)], task="ToolHome",
+                            hyperparameters=wide), 1000.0)
+    board = build(tmp_path)
+    pairs = comparisons([board])
+    auc, measured = in_metric(pairs, "auc"), rates(board)
+    assert [a.entry.regime for a in asks(pairs, auc, measured)][:2] == ["one-step"] * 2  # quickest first
+    now = asks(pairs, auc, measured, frozenset({"n-step-wide"}))
+    assert [a.entry.regime for a in now] == ["n-step-wide"] * 2 + ["one-step"] * 2
+    assert ("those of the learner regime the suites run now (`n-step-wide`) first, each group quickest first"
+            in "\n".join(to_decide_markdown(now, frozenset({"n-step-wide"}))))

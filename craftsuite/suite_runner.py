@@ -325,8 +325,9 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         names = {"teachers": {t.run_name() for t in teachers.values()}, "students": {c.run_name() for c in configs}}
         if kept is not None:
             restored = restore(kept, out, names, log=log)
+            # counts what it copied: runs --out holds finished already are reused from there, said next
             log(f"results archive {kept}: {restored['students']} of {len(configs)} student runs and "
-                f"{restored['teachers']} of {len(teachers)} teachers are there already (not trained again)")
+                f"{restored['teachers']} of {len(teachers)} teachers copied from it (not trained again)")
         for run in _counting_acceptance([out / "students" / name for name in sorted(names["students"])]):
             reread_in_place(run)  # (restored ones too)
             log(f"re-read {run.name}: its success counted the automaton's acceptance; now completion")

@@ -233,7 +233,7 @@ def test_a_transfer_on_the_sb3_engine_reuses_the_finished_runs_its_archive_holds
     said = []
     result = suite_runner.transfer(suite, tmp_path / "out", video=False, progress=False, log=said.append,
                                    archive=tmp_path / "results")
-    assert f"results archive {store}: 2 of 2 student runs and 1 of 1 teachers are there already (not trained again)" \
+    assert f"results archive {store}: 2 of 2 student runs and 1 of 1 teachers copied from it (not trained again)" \
         in said
     assert pools[0].jobs == ["_teacher_job"]  # the teacher's reuse goes through the pool; nothing trains
     assert sorted(p.name for p in result.students) == sorted(c.run_name() for c in students)

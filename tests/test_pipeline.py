@@ -444,7 +444,7 @@ def test_a_suite_accumulates_in_the_archive_and_nothing_trains_twice(tmp_path):
     said.clear()
     second = transfer(tiny, tmp_path / "elsewhere", workers=2, video=True, progress=False, log=said.append,
                       archive=tmp_path / "results")
-    assert "4 of 4 student runs and 1 of 1 teachers are there already" in " ".join(said)
+    assert "4 of 4 student runs and 1 of 1 teachers copied from it" in " ".join(said)
     assert all(not (p / "model.zip").exists() for p in second.students)
     assert second.video is None and any(s.startswith("no video: the best student") for s in said)
     assert [json.loads((p / "result.json").read_text()) for p in second.students] == \

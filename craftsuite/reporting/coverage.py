@@ -18,7 +18,7 @@ class Coverage:
     """How much of a suite, as defined now, an archive holds."""
 
     suite: Suite
-    cells: dict  # (world, task) -> [runs archived, runs asked, transitions to train, {method: [archived, asked]}]
+    cells: dict  # (world, task) -> [transitions to train, {method: [runs archived, runs asked]}]
     hours: float | None  # the time still to train at the recorded rates, one population process (None: no rate)
     unknown: list[str]  # the worlds left to train that no rate covers (not in ``hours``)
     projection: str  # that time in words ("" without it)
@@ -26,15 +26,15 @@ class Coverage:
 
     @property
     def archived(self) -> int:
-        return sum(c[0] for c in self.cells.values())
+        return sum(done for _, methods in self.cells.values() for done, _ in methods.values())
 
     @property
     def asked(self) -> int:
-        return sum(c[1] for c in self.cells.values())
+        return sum(total for _, methods in self.cells.values() for _, total in methods.values())
 
     @property
     def left(self) -> int:
-        return sum(c[2] for c in self.cells.values())
+        return sum(todo for todo, _ in self.cells.values())
 
 
 def coverage(root: Path, suite_name: str, rates: dict[str, float] | None = None) -> Coverage | None:
@@ -48,15 +48,13 @@ def coverage(root: Path, suite_name: str, rates: dict[str, float] | None = None)
         return None
     cells: dict[tuple[str, str], list] = {}
     for config in suite.student_configs(Path(root) / "teachers"):
-        cell = cells.setdefault((config.world, config.task), [0, 0, 0, {}])
-        seeds = cell[3].setdefault(config.method, [0, 0])
-        cell[1] += 1
+        cell = cells.setdefault((config.world, config.task), [0, {}])
+        seeds = cell[1].setdefault(config.method, [0, 0])
         seeds[1] += 1
         if (Path(root) / "students" / config.run_name() / "result.json").is_file():
-            cell[0] += 1
             seeds[0] += 1
         else:
-            cell[2] += config.steps
+            cell[0] += config.steps
     hours, unknown, projection = _projection(cells, rates or {})
     students = Path(root) / "students"
     held = sum((run / "result.json").is_file() for run in students.iterdir()) if students.is_dir() else 0
@@ -81,11 +79,10 @@ def coverage_markdown(found: Coverage | None) -> list[str]:
     lines += ["| world | rung | runs archived / asked | transitions to train | methods short of seeds (archived of "
               "asked, where any are) |",
               "|---|---|---|---|---|"]
-    for (world, task), (done, total, todo, methods) in sorted(found.cells.items(),
-                                                              key=lambda kv: (kv[0][0], rung_order(kv[0][1]))):
-        missing = ", ".join(f"`{m}`" + (f" ({done_m} of {asked_m})" if done_m else "")
-                            for m in suite.methods if m in methods
-                            for done_m, asked_m in [methods[m]] if done_m < asked_m) or "none"
+    for (world, task), (todo, methods) in sorted(found.cells.items(), key=lambda kv: (kv[0][0], rung_order(kv[0][1]))):
+        done, total = (sum(seeds) for seeds in zip(*methods.values()))
+        missing = ", ".join(f"`{m}`" + (f" ({methods[m][0]} of {methods[m][1]})" if methods[m][0] else "")
+                            for m in suite.methods if m in methods and methods[m][0] < methods[m][1]) or "none"
         lines.append(f"| {world} | {task} | {done} / {total} | {todo / 1e6:,.1f}M | {missing} |")
     return [*lines, ""]
 
@@ -95,7 +92,7 @@ def _projection(cells: dict, rates: dict[str, float]) -> tuple[float | None, lis
     population process, the worlds left to train that no rate covers, and in words (None
     and "" where no world left to train has a rate)."""
     left: dict[str, float] = {}
-    for (world, _), (_, _, todo, _) in cells.items():
+    for (world, _), (todo, _) in cells.items():
         left[world] = left.get(world, 0.0) + todo
     known = {w: t / rates[w] for w, t in left.items() if t and rates.get(w)}
     unknown = sorted(w for w, t in left.items() if t and not rates.get(w))

@@ -2,7 +2,9 @@
 
 Local workers are spawned processes (one torch thread each: they share the cores). Each
 exits soon after the process that started it is gone, and ``close(abort=True)`` stops the
-running ones at once; every run resumes from its last checkpoint when asked for again.
+running ones at once (on Ray, it cancels the tasks submitted, which a cluster joined at an
+address would otherwise train to the end); every run resumes from its last checkpoint when
+asked for again.
 """
 
 from __future__ import annotations
@@ -105,6 +107,7 @@ class WorkerPool:
         if ray is not None:
             self.ray, self.started = connect_ray(ray)
             self._rows = external_rows()
+            self._refs = []  # the tasks submitted: what an abort cancels on a cluster that outlives this process
         else:
             context = mp.get_context("spawn")
             # the workers' pids, as each reports them: what an abort stops
@@ -118,7 +121,9 @@ class WorkerPool:
         if self.ray is not None:
             if self._task is None:
                 self._task = self.ray.remote(num_cpus=1)(_run_with_rows)
-            return self._task.remote(self._rows, job, *args).future()
+            ref = self._task.remote(self._rows, job, *args)
+            self._refs.append(ref)
+            return ref.future()
         return self.pool.submit(job, *args)
 
     def close(self, abort: bool = False) -> None:
@@ -134,8 +139,12 @@ class WorkerPool:
                     process.terminate()
                 for process in workers:  # gone, their runs' locks with them, before the caller goes on
                     process.join(timeout=30)
-        elif self.started:
-            self.ray.shutdown()
+        else:
+            if abort:  # a cluster this process joined trains on after it: its tasks are stopped by name
+                for ref in self._refs:
+                    self.ray.cancel(ref, force=True)  # a finished task's is nothing; a running one's worker is killed
+            if self.started:
+                self.ray.shutdown()
 
     def _workers(self) -> list[mp.process.BaseProcess]:
         """The live local workers: this process's children whose pids the workers reported."""

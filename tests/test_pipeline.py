@@ -8,14 +8,17 @@ import signal
 import subprocess
 import sys
 import time
+from concurrent.futures import Future
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
+from craftsuite import worker_pool
 from craftsuite.cli import main
 from craftsuite.configs import StudentConfig
 from craftsuite.runs import FORMAT, read_csv
-from craftsuite.suite_runner import run_students
+from craftsuite.suite_runner import TimeLimitReached, run_students
 from craftsuite.suites import SUITES
 
 TINY = '{"learning_starts": 100, "buffer_size": 5000}'
@@ -357,6 +360,65 @@ def test_students_on_a_local_ray_instance(tmp_path):
         assert json.loads((p / "result.json").read_text())["steps"] == 300
         assert [int(r["step"]) for r in read_csv(p / "evals.csv")] == [150, 300]
 
+
+
+class _JoinedRay:
+    """The part of Ray the pool uses, as a cluster this process joined (not started): a task
+    never finishes on its own, and the refs cancelled are recorded."""
+
+    def __init__(self):
+        self.cancelled, self.shut = [], False
+
+    def remote(self, num_cpus):
+        def task(function):
+            def submit(*args):
+                return SimpleNamespace(future=Future)
+            return SimpleNamespace(remote=submit)
+        return task
+
+    def cancel(self, ref, force=False):
+        self.cancelled.append((ref, force))
+
+    def shutdown(self):
+        self.shut = True
+
+
+def test_an_abort_cancels_the_tasks_sent_to_a_joined_ray_cluster(monkeypatch):
+    """A cluster joined at an address outlives the driver: an abort (a failed job, the time
+    limit, an interrupt) has to stop its tasks by name, and leaves the cluster up."""
+    ray = _JoinedRay()
+    monkeypatch.setattr(worker_pool, "connect_ray", lambda address: (ray, False))
+    pool = worker_pool.WorkerPool(2, ray="auto")
+    pool.submit(print, "a")
+    pool.submit(print, "b")
+    pool.close()  # waiting for the jobs cancels nothing
+    assert ray.cancelled == []
+    pool.close(abort=True)
+    assert len(ray.cancelled) == 2 and all(force for _, force in ray.cancelled)
+    assert not ray.shut  # someone else's cluster: not shut down
+
+
+@pytest.mark.slow  # starts a Ray instance
+def test_the_time_limit_stops_a_student_on_a_ray_cluster_it_joined(tmp_path):
+    ray = pytest.importorskip("ray")
+    ray.init(num_cpus=1, include_dashboard=False, log_to_driver=False)  # as a cluster joined: it outlives the pool
+    # the worker imports torch and the package before it takes the run's lock: minutes on a loaded machine
+    try:
+        config = StudentConfig(method="dqn", world="Grid7", seed=0, steps=1_000_000, eval_every=100_000,
+                               hyperparameters={"learning_starts": 100, "buffer_size": 1000})
+        lock = tmp_path / config.run_name() / ".lock"
+        with pytest.raises(TimeLimitReached):
+            run_students([config], tmp_path, ray="auto", progress=False, deadline=time.monotonic() + 150)
+        owner = lock.read_text().split() if lock.exists() else []
+        assert len(owner) == 2, f"the student did not start on Ray before the time limit: {sorted(tmp_path.rglob('*'))}"
+        pid = int(owner[1])
+        deadline = time.time() + 30
+        while _alive(pid) and time.time() < deadline:
+            time.sleep(0.2)
+        assert not _alive(pid), "the Ray task trained on after the time limit"
+        assert not (tmp_path / config.run_name() / "result.json").exists()  # stopped mid-run: resumable
+    finally:
+        ray.shutdown()
 
 _DRIVER = """
 import sys

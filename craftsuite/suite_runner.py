@@ -51,15 +51,20 @@ def _population_job(configs: list[dict], root: str, task: str | dict | None = No
                                                  device=device)]
 
 
-def cells(configs: list[StudentConfig], members: int | None = None) -> list[list[StudentConfig]]:
+def cells(configs: list[StudentConfig], members: int | None = None, finished=None) -> list[list[StudentConfig]]:
     """The population engine's jobs: configs equal but for the seed, together, in order, at
     most ``members`` to a job (default: a cell's seeds all in one); each SB3 config alone (a
     finished run, reused). Smaller populations finish sooner and more of them run at once:
-    on many cores, or on a GPU that one process cannot keep busy."""
+    on many cores, or on a GPU that one process cannot keep busy. ``finished(config)``, if
+    given, says which runs train nothing: a cell's others come first, so that seeds added to
+    a cell (``--seeds 27 --members 7`` over 20 finished) train as populations of ``members``
+    rather than in groups counted from seed 0 (seed 20 alone, then 21-26)."""
     groups: dict[str, list[StudentConfig]] = {}
     for c in {c.run_name(): c for c in configs}.values():  # a run asked for twice is one run
         key = json.dumps(c.cell(), sort_keys=True) if c.engine == "population" else c.run_name()
         groups.setdefault(key, []).append(c)
+    if finished is not None:  # (a stable sort: seed order within each side)
+        groups = {key: sorted(group, key=lambda c: bool(finished(c))) for key, group in groups.items()}
     size = members or max(map(len, groups.values()), default=1)
     return [group[i:i + size] for group in groups.values() for i in range(0, len(group), size)]
 
@@ -120,7 +125,7 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     teachers = teachers or {}
-    jobs = cells(configs, members)
+    jobs = cells(configs, members, finished=lambda c: (root / c.run_name() / "result.json").is_file())
     waiting = {task: [job for job in jobs if job[0].task == task and METHODS[job[0].method].needs_table]
                for task in teachers}
     ready = [job for job in jobs if not (job[0].task in teachers and METHODS[job[0].method].needs_table)]

@@ -333,6 +333,18 @@ def test_run_students_hands_over_each_population_as_it_finishes(tmp_path):
                       ("students", [second], sorted([first, second]))]
 
 
+def test_run_students_puts_the_seeds_still_to_train_in_one_population(tmp_path):
+    configs = [StudentConfig(method="dqn", world="Grid7", seed=s, steps=300) for s in range(5)]
+    for c in configs[:3]:  # finished here already (a restored archive, an earlier part)
+        (tmp_path / c.run_name()).mkdir()
+        (tmp_path / c.run_name() / "result.json").write_text("{}")
+    pool, jobs = _StaggeredPool(), []
+    submit = pool.submit
+    pool.submit = lambda job, configs, *rest: jobs.append([c["seed"] for c in configs]) or submit(job, configs, *rest)
+    run_students(configs, tmp_path, pool=pool, progress=False, members=2)
+    assert jobs[0] == [3, 4]  # not seeds 2 and 3, then 4 alone
+
+
 def test_a_deadline_stops_the_populations_still_training_and_says_how_many(tmp_path):
     from craftsuite.suite_runner import TimeLimitReached
 

@@ -279,6 +279,20 @@ def test_a_cell_splits_into_populations_of_at_most_members_seeds_in_seed_order()
     assert cells(configs, members=50) == whole
 
 
+def test_seeds_added_to_a_cell_train_together_as_populations_of_members():
+    from craftsuite.configs import StudentConfig
+    from craftsuite.suite_runner import cells
+
+    # 20 seeds finished, 7 asked for: one population of the 7, not seed 20 with 14-19 and then 21-26
+    configs = [StudentConfig(method="dqn", world="Grid10", seed=s, steps=1000) for s in range(27)]
+    jobs = cells(configs, members=7, finished=lambda c: c.seed < 20)
+    assert [c.seed for c in jobs[0]] == list(range(20, 27))
+    assert [[c.seed for c in job] for job in jobs[1:]] == [list(range(0, 7)), list(range(7, 14)),
+                                                            list(range(14, 20))]  # train nothing
+    assert [[c.seed for c in job] for job in cells(configs, members=7)] == [
+        list(range(i, min(i + 7, 27))) for i in range(0, 27, 7)]  # without the predicate: seed order
+
+
 def test_each_member_logs_to_tensorboard_as_an_sb3_run_and_a_resume_drops_what_the_kill_logged(tmp_path,
                                                                                              monkeypatch):
     from ..scalars import hparams_sessions, scalar_steps

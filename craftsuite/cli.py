@@ -661,7 +661,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "merged over the suite's, e.g. '{\"features_extractor\": \"flatten\"}'")
     p.add_argument("--workers", type=_positive, help="parallel local processes (default: one per core)")
     p.add_argument("--members", type=_positive, help="at most this many seeds of a cell trained as one population "
-                   "(default: all of them; the seeds still to train are grouped first, finished ones train nothing); smaller populations finish sooner and more run at once, for many cores; "
+                   "(default: all of them; the seeds still to train are grouped first, finished ones train "
+                   "nothing); smaller populations finish sooner and more run at once, for many cores; "
                    "the processes sharing one GPU take turns on it, so there fewer, larger populations (e.g. 80) "
                    "should use it better (experiments/fresh-seeds)")
     p.add_argument("--ray", metavar="ADDRESS", help="run the students on Ray ('local' starts one here)")

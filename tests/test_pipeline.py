@@ -346,8 +346,6 @@ def test_run_students_puts_the_seeds_still_to_train_in_one_population(tmp_path):
 
 
 def test_a_deadline_stops_the_populations_still_training_and_says_how_many(tmp_path):
-    from craftsuite.suite_runner import TimeLimitReached
-
     configs = [StudentConfig(method="dqn", world="Grid7", seed=s, steps=300) for s in (0, 1, 2)]
     handed, pool = [], _StaggeredPool()
     with pytest.raises(TimeLimitReached, match="with 2 of 3 student runs unfinished: those training were stopped"):
@@ -371,7 +369,6 @@ def test_students_on_a_local_ray_instance(tmp_path):
     for p in paths:
         assert json.loads((p / "result.json").read_text())["steps"] == 300
         assert [int(r["step"]) for r in read_csv(p / "evals.csv")] == [150, 300]
-
 
 
 class _JoinedRay:
@@ -431,6 +428,7 @@ def test_the_time_limit_stops_a_student_on_a_ray_cluster_it_joined(tmp_path):
         assert not (tmp_path / config.run_name() / "result.json").exists()  # stopped mid-run: resumable
     finally:
         ray.shutdown()
+
 
 _DRIVER = """
 import sys

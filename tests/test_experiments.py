@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import importlib.util
+import os
+import subprocess
 import sys
 from pathlib import Path
 
@@ -77,3 +79,46 @@ def test_the_learner_regime_grid_rule_takes_the_largest_in_the_zone_else_the_nea
     assert budgets.grid_choice({10_000: 0.31, 15_000: 0.74, 20_000: 0.78, 30_000: 1.0})[0] == 20_000
     assert budgets.grid_choice({10_000: 0.9, 15_000: 1.0})[0] == 10_000  # none inside: the nearest
     assert budgets.grid_choice({10_000: 0.85, 15_000: 0.85})[0] == 10_000  # a tie: the smaller budget
+
+
+PART = Path(__file__).resolve().parents[1] / "experiments" / "suite-campaign" / "part.sh"
+
+
+def _part(tmp_path, queue_text: str, cutoff: str = "23:59"):
+    """Runs part.sh over ``queue_text`` with a stand-in python that prints its command line."""
+    stub = tmp_path / "python"
+    stub.write_text('#!/bin/sh\necho "pwd=$PWD commit=$CRAFTSUITE_COMMIT $*"\n')
+    stub.chmod(0o755)
+    queue = tmp_path / "A.queue"
+    queue.write_text(queue_text)
+    return subprocess.run(["bash", str(PART), str(PART.parents[2]), cutoff, "out", str(queue)], cwd=tmp_path,
+                          env={**os.environ, "PYTHON": str(stub)}, capture_output=True, text=True, timeout=60)
+
+
+def test_a_campaign_part_runs_its_queue_in_order_and_skips_what_the_time_left_cannot_cover(tmp_path):
+    done = _part(tmp_path, "# seeds 20-34\nfirst 0 --suite hard --tasks GoldMine\n"
+                           "long 100000 --suite hard --tasks DiamondMine\nsecond 0 --suite standard\n")
+    assert done.returncode == 0, done.stderr
+    said = [line.split(" ", 1)[1] for line in done.stdout.splitlines()]
+    assert [s.split(":")[0] for s in said] == ["first", "first", "long", "second", "second", "queue done"]
+    assert "skipped" in said[2] and "needs 100000" in said[2]
+    out = tmp_path / "out"
+    first = (out / "first.log").read_text()
+    commit = subprocess.run(["git", "-C", str(PART.parents[2]), "rev-parse", "HEAD"], capture_output=True,
+                            text=True).stdout.strip()
+    assert f"pwd={PART.parents[2]} commit={commit} -m craftsuite transfer --suite hard --tasks GoldMine " in first
+    assert f"--archive {tmp_path / 'results'} --out {out / 'first'}" in first and "--time-limit " in first
+    assert not (out / "long.log").exists() and (out / "long.status").read_text() == "skipped\n"
+    assert (out / "second.status").read_text() == "exit 0\n"
+    # run again over an amended queue: only the line not yet started runs
+    again = _part(tmp_path, "first 0 --suite hard\nlong 0 --suite hard\nsecond 0 --suite standard\nthird 0 --x\n")
+    ran = [line.split(" ", 1)[1].split(":")[0] for line in again.stdout.splitlines()]
+    assert ran == ["third", "third", "queue done"]
+
+
+def test_a_campaign_part_refuses_a_queue_line_without_minutes_and_a_cut_off_that_is_not_a_time(tmp_path):
+    bad = _part(tmp_path, "first soon --suite hard\n")
+    assert bad.returncode == 2 and "line first: MINUTES 'soon' is not a whole number" in bad.stderr
+    assert not (tmp_path / "out" / "first.status").exists()
+    late = _part(tmp_path, "first 0 --suite hard\n", cutoff="quarter past")
+    assert late.returncode == 2 and "give it as HH:MM" in late.stderr and not (tmp_path / "out").exists()

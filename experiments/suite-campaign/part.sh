@@ -7,7 +7,8 @@
 #   bash experiments/suite-campaign/part.sh TREE HH:MM OUT QUEUE > OUT/A.out &
 # QUEUE holds one transfer a line, `NAME MINUTES ARGS...`: MINUTES is the least time left
 # at which it starts (its expected duration at the rate measured), ARGS the rest of its
-# `craftsuite transfer` command (--suite, --worlds, --tasks, --methods, --seeds, --members).
+# `craftsuite transfer` command (--suite, --worlds, --tasks, --methods, --seeds, --members),
+# split at spaces (no quoting: a JSON argument does not fit on a queue line).
 # Lines starting with # are comments. The queue is read again before each transfer, so an
 # amendment edits the lines not yet started; a started or skipped NAME leaves OUT/NAME.status
 # and is not run again. Runs land in OUT/NAME (log OUT/NAME.log) and in ./results, recording

@@ -22,6 +22,8 @@ commit=$(git -C "$tree" rev-parse HEAD 2>/dev/null) \
   || { echo "part.sh: TREE '$tree' is not a checkout: make it with git worktree add TREE PLAN_COMMIT" >&2; exit 2; }
 end=$(date -u -d "$cutoff" +%s 2>/dev/null) \
   || { echo "part.sh: cut-off '$cutoff' is not a time: give it as HH:MM (UTC, today)" >&2; exit 2; }
+[ "$end" -gt "$(date +%s)" ] \
+  || { echo "part.sh: cut-off $cutoff UTC has passed: give a later one (HH:MM, today)" >&2; exit 2; }
 [ -f "$queue" ] || { echo "part.sh: no queue file '$queue': write one transfer a line, NAME MINUTES ARGS..." >&2; exit 2; }
 py=${PYTHON:-$PWD/.venv/bin/python}
 archive=$PWD/results

@@ -30,7 +30,7 @@ from .files import atomic_write
 from .ids import file_stem
 from .methods import METHODS, methods_for
 from .progress import progress_bar
-from .runs import read_result
+from .runs import RunDir, read_result
 from .suites import Suite
 from .task_registry import carried, resolve_task
 from .worker_pool import WorkerPool
@@ -125,7 +125,8 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     teachers = teachers or {}
-    jobs = cells(configs, members, finished=lambda c: (root / c.run_name() / "result.json").is_file())
+    # what a population will train: the engine skips the members whose RunDir is finished
+    jobs = cells(configs, members, finished=lambda c: RunDir(root / c.run_name(), c).finished())
     waiting = {task: [job for job in jobs if job[0].task == task and METHODS[job[0].method].needs_table]
                for task in teachers}
     ready = [job for job in jobs if not (job[0].task in teachers and METHODS[job[0].method].needs_table)]

@@ -11,8 +11,8 @@
 # split at spaces (no quoting: a JSON argument does not fit on a queue line).
 # Lines starting with # are comments. The queue is read again before each transfer, so an
 # amendment edits the lines not yet started; a started or skipped NAME leaves OUT/NAME.status
-# and is not run again (delete that file to run it again: a transfer resumes what it began). Runs land in OUT/NAME (log OUT/NAME.log) and in ./results, recording
-# TREE's commit. PYTHON (default ./.venv/bin/python) runs them.
+# and is not run again (delete that file to run it again: a transfer resumes what it began).
+# Runs land in OUT/NAME (log OUT/NAME.log) and in ./results, recording TREE's commit. PYTHON (default ./.venv/bin/python) runs them.
 set -u
 if [ $# -ne 4 ]; then
   echo "usage: part.sh TREE HH:MM OUT QUEUE (see the comment at the top of this script)" >&2; exit 2

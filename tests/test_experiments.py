@@ -85,10 +85,10 @@ def test_the_learner_regime_grid_rule_takes_the_largest_in_the_zone_else_the_nea
 PART = Path(__file__).resolve().parents[1] / "experiments" / "suite-campaign" / "part.sh"
 
 
-def _part(tmp_path, queue_text: str, cutoff: str = "23:59"):
-    """Runs part.sh over ``queue_text`` with a stand-in python that prints its command line."""
-    if cutoff == "23:59" and time.gmtime().tm_hour == 23 and time.gmtime().tm_min >= 58:
-        pytest.skip("the cut-off these tests use, 23:59 UTC, is about to pass")
+def _part(tmp_path, queue_text: str, cutoff: str | None = None):
+    """Runs part.sh over ``queue_text`` with a stand-in python that prints its command line;
+    by default its cut-off is this time tomorrow, in the dated form a cut-off past midnight takes."""
+    cutoff = cutoff or time.strftime("%Y-%m-%d %H:%M", time.gmtime(time.time() + 86_400))
     stub = tmp_path / "python"
     stub.write_text('#!/bin/sh\necho "pwd=$PWD commit=$CRAFTSUITE_COMMIT $*"\n')
     stub.chmod(0o755)
@@ -126,4 +126,5 @@ def test_a_campaign_part_refuses_a_queue_line_without_minutes_and_a_cut_off_not_
     late = _part(tmp_path, "first 0 --suite hard\n", cutoff="quarter past")
     assert late.returncode == 2 and "give it as HH:MM" in late.stderr and not (tmp_path / "out").exists()
     past = _part(tmp_path, "first 0 --suite hard\n", cutoff="00:00")
-    assert past.returncode == 2 and "has passed" in past.stderr and not (tmp_path / "out").exists()
+    assert past.returncode == 2 and "has passed" in past.stderr and "YYYY-MM-DD HH:MM" in past.stderr
+    assert not (tmp_path / "out").exists()

@@ -4,7 +4,9 @@
 # (`--time-limit`) and archived population by population as it goes.
 # Usage, from the project root (one call per process, in the background):
 #   git worktree add TREE PLAN_COMMIT      # the plan's code, while this checkout moves on
-#   bash experiments/suite-campaign/part.sh TREE HH:MM OUT QUEUE > OUT/A.out &
+#   bash experiments/suite-campaign/part.sh TREE CUTOFF OUT QUEUE > OUT/A.out &
+# CUTOFF, in UTC: HH:MM for today, or 'YYYY-MM-DD HH:MM' (one argument) for a cut-off past
+# midnight (a bare HH:MM is never read as tomorrow's: a cut-off already past is refused).
 # QUEUE holds one transfer a line, `NAME MINUTES ARGS...`: MINUTES is the least time left
 # at which it starts (its expected duration at the rate measured), ARGS the rest of its
 # `craftsuite transfer` command (--suite, --worlds, --tasks, --methods, --seeds, --members),
@@ -12,18 +14,19 @@
 # Lines starting with # are comments. The queue is read again before each transfer, so an
 # amendment edits the lines not yet started; a started or skipped NAME leaves OUT/NAME.status
 # and is not run again (delete that file to run it again: a transfer resumes what it began).
-# Runs land in OUT/NAME (log OUT/NAME.log) and in ./results, recording TREE's commit. PYTHON (default ./.venv/bin/python) runs them.
+# Runs land in OUT/NAME (log OUT/NAME.log) and in ./results, recording TREE's commit;
+# PYTHON (default ./.venv/bin/python) runs them.
 set -u
 if [ $# -ne 4 ]; then
-  echo "usage: part.sh TREE HH:MM OUT QUEUE (see the comment at the top of this script)" >&2; exit 2
+  echo "usage: part.sh TREE CUTOFF OUT QUEUE (see the comment at the top of this script)" >&2; exit 2
 fi
 tree=$1 cutoff=$2 out=$(realpath -m "$3") queue=$4
 commit=$(git -C "$tree" rev-parse HEAD 2>/dev/null) \
   || { echo "part.sh: TREE '$tree' is not a checkout: make it with git worktree add TREE PLAN_COMMIT" >&2; exit 2; }
 end=$(date -u -d "$cutoff" +%s 2>/dev/null) \
-  || { echo "part.sh: cut-off '$cutoff' is not a time: give it as HH:MM (UTC, today)" >&2; exit 2; }
+  || { echo "part.sh: cut-off '$cutoff' is not a time: give it as HH:MM (UTC, today) or 'YYYY-MM-DD HH:MM'" >&2; exit 2; }
 [ "$end" -gt "$(date +%s)" ] \
-  || { echo "part.sh: cut-off $cutoff UTC has passed: give a later one (HH:MM, today)" >&2; exit 2; }
+  || { echo "part.sh: cut-off $cutoff UTC has passed: give a later one (HH:MM today, or 'YYYY-MM-DD HH:MM' past midnight)" >&2; exit 2; }
 [ -f "$queue" ] || { echo "part.sh: no queue file '$queue': write one transfer a line, NAME MINUTES ARGS..." >&2; exit 2; }
 py=${PYTHON:-$PWD/.venv/bin/python}
 archive=$PWD/results

@@ -4,7 +4,9 @@
 # (`--time-limit`) and archived population by population as it goes.
 # Usage, from the project root (one call per process, in the background):
 #   git worktree add TREE PLAN_COMMIT      # the plan's code, while this checkout moves on
-#   bash experiments/suite-campaign/part.sh TREE CUTOFF OUT QUEUE > OUT/A.out &
+#   bash TREE/experiments/suite-campaign/part.sh TREE CUTOFF OUT QUEUE > OUT/A.out &
+# (TREE's copy of this script: bash reads a script as it runs, so a running part must not
+# read the copy this checkout edits; run it from the root all the same, where ./results is.)
 # CUTOFF, in UTC: HH:MM for today, or 'YYYY-MM-DD HH:MM' (one argument) for a cut-off past
 # midnight (a bare HH:MM is never read as tomorrow's: a cut-off already past is refused).
 # QUEUE holds one transfer a line, `NAME MINUTES ARGS...`: MINUTES is the least time left

@@ -86,11 +86,14 @@ PART = Path(__file__).resolve().parents[1] / "experiments" / "suite-campaign" / 
 
 
 def _part(tmp_path, queue_text: str, cutoff: str | None = None):
-    """Runs part.sh over ``queue_text`` with a stand-in python that prints its command line;
-    by default its cut-off is this time tomorrow, in the dated form a cut-off past midnight takes."""
+    """Runs part.sh over ``queue_text`` with a stand-in python that prints its command line
+    (and exits as a transfer its time limit stopped where the line says ``--stops``); by
+    default its cut-off is this time tomorrow, in the dated form a cut-off past midnight takes."""
+    from craftsuite.cli import TIME_LIMIT_STATUS
     cutoff = cutoff or time.strftime("%Y-%m-%d %H:%M", time.gmtime(time.time() + 86_400))
     stub = tmp_path / "python"
-    stub.write_text('#!/bin/sh\necho "pwd=$PWD commit=$CRAFTSUITE_COMMIT $*"\n')
+    stub.write_text('#!/bin/sh\necho "pwd=$PWD commit=$CRAFTSUITE_COMMIT $*"\n'
+                    f'case "$*" in *--stops*) exit {TIME_LIMIT_STATUS};; esac\n')
     stub.chmod(0o755)
     queue = tmp_path / "A.queue"
     queue.write_text(queue_text)
@@ -117,6 +120,28 @@ def test_a_campaign_part_runs_its_queue_in_order_and_skips_what_the_time_left_ca
     again = _part(tmp_path, "first 0 --suite hard\nlong 0 --suite hard\nsecond 0 --suite standard\nthird 0 --x\n")
     ran = [line.split(" ", 1)[1].split(":")[0] for line in again.stdout.splitlines()]
     assert ran == ["third", "third", "queue done"]
+
+
+def test_a_campaign_part_resumes_a_transfer_its_cut_off_stopped_in_its_next_call(tmp_path):
+    def said(done):
+        assert done.returncode == 0, done.stderr
+        return [line.split(" ", 1)[1] for line in done.stdout.splitlines()]
+
+    queue = "long 0 --suite hard --stops\nshort 0 --suite standard\n"
+    first = said(_part(tmp_path, queue))
+    assert [s.split(",")[0] for s in first] == ["long: start", "long: exit 3", "short: start", "short: exit 0",
+                                                "queue done"]
+    out = tmp_path / "out"
+    # the next call resumes the stopped one first, once, and leaves the finished one alone
+    again = said(_part(tmp_path, "short 0 --suite standard\nlong 0 --suite hard --stops\n"))
+    assert [s.split(",")[0] for s in again] == ["long: resume", "long: exit 3", "queue done"]
+    log = (out / "long.log").read_text()
+    assert log.count("== part.sh: start ") == 1 and log.count("== part.sh: resume ") == 1
+    assert log.count("-m craftsuite transfer --suite hard --stops") == 2  # the first call's lines kept
+    # one the time left cannot cover is not resumed, and stays resumable
+    late = said(_part(tmp_path, "long 100000 --suite hard --stops\n"))
+    assert late[0].startswith("long: not resumed") and late[0].endswith("needs 100000")
+    assert (out / "long.status").read_text() == "exit 3\n"
 
 
 def test_a_campaign_part_refuses_a_queue_line_without_minutes_and_a_cut_off_not_ahead(tmp_path):

@@ -15,9 +15,12 @@
 # split at spaces (no quoting: a JSON argument does not fit on a queue line).
 # Lines starting with # are comments. The queue is read again before each transfer, so an
 # amendment edits the lines not yet started; a started or skipped NAME leaves OUT/NAME.status
-# and is not run again (delete that file to run it again: a transfer resumes what it began).
-# Runs land in OUT/NAME (log OUT/NAME.log) and in ./results, recording TREE's commit;
-# PYTHON (default ./.venv/bin/python) runs them.
+# and is not run again, except one the cut-off stopped (`exit 3`, the status of a transfer
+# its --time-limit stopped): the next part.sh over the same OUT and queue resumes it first,
+# from its runs' checkpoints (a later session's part, from the same TREE so that its runs
+# keep one commit). To run another NAME again, delete its status file.
+# Runs land in OUT/NAME (log OUT/NAME.log, each start appended) and in ./results, recording
+# TREE's commit; PYTHON (default ./.venv/bin/python) runs them.
 set -u
 if [ $# -ne 4 ]; then
   echo "usage: part.sh TREE CUTOFF OUT QUEUE (see the comment at the top of this script)" >&2; exit 2
@@ -33,15 +36,31 @@ end=$(date -u -d "$cutoff" +%s 2>/dev/null) \
 py=${PYTHON:-$PWD/.venv/bin/python}
 archive=$PWD/results
 
-next() {  # the queue's first line whose NAME has no status yet; every line checked first
-  local name minutes args first=""
+stopped=3  # the exit status of a transfer its --time-limit stopped (craftsuite.cli.TIME_LIMIT_STATUS)
+ran=" "    # the NAMEs this call has started: each runs at most once a call
+
+due() {  # whether NAME is still to run: never started, or stopped at a cut-off and not yet resumed
+  local status=""
+  [[ $ran == *" $1 "* ]] && return 1
+  [ -e "$out/$1.status" ] || return 0
+  read -r status < "$out/$1.status"
+  [[ $status == "exit $stopped" ]]
+}
+
+next() {  # the queue's first line still due (resumable ones first); every line checked first
+  local name minutes args first="" resume=""
   while read -r name minutes args; do
     [[ -z $name || $name == \#* ]] && continue
     [[ $minutes =~ ^[0-9]+$ ]] \
       || { echo "part.sh: $queue, line $name: MINUTES '$minutes' is not a whole number" >&2; return 2; }
-    [[ -z $first && ! -e "$out/$name.status" ]] && first="$name $minutes $args"
+    due "$name" || continue
+    if [ -e "$out/$name.status" ]; then
+      [[ -z $resume ]] && resume="$name $minutes $args"
+    else
+      [[ -z $first ]] && first="$name $minutes $args"
+    fi
   done < "$queue"
-  echo "$first"
+  echo "${resume:-$first}"
 }
 
 next > /dev/null || exit 2  # a bad queue is refused before anything is made
@@ -51,17 +70,24 @@ while :; do
   line=$(next) || exit 2
   [ -z "$line" ] && break
   read -r name minutes args <<< "$line"
+  ran+="$name "
+  [ -e "$out/$name.status" ] && verb=resume || verb=start
   left=$(( (end - $(date +%s)) / 60 ))
   if [ "$left" -lt "$minutes" ]; then
-    echo "$(date -u +%H:%M) $name: skipped, $left min left, needs $minutes"
-    echo skipped > "$out/$name.status"
+    if [ $verb = resume ]; then  # what it trained is kept: it stays for the next call to resume
+      echo "$(date -u +%H:%M) $name: not resumed, $left min left, needs $minutes"
+    else
+      echo "$(date -u +%H:%M) $name: skipped, $left min left, needs $minutes"
+      echo skipped > "$out/$name.status"
+    fi
     continue
   fi
-  echo "$(date -u +%H:%M) $name: start, $left min left"
+  echo "$(date -u +%H:%M) $name: $verb, $left min left"
   echo started > "$out/$name.status"
+  echo "== part.sh: $verb $(date -u '+%Y-%m-%d %H:%M') UTC, commit $commit, $left min left" >> "$out/$name.log"
   # shellcheck disable=SC2086  # ARGS are words of the command, split as written in the queue
   (cd "$tree" && CRAFTSUITE_COMMIT=$commit "$py" -m craftsuite transfer $args --workers 1 --no-video \
-    --time-limit "$left" --archive "$archive" --out "$out/$name") > "$out/$name.log" 2>&1
+    --time-limit "$left" --archive "$archive" --out "$out/$name") >> "$out/$name.log" 2>&1
   status=$?
   echo "exit $status" > "$out/$name.status"
   echo "$(date -u +%H:%M) $name: exit $status"

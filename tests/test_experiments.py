@@ -132,16 +132,18 @@ def test_a_campaign_part_resumes_a_transfer_its_cut_off_stopped_in_its_next_call
     assert [s.split(",")[0] for s in first] == ["long: start", "long: exit 3", "short: start", "short: exit 0",
                                                 "queue done"]
     out = tmp_path / "out"
-    # the next call resumes the stopped one first, once, and leaves the finished one alone
-    again = said(_part(tmp_path, "short 0 --suite standard\nlong 0 --suite hard --stops\n"))
-    assert [s.split(",")[0] for s in again] == ["long: resume", "long: exit 3", "queue done"]
+    # the next call resumes the stopped one first (before a line never started), once, and
+    # leaves the finished one alone
+    again = said(_part(tmp_path, "short 0 --suite standard\nnew 0 --x\nlong 0 --suite hard --stops\n"))
+    assert [s.split(",")[0] for s in again] == ["long: resume", "long: exit 3", "new: start", "new: exit 0",
+                                                "queue done"]
     log = (out / "long.log").read_text()
     assert log.count("== part.sh: start ") == 1 and log.count("== part.sh: resume ") == 1
     assert log.count("-m craftsuite transfer --suite hard --stops") == 2  # the first call's lines kept
     # one the time left cannot cover is not resumed, and stays resumable
     late = said(_part(tmp_path, "long 100000 --suite hard --stops\n"))
     assert late[0].startswith("long: not resumed") and late[0].endswith("needs 100000")
-    assert (out / "long.status").read_text() == "exit 3\n"
+    assert (out / "long.status").read_text() == "exit 3\n" and (out / "long.log").read_text() == log
 
 
 def test_a_campaign_part_refuses_a_queue_line_without_minutes_and_a_cut_off_not_ahead(tmp_path):

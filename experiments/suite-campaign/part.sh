@@ -14,11 +14,13 @@
 # `craftsuite transfer` command (--suite, --worlds, --tasks, --methods, --seeds, --members),
 # split at spaces (no quoting: a JSON argument does not fit on a queue line).
 # Lines starting with # are comments. The queue is read again before each transfer, so an
-# amendment edits the lines not yet started; a started or skipped NAME leaves OUT/NAME.status
-# and is not run again, except one the cut-off stopped (`exit 3`, the status of a transfer
-# its --time-limit stopped): the next part.sh over the same OUT and queue resumes it first,
-# from its runs' checkpoints (a later session's part, from the same TREE so that its runs
-# keep one commit). To run another NAME again, delete its status file.
+# amendment edits the lines not yet started (and the resume of a stopped one: keep its ARGS,
+# or it trains something else into the same OUT/NAME). A started or skipped NAME leaves
+# OUT/NAME.status and is not run again, except one the cut-off stopped (`exit 3`, the status
+# of a transfer its --time-limit stopped): the next part.sh over the same OUT and queue
+# resumes it first, from its runs' checkpoints (a later session's part, from the same TREE so
+# that its runs keep one commit; each start's line in the log names the commit it ran). To
+# run another NAME again, delete its status file.
 # Runs land in OUT/NAME (log OUT/NAME.log, each start appended) and in ./results, recording
 # TREE's commit; PYTHON (default ./.venv/bin/python) runs them.
 set -u
@@ -37,9 +39,9 @@ py=${PYTHON:-$PWD/.venv/bin/python}
 archive=$PWD/results
 
 stopped=3  # the exit status of a transfer its --time-limit stopped (craftsuite.cli.TIME_LIMIT_STATUS)
-ran=" "    # the NAMEs this call has started: each runs at most once a call
+ran=" "    # the NAMEs this call has taken up (run, skipped or not resumed): each at most once a call
 
-due() {  # whether NAME is still to run: never started, or stopped at a cut-off and not yet resumed
+due() {  # whether NAME is still to run: no status yet, or stopped at a cut-off, and not taken up by this call
   local status=""
   [[ $ran == *" $1 "* ]] && return 1
   [ -e "$out/$1.status" ] || return 0

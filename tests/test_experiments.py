@@ -155,3 +155,23 @@ def test_a_campaign_part_refuses_a_queue_line_without_minutes_and_a_cut_off_not_
     past = _part(tmp_path, "first 0 --suite hard\n", cutoff="00:00")
     assert past.returncode == 2 and "has passed" in past.stderr and "YYYY-MM-DD HH:MM" in past.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_a_campaign_part_resumes_a_transfer_whose_part_sh_was_interrupted_and_leaves_a_running_one(tmp_path):
+    boot = Path("/proc/sys/kernel/random/boot_id")
+    if not boot.exists():
+        pytest.skip("needs Linux's boot id")
+    out = tmp_path / "out"
+    out.mkdir()
+    gone = subprocess.run(["sh", "-c", "echo $$"], capture_output=True, text=True).stdout.strip()
+    this_boot = boot.read_text().strip()
+    (out / "killed.status").write_text(f"started {gone} {this_boot}\n")  # its part.sh died
+    (out / "rebooted.status").write_text(f"started {os.getpid()} another-boot\n")  # a PID of an earlier boot
+    (out / "running.status").write_text(f"started {os.getpid()} {this_boot}\n")  # its part.sh still runs
+    (out / "old.status").write_text("started\n")  # an older part.sh's: nothing to tell whether it runs
+    done = _part(tmp_path, "old 0 --a\nrunning 0 --b\nkilled 0 --c\nrebooted 0 --d\n")
+    assert done.returncode == 0, done.stderr
+    said = [line.split(" ", 1)[1].split(",")[0] for line in done.stdout.splitlines()]
+    assert said == ["killed: resume", "killed: exit 0", "rebooted: resume", "rebooted: exit 0", "queue done"]
+    assert (out / "running.status").read_text() == f"started {os.getpid()} {this_boot}\n"
+    assert (out / "old.status").read_text() == "started\n" and not (out / "running.log").exists()

@@ -17,10 +17,12 @@
 # amendment edits the lines not yet started (and the resume of a stopped one: keep its ARGS,
 # or it trains something else into the same OUT/NAME). A started or skipped NAME leaves
 # OUT/NAME.status and is not run again, except one the cut-off stopped (`exit 3`, the status
-# of a transfer its --time-limit stopped): the next part.sh over the same OUT and queue
-# resumes it first, from its runs' checkpoints (a later session's part, from the same TREE so
-# that its runs keep one commit; each start's line in the log names the commit it ran). To
-# run another NAME again, delete its status file.
+# of a transfer its --time-limit stopped) or one interrupted (`started PID BOOT` whose
+# part.sh is gone: killed, or the machine restarted): the next part.sh over the same OUT and
+# queue resumes it first, from its runs' checkpoints (a later session's part, from the same
+# TREE so that its runs keep one commit; each start's line in the log names the commit it
+# ran). One whose part.sh still runs is left to it. To run another NAME again, delete its
+# status file.
 # Runs land in OUT/NAME (log OUT/NAME.log, each start appended) and in ./results, recording
 # TREE's commit; PYTHON (default ./.venv/bin/python) runs them.
 set -u
@@ -40,13 +42,20 @@ archive=$PWD/results
 
 stopped=3  # the exit status of a transfer its --time-limit stopped (craftsuite.cli.TIME_LIMIT_STATUS)
 ran=" "    # the NAMEs this call has taken up (run, skipped or not resumed): each at most once a call
+# this boot of the machine: a PID recorded in an earlier boot names no process now
+boot=$(cat /proc/sys/kernel/random/boot_id 2>/dev/null || echo unknown)
 
-due() {  # whether NAME is still to run: no status yet, or stopped at a cut-off, and not taken up by this call
-  local status=""
+due() {  # whether NAME is still to run: no status yet, stopped at a cut-off, or interrupted
+  # (its part.sh gone), and not taken up by this call
+  local status="" pid="" since=""
   [[ $ran == *" $1 "* ]] && return 1
   [ -e "$out/$1.status" ] || return 0
   read -r status < "$out/$1.status"
-  [[ $status == "exit $stopped" ]]
+  [[ $status == "exit $stopped" ]] && return 0
+  read -r status pid since <<< "$status"
+  [[ $status == started && $pid =~ ^[0-9]+$ ]] || return 1  # finished, skipped, or of an older part.sh
+  [[ $since != "$boot" ]] && return 0
+  ! { kill -0 "$pid" 2>/dev/null || [ -e "/proc/$pid" ]; }  # (a process of another user's: alive)
 }
 
 next() {  # the queue's first line still due (resumable ones first); every line checked first
@@ -85,7 +94,7 @@ while :; do
     continue
   fi
   echo "$(date -u +%H:%M) $name: $verb, $left min left"
-  echo started > "$out/$name.status"
+  echo "started $$ $boot" > "$out/$name.status"
   echo "== part.sh: $verb $(date -u '+%Y-%m-%d %H:%M') UTC, commit $commit, $left min left" >> "$out/$name.log"
   # shellcheck disable=SC2086  # ARGS are words of the command, split as written in the queue
   (cd "$tree" && CRAFTSUITE_COMMIT=$commit "$py" -m craftsuite transfer $args --workers 1 --no-video \

@@ -169,9 +169,15 @@ def test_a_campaign_part_resumes_a_transfer_whose_part_sh_was_interrupted_and_le
     (out / "rebooted.status").write_text(f"started {os.getpid()} another-boot\n")  # a PID of an earlier boot
     (out / "running.status").write_text(f"started {os.getpid()} {this_boot}\n")  # its part.sh still runs
     (out / "old.status").write_text("started\n")  # an older part.sh's: nothing to tell whether it runs
-    done = _part(tmp_path, "old 0 --a\nrunning 0 --b\nkilled 0 --c\nrebooted 0 --d\n")
+    (out / "orphan.status").write_text(f"started {gone} {this_boot}\n")  # its part.sh died, its transfer runs on
+    orphan = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)", "--out", str(out / "orphan")])
+    try:
+        done = _part(tmp_path, "old 0 --a\nrunning 0 --b\norphan 0 --e\nkilled 0 --c\nrebooted 0 --d\n")
+    finally:
+        orphan.kill()
     assert done.returncode == 0, done.stderr
     said = [line.split(" ", 1)[1].split(",")[0] for line in done.stdout.splitlines()]
     assert said == ["killed: resume", "killed: exit 0", "rebooted: resume", "rebooted: exit 0", "queue done"]
+    assert not (out / "orphan.log").exists()
     assert (out / "running.status").read_text() == f"started {os.getpid()} {this_boot}\n"
     assert (out / "old.status").read_text() == "started\n" and not (out / "running.log").exists()

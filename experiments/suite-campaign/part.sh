@@ -21,8 +21,8 @@
 # part.sh is gone: killed, or the machine restarted): the next part.sh over the same OUT and
 # queue resumes it first, from its runs' checkpoints (a later session's part, from the same
 # TREE so that its runs keep one commit; each start's line in the log names the commit it
-# ran). One whose part.sh still runs is left to it. To run another NAME again, delete its
-# status file.
+# ran). One whose part.sh, or its transfer, still runs is left to it. To run another NAME
+# again, delete its status file.
 # Runs land in OUT/NAME (log OUT/NAME.log, each start appended) and in ./results, recording
 # TREE's commit; PYTHON (default ./.venv/bin/python) runs them.
 set -u
@@ -55,7 +55,9 @@ due() {  # whether NAME is still to run: no status yet, stopped at a cut-off, or
   read -r status pid since <<< "$status"
   [[ $status == started && $pid =~ ^[0-9]+$ ]] || return 1  # finished, skipped, or of an older part.sh
   [[ $since != "$boot" ]] && return 0
-  ! { kill -0 "$pid" 2>/dev/null || [ -e "/proc/$pid" ]; }  # (a process of another user's: alive)
+  { kill -0 "$pid" 2>/dev/null || [ -e "/proc/$pid" ]; } && return 1  # (a process of another user's: alive)
+  # its part.sh is gone; a transfer it left running (part.sh killed alone) still owns OUT/NAME
+  ! pgrep -f -- "--out $out/$1\$" > /dev/null
 }
 
 next() {  # the queue's first line still due (resumable ones first); every line checked first

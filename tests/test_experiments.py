@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import re
 import subprocess
 import sys
 import time
@@ -86,13 +87,15 @@ PART = Path(__file__).resolve().parents[1] / "experiments" / "suite-campaign" / 
 
 
 def _part(tmp_path, queue_text: str, cutoff: str | None = None):
-    """Runs part.sh over ``queue_text`` with a stand-in python that prints its command line
-    (and exits as a transfer its time limit stopped where the line says ``--stops``); by
-    default its cut-off is this time tomorrow, in the dated form a cut-off past midnight takes."""
+    """Runs part.sh over ``queue_text`` with a stand-in python that prints its command line and
+    the status part.sh wrote for it (and exits as a transfer its time limit stopped where the
+    line says ``--stops``); by default its cut-off is this time tomorrow, in the dated form a
+    cut-off past midnight takes."""
     from craftsuite.cli import TIME_LIMIT_STATUS
     cutoff = cutoff or time.strftime("%Y-%m-%d %H:%M", time.gmtime(time.time() + 86_400))
     stub = tmp_path / "python"
     stub.write_text('#!/bin/sh\necho "pwd=$PWD commit=$CRAFTSUITE_COMMIT $*"\n'
+                    'for a; do last=$a; done; echo "status=$(cat "$last.status")"\n'  # --out OUT/NAME last
                     f'case "$*" in *--stops*) exit {TIME_LIMIT_STATUS};; esac\n')
     stub.chmod(0o755)
     queue = tmp_path / "A.queue"
@@ -160,24 +163,35 @@ def test_a_campaign_part_refuses_a_queue_line_without_minutes_and_a_cut_off_not_
 def test_a_campaign_part_resumes_a_transfer_whose_part_sh_was_interrupted_and_leaves_a_running_one(tmp_path):
     boot = Path("/proc/sys/kernel/random/boot_id")
     if not boot.exists():
-        pytest.skip("needs Linux's boot id")
+        pytest.skip("needs Linux's /proc")
     out = tmp_path / "out"
     out.mkdir()
+
+    def started(pid, start=None, on=boot.read_text().strip()):  # a status as part.sh writes it
+        start = start or Path(f"/proc/{pid}/stat").read_text().rsplit(") ", 1)[1].split()[19]
+        return f"started {pid} {start} {on}\n"
+
     gone = subprocess.run(["sh", "-c", "echo $$"], capture_output=True, text=True).stdout.strip()
-    this_boot = boot.read_text().strip()
-    (out / "killed.status").write_text(f"started {gone} {this_boot}\n")  # its part.sh died
-    (out / "rebooted.status").write_text(f"started {os.getpid()} another-boot\n")  # a PID of an earlier boot
-    (out / "running.status").write_text(f"started {os.getpid()} {this_boot}\n")  # its part.sh still runs
-    (out / "old.status").write_text("started\n")  # an older part.sh's: nothing to tell whether it runs
-    (out / "orphan.status").write_text(f"started {gone} {this_boot}\n")  # its part.sh died, its transfer runs on
-    orphan = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)", "--out", str(out / "orphan")])
+    statuses = {"killed": started(gone, start="1"),  # its part.sh died
+                "rebooted": started(os.getpid(), on="another-boot"),  # a PID of an earlier boot
+                "reused": started(os.getpid(), start="1"),  # a PID another process took since
+                "running": started(os.getpid()),  # its part.sh still runs
+                "orphan+1": started(gone, start="1"),  # its part.sh died, its transfer runs on
+                "old": "started\n"}  # an older part.sh's: nothing tells whether it runs
+    for name, status in statuses.items():
+        (out / f"{name}.status").write_text(status)
+    orphan = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)", "--out", str(out / "orphan+1")])
     try:
-        done = _part(tmp_path, "old 0 --a\nrunning 0 --b\norphan 0 --e\nkilled 0 --c\nrebooted 0 --d\n")
+        done = _part(tmp_path, "".join(f"{name} 0 --x\n" for name in statuses))
     finally:
         orphan.kill()
     assert done.returncode == 0, done.stderr
     said = [line.split(" ", 1)[1].split(",")[0] for line in done.stdout.splitlines()]
-    assert said == ["killed: resume", "killed: exit 0", "rebooted: resume", "rebooted: exit 0", "queue done"]
-    assert not (out / "orphan.log").exists()
-    assert (out / "running.status").read_text() == f"started {os.getpid()} {this_boot}\n"
-    assert (out / "old.status").read_text() == "started\n" and not (out / "running.log").exists()
+    assert said == ["killed: resume", "killed: exit 0", "rebooted: resume", "rebooted: exit 0",
+                    "reused: resume", "reused: exit 0", "queue done"]
+    for name in ("running", "orphan+1", "old"):  # left as they were
+        assert (out / f"{name}.status").read_text() == statuses[name] and not (out / f"{name}.log").exists()
+    assert (out / "killed.status").read_text() == "exit 0\n"
+    # while its transfer ran, the status named the part.sh that ran it, as the next call reads it
+    assert re.search(rf"^status=started [0-9]+ [0-9]+ {boot.read_text().strip()}$",
+                     (out / "killed.log").read_text(), re.M)

@@ -17,12 +17,13 @@
 # amendment edits the lines not yet started (and the resume of a stopped one: keep its ARGS,
 # or it trains something else into the same OUT/NAME). A started or skipped NAME leaves
 # OUT/NAME.status and is not run again, except one the cut-off stopped (`exit 3`, the status
-# of a transfer its --time-limit stopped) or one interrupted (`started PID BOOT` whose
+# of a transfer its --time-limit stopped) or one interrupted (`started PID START BOOT` whose
 # part.sh is gone: killed, or the machine restarted): the next part.sh over the same OUT and
 # queue resumes it first, from its runs' checkpoints (a later session's part, from the same
 # TREE so that its runs keep one commit; each start's line in the log names the commit it
-# ran). One whose part.sh, or its transfer, still runs is left to it. To run another NAME
-# again, delete its status file.
+# ran). One whose part.sh, or its transfer, still runs is left to it. (Telling which runs takes
+# Linux's /proc: elsewhere the status is a bare `started`, run again only once it is deleted.)
+# To run another NAME again, delete its status file.
 # Runs land in OUT/NAME (log OUT/NAME.log, each start appended) and in ./results, recording
 # TREE's commit; PYTHON (default ./.venv/bin/python) runs them.
 set -u
@@ -42,22 +43,40 @@ archive=$PWD/results
 
 stopped=3  # the exit status of a transfer its --time-limit stopped (craftsuite.cli.TIME_LIMIT_STATUS)
 ran=" "    # the NAMEs this call has taken up (run, skipped or not resumed): each at most once a call
-# this boot of the machine: a PID recorded in an earlier boot names no process now
 boot=$(cat /proc/sys/kernel/random/boot_id 2>/dev/null || echo unknown)
 
-due() {  # whether NAME is still to run: no status yet, stopped at a cut-off, or interrupted
-  # (its part.sh gone), and not taken up by this call
-  local status="" pid="" since=""
+identity() {  # PID -> "PID START BOOT": a PID is reused (by a later process, or after a restart),
+  # the three together are not; nothing where /proc cannot tell
+  local stat fields
+  stat=$(cat "/proc/$1/stat" 2>/dev/null) || return 1
+  read -ra fields <<< "${stat##*) }"  # the fields after the command's name, which may hold spaces
+  echo "$1 ${fields[19]} $boot"       # field 22: the start time, in clock ticks after boot
+}
+
+writing() {  # whether a process's command line holds `--out OUT/NAME`: a transfer still running
+  local cmdline args i
+  for cmdline in /proc/[0-9]*/cmdline; do
+    mapfile -d '' args 2>/dev/null < "$cmdline" || continue
+    for ((i = 0; i + 1 < ${#args[@]}; i++)); do
+      [[ ${args[i]} == --out && ${args[i + 1]} == "$out/$1" ]] && return 0
+    done
+  done
+  return 1
+}
+
+due() {  # whether NAME is still to run: no status yet, stopped at a cut-off, or interrupted,
+  # and not taken up by this call
+  local status="" pid=""
   [[ $ran == *" $1 "* ]] && return 1
   [ -e "$out/$1.status" ] || return 0
   read -r status < "$out/$1.status"
   [[ $status == "exit $stopped" ]] && return 0
-  read -r status pid since <<< "$status"
-  [[ $status == started && $pid =~ ^[0-9]+$ ]] || return 1  # finished, skipped, or of an older part.sh
-  [[ $since != "$boot" ]] && return 0
-  { kill -0 "$pid" 2>/dev/null || [ -e "/proc/$pid" ]; } && return 1  # (a process of another user's: alive)
-  # its part.sh is gone; a transfer it left running (part.sh killed alone) still owns OUT/NAME
-  ! pgrep -f -- "--out $out/$1\$" > /dev/null
+  [[ $status == "started "* ]] || return 1  # finished or skipped (or an older part.sh's bare `started`)
+  # interrupted: the part.sh that started it is gone (killed, or the machine restarted), and no
+  # transfer it left (a part.sh killed alone) still writes to OUT/NAME
+  read -r _ pid _ <<< "$status"
+  [[ $(identity "$pid") == "${status#started }" ]] && return 1
+  ! writing "$1"
 }
 
 next() {  # the queue's first line still due (resumable ones first); every line checked first
@@ -77,6 +96,7 @@ next() {  # the queue's first line still due (resumable ones first); every line 
 }
 
 next > /dev/null || exit 2  # a bad queue is refused before anything is made
+me=$(identity $$)
 mkdir -p "$out"
 
 while :; do
@@ -96,7 +116,7 @@ while :; do
     continue
   fi
   echo "$(date -u +%H:%M) $name: $verb, $left min left"
-  echo "started $$ $boot" > "$out/$name.status"
+  echo "started $me" > "$out/$name.status"  # bare where /proc cannot name this process
   echo "== part.sh: $verb $(date -u '+%Y-%m-%d %H:%M') UTC, commit $commit, $left min left" >> "$out/$name.log"
   # shellcheck disable=SC2086  # ARGS are words of the command, split as written in the queue
   (cd "$tree" && CRAFTSUITE_COMMIT=$commit "$py" -m craftsuite transfer $args --workers 1 --no-video \

@@ -167,7 +167,9 @@ def test_a_campaign_part_resumes_a_transfer_whose_part_sh_was_interrupted_and_le
     out = tmp_path / "out"
     out.mkdir()
 
-    def started(pid, start=None, on=boot.read_text().strip()):  # a status as part.sh writes it
+    this_boot = boot.read_text().strip()
+
+    def started(pid, start=None, on=this_boot):  # a status as part.sh writes it
         start = start or Path(f"/proc/{pid}/stat").read_text().rsplit(") ", 1)[1].split()[19]
         return f"started {pid} {start} {on}\n"
 
@@ -193,5 +195,5 @@ def test_a_campaign_part_resumes_a_transfer_whose_part_sh_was_interrupted_and_le
         assert (out / f"{name}.status").read_text() == statuses[name] and not (out / f"{name}.log").exists()
     assert (out / "killed.status").read_text() == "exit 0\n"
     # while its transfer ran, the status named the part.sh that ran it, as the next call reads it
-    assert re.search(rf"^status=started [0-9]+ [0-9]+ {boot.read_text().strip()}$",
+    assert re.search(rf"^status=started [0-9]+ [0-9]+ {this_boot}$",
                      (out / "killed.log").read_text(), re.M)

@@ -166,7 +166,6 @@ def test_a_campaign_part_resumes_a_transfer_whose_part_sh_was_interrupted_and_le
         pytest.skip("needs Linux's /proc")
     out = tmp_path / "out"
     out.mkdir()
-
     this_boot = boot.read_text().strip()
 
     def started(pid, start=None, on=this_boot):  # a status as part.sh writes it

@@ -116,7 +116,7 @@ while :; do
     continue
   fi
   echo "$(date -u +%H:%M) $name: $verb, $left min left"
-  echo "started $me" > "$out/$name.status"  # bare where /proc cannot name this process
+  echo "started${me:+ $me}" > "$out/$name.status"  # bare where /proc cannot name this process
   echo "== part.sh: $verb $(date -u '+%Y-%m-%d %H:%M') UTC, commit $commit, $left min left" >> "$out/$name.log"
   # shellcheck disable=SC2086  # ARGS are words of the command, split as written in the queue
   (cd "$tree" && CRAFTSUITE_COMMIT=$commit "$py" -m craftsuite transfer $args --workers 1 --no-video \

@@ -106,7 +106,7 @@ def _part(tmp_path, queue_text: str, cutoff: str | None = None):
 
 def test_a_campaign_part_runs_its_queue_in_order_and_skips_what_the_time_left_cannot_cover(tmp_path):
     done = _part(tmp_path, "# seeds 20-34\nfirst 0 --suite hard --tasks GoldMine\n"
-                           "long 100000 --suite hard --tasks DiamondMine\nsecond 0 --suite standard\n")
+                           "long 100000 --suite hard --tasks DiamondMine\nsecond 0 --suite standard --workers 2\n")
     assert done.returncode == 0, done.stderr
     said = [line.split(" ", 1)[1] for line in done.stdout.splitlines()]
     assert [s.split(":")[0] for s in said] == ["first", "first", "long", "second", "second", "queue done"]
@@ -115,10 +115,13 @@ def test_a_campaign_part_runs_its_queue_in_order_and_skips_what_the_time_left_ca
     first = (out / "first.log").read_text()
     commit = subprocess.run(["git", "-C", str(PART.parents[2]), "rev-parse", "HEAD"], capture_output=True,
                             text=True).stdout.strip()
-    assert f"pwd={PART.parents[2]} commit={commit} -m craftsuite transfer --suite hard --tasks GoldMine " in first
+    assert f"pwd={PART.parents[2]} commit={commit} -m craftsuite transfer --workers 1 --suite hard --tasks GoldMine " \
+        in first
     assert f"--archive {tmp_path / 'results'} --out {out / 'first'}" in first and "--time-limit " in first
     assert not (out / "long.log").exists() and (out / "long.status").read_text() == "skipped\n"
     assert (out / "second.status").read_text() == "exit 0\n"
+    # a line's own --workers comes after part.sh's one core, so the transfer takes it (argparse keeps the last)
+    assert "transfer --workers 1 --suite standard --workers 2 --no-video " in (out / "second.log").read_text()
     # run again over an amended queue: only the line not yet started runs
     again = _part(tmp_path, "first 0 --suite hard\nlong 0 --suite hard\nsecond 0 --suite standard\nthird 0 --x\n")
     ran = [line.split(" ", 1)[1].split(":")[0] for line in again.stdout.splitlines()]
@@ -142,7 +145,7 @@ def test_a_campaign_part_resumes_a_transfer_its_cut_off_stopped_in_its_next_call
                                                 "queue done"]
     log = (out / "long.log").read_text()
     assert log.count("== part.sh: start ") == 1 and log.count("== part.sh: resume ") == 1
-    assert log.count("-m craftsuite transfer --suite hard --stops") == 2  # the first call's lines kept
+    assert log.count("-m craftsuite transfer --workers 1 --suite hard --stops") == 2  # the first call's lines kept
     # one the time left cannot cover is not resumed, and stays resumable
     late = said(_part(tmp_path, "long 100000 --suite hard --stops\n"))
     assert late[0].startswith("long: not resumed") and late[0].endswith("needs 100000")

@@ -12,7 +12,10 @@
 # QUEUE holds one transfer a line, `NAME MINUTES ARGS...`: MINUTES is the least time left
 # at which it starts (its expected duration at the rate measured), ARGS the rest of its
 # `craftsuite transfer` command (--suite, --worlds, --tasks, --methods, --seeds, --members),
-# split at spaces (no quoting: a JSON argument does not fit on a queue line).
+# split at spaces (no quoting: a JSON argument does not fit on a queue line). A transfer
+# takes one core (`--workers 1`, one process a core) unless its ARGS say `--workers N`: a
+# cell split into N populations over N cores finishes within a session, where checkpoints
+# would not outlive a change of machine.
 # Lines starting with # are comments. The queue is read again before each transfer, so an
 # amendment edits the lines not yet started (and the resume of a stopped one: keep its ARGS,
 # or it trains something else into the same OUT/NAME). A started or skipped NAME leaves
@@ -119,7 +122,7 @@ while :; do
   echo "started${me:+ $me}" > "$out/$name.status"  # bare where /proc cannot name this process
   echo "== part.sh: $verb $(date -u '+%Y-%m-%d %H:%M') UTC, commit $commit, $left min left" >> "$out/$name.log"
   # shellcheck disable=SC2086  # ARGS are words of the command, split as written in the queue
-  (cd "$tree" && CRAFTSUITE_COMMIT=$commit "$py" -m craftsuite transfer $args --workers 1 --no-video \
+  (cd "$tree" && CRAFTSUITE_COMMIT=$commit "$py" -m craftsuite transfer --workers 1 $args --no-video \
     --time-limit "$left" --archive "$archive" --out "$out/$name") >> "$out/$name.log" 2>&1
   status=$?
   echo "exit $status" > "$out/$name.status"

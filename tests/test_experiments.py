@@ -86,22 +86,26 @@ def test_the_learner_regime_grid_rule_takes_the_largest_in_the_zone_else_the_nea
 PART = Path(__file__).resolve().parents[1] / "experiments" / "suite-campaign" / "part.sh"
 
 
-def _part(tmp_path, queue_text: str, cutoff: str | None = None):
+def _part(tmp_path, queue_text: str, cutoff: str | None = None, run=subprocess.run, **kwargs):
     """Runs part.sh over ``queue_text`` with a stand-in python that prints its command line and
     the status part.sh wrote for it (and exits as a transfer its time limit stopped where the
-    line says ``--stops``); by default its cut-off is this time tomorrow, in the dated form a
-    cut-off past midnight takes."""
+    line says ``--stops``; waits until the file HOLD names exists, where that is set); by
+    default its cut-off is this time tomorrow, in the dated form a cut-off past midnight takes.
+    ``run`` (subprocess.Popen: in the background) and ``kwargs`` go to the process."""
     from craftsuite.cli import TIME_LIMIT_STATUS
     cutoff = cutoff or time.strftime("%Y-%m-%d %H:%M", time.gmtime(time.time() + 86_400))
     stub = tmp_path / "python"
     stub.write_text('#!/bin/sh\necho "pwd=$PWD commit=$CRAFTSUITE_COMMIT $*"\n'
                     'for a; do last=$a; done; echo "status=$(cat "$last.status")"\n'  # --out OUT/NAME last
+                    'while [ -n "$HOLD" ] && [ ! -e "$HOLD" ]; do sleep 0.05; done\n'
                     f'case "$*" in *--stops*) exit {TIME_LIMIT_STATUS};; esac\n')
     stub.chmod(0o755)
     queue = tmp_path / "A.queue"
     queue.write_text(queue_text)
-    return subprocess.run(["bash", str(PART), str(PART.parents[2]), cutoff, "out", str(queue)], cwd=tmp_path,
-                          env={**os.environ, "PYTHON": str(stub)}, capture_output=True, text=True, timeout=60)
+    env = {**os.environ, "PYTHON": str(stub), **kwargs.pop("env", {})}
+    if run is subprocess.run:
+        kwargs = {"capture_output": True, "text": True, "timeout": 60} | kwargs
+    return run(["bash", str(PART), str(PART.parents[2]), cutoff, "out", str(queue)], cwd=tmp_path, env=env, **kwargs)
 
 
 def test_a_campaign_part_runs_its_queue_in_order_and_skips_what_the_time_left_cannot_cover(tmp_path):
@@ -161,6 +165,30 @@ def test_a_campaign_part_refuses_a_queue_line_without_minutes_and_a_cut_off_not_
     past = _part(tmp_path, "first 0 --suite hard\n", cutoff="00:00")
     assert past.returncode == 2 and "has passed" in past.stderr and "YYYY-MM-DD HH:MM" in past.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_a_second_campaign_part_over_the_same_out_is_refused_while_the_first_runs(tmp_path):
+    hold, out = tmp_path / "go", tmp_path / "out"
+    first = _part(tmp_path, "slow 0 --x\n", run=subprocess.Popen, env={"HOLD": str(hold)},
+                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        for _ in range(600):  # the first has started its transfer
+            if (out / "slow.status").exists() and (out / "slow.status").read_text().startswith("started"):
+                break
+            time.sleep(0.05)
+        second = _part(tmp_path, "slow 0 --x\nother 0 --x\n")
+        assert second.returncode == 2 and "another part.sh runs over OUT" in second.stderr
+        assert not (out / "other.status").exists()
+        # the lock is part.sh's own: killed alone, the transfer it left running holds none, and the
+        # next call runs the other lines and leaves that one to its transfer
+        first.kill()
+        first.wait(timeout=60)
+        third = _part(tmp_path, "slow 0 --x\nother 0 --x\n")
+        assert third.returncode == 0, third.stderr
+        assert (out / "other.status").read_text() == "exit 0\n"
+        assert (out / "slow.status").read_text().startswith("started")
+    finally:
+        hold.touch()
 
 
 def test_a_campaign_part_resumes_a_transfer_whose_part_sh_was_interrupted_and_leaves_a_running_one(tmp_path):

@@ -26,7 +26,8 @@
 # TREE so that its runs keep one commit; each start's line in the log names the commit it
 # ran). One whose part.sh, or its transfer, still runs is left to it. (Telling which runs takes
 # Linux's /proc: elsewhere the status is a bare `started`, run again only once it is deleted.)
-# To run another NAME again, delete its status file.
+# To run another NAME again, delete its status file. One part.sh runs over an OUT at a time:
+# a second call over it is refused while the first runs (with flock, which Linux has).
 # Runs land in OUT/NAME (log OUT/NAME.log, each start appended) and in ./results, recording
 # TREE's commit; PYTHON (default ./.venv/bin/python) runs them.
 set -u
@@ -101,6 +102,13 @@ next() {  # the queue's first line still due (resumable ones first); every line 
 next > /dev/null || exit 2  # a bad queue is refused before anything is made
 me=$(identity $$)
 mkdir -p "$out"
+# one part.sh over an OUT at a time: two would both take up its first due line and train it
+# twice into one OUT/NAME. The lock is this process's own (its transfers do not hold it), so a
+# transfer left running by a killed part.sh is not mistaken for it: `due` finds that one.
+if command -v flock > /dev/null; then
+  exec 9> "$out/.part.lock"
+  flock -n 9 || { echo "part.sh: another part.sh runs over OUT '$out': wait for it to end, or give this one another OUT" >&2; exit 2; }
+fi
 
 while :; do
   line=$(next) || exit 2
@@ -123,7 +131,7 @@ while :; do
   echo "== part.sh: $verb $(date -u '+%Y-%m-%d %H:%M') UTC, commit $commit, $left min left" >> "$out/$name.log"
   # shellcheck disable=SC2086  # ARGS are words of the command, split as written in the queue
   (cd "$tree" && CRAFTSUITE_COMMIT=$commit "$py" -m craftsuite transfer --workers 1 $args --no-video \
-    --time-limit "$left" --archive "$archive" --out "$out/$name") >> "$out/$name.log" 2>&1
+    --time-limit "$left" --archive "$archive" --out "$out/$name") >> "$out/$name.log" 2>&1 9>&-
   status=$?
   echo "exit $status" > "$out/$name.status"
   echo "$(date -u +%H:%M) $name: exit $status"

@@ -107,7 +107,10 @@ mkdir -p "$out"
 # transfer left running by a killed part.sh is not mistaken for it: `due` finds that one.
 if command -v flock > /dev/null; then
   exec 9> "$out/.part.lock"
-  flock -n 9 || { echo "part.sh: another part.sh runs over OUT '$out': wait for it to end, or give this one another OUT" >&2; exit 2; }
+  flock -n 9 || {
+    echo "part.sh: another part.sh runs over OUT '$out': wait for it to end, or give this one another OUT" >&2
+    exit 2
+  }
 fi
 
 while :; do

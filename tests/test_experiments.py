@@ -90,7 +90,8 @@ PART = Path(__file__).resolve().parents[1] / "experiments" / "suite-campaign" / 
 def _part(tmp_path, queue_text: str, cutoff: str | None = None, run=subprocess.run, **kwargs):
     """Runs part.sh over ``queue_text`` with a stand-in python that prints its command line and
     the status part.sh wrote for it (and exits as a transfer its time limit stopped where the
-    line says ``--stops``; waits until the file HOLD names exists, where that is set); by
+    line says ``--stops``, fails where it says ``--fails``, is killed by SIGKILL where it says
+    ``--killed``; waits until the file HOLD names exists, where that is set); by
     default its cut-off is this time tomorrow, in the dated form a cut-off past midnight takes.
     ``run`` (subprocess.Popen: in the background) and ``kwargs`` go to the process."""
     from craftsuite.cli import TIME_LIMIT_STATUS
@@ -99,7 +100,8 @@ def _part(tmp_path, queue_text: str, cutoff: str | None = None, run=subprocess.r
     stub.write_text('#!/bin/sh\necho "pwd=$PWD commit=$CRAFTSUITE_COMMIT $*"\n'
                     'for a; do last=$a; done; echo "status=$(cat "$last.status")"\n'  # --out OUT/NAME last
                     'while [ -n "$HOLD" ] && [ ! -e "$HOLD" ]; do sleep 0.05; done\n'
-                    f'case "$*" in *--stops*) exit {TIME_LIMIT_STATUS};; esac\n')
+                    f'case "$*" in *--stops*) exit {TIME_LIMIT_STATUS};; *--fails*) exit 1;; esac\n'
+                    'case "$*" in *--killed*) kill -9 $$;; esac\n')
     stub.chmod(0o755)
     queue = tmp_path / "A.queue"
     queue.write_text(queue_text)
@@ -155,6 +157,19 @@ def test_a_campaign_part_resumes_a_transfer_its_cut_off_stopped_in_its_next_call
     late = said(_part(tmp_path, "long 100000 --suite hard --stops\n"))
     assert late[0].startswith("long: not resumed") and late[0].endswith("needs 100000")
     assert (out / "long.status").read_text() == "exit 3\n" and (out / "long.log").read_text() == log
+
+
+def test_a_campaign_part_resumes_a_transfer_killed_by_a_signal_but_not_one_that_failed(tmp_path):
+    def said(done):
+        assert done.returncode == 0, done.stderr
+        return [line.split(" ", 1)[1].split(",")[0] for line in done.stdout.splitlines()]
+
+    queue = "oom 0 --suite hard --killed\nbug 0 --suite hard --fails\n"
+    assert said(_part(tmp_path, queue)) == ["oom: start", "oom: exit 137", "bug: start", "bug: exit 1", "queue done"]
+    # the next call takes up the one killed (as the kernel kills for memory), once a call, and
+    # leaves the one that failed on its own to whoever reads its log
+    assert said(_part(tmp_path, queue)) == ["oom: resume", "oom: exit 137", "queue done"]
+    assert (tmp_path / "out" / "bug.log").read_text().count("== part.sh: ") == 1
 
 
 def test_a_campaign_part_refuses_a_queue_line_without_minutes_and_a_cut_off_not_ahead(tmp_path):

@@ -100,8 +100,8 @@ def _part(tmp_path, queue_text: str, cutoff: str | None = None, run=subprocess.r
     stub.write_text('#!/bin/sh\necho "pwd=$PWD commit=$CRAFTSUITE_COMMIT $*"\n'
                     'for a; do last=$a; done; echo "status=$(cat "$last.status")"\n'  # --out OUT/NAME last
                     'while [ -n "$HOLD" ] && [ ! -e "$HOLD" ]; do sleep 0.05; done\n'
-                    f'case "$*" in *--stops*) exit {TIME_LIMIT_STATUS};; *--fails*) exit 1;; esac\n'
-                    'case "$*" in *--killed*) kill -9 $$;; esac\n')
+                    f'case "$*" in *--stops*) exit {TIME_LIMIT_STATUS};; *--fails*) exit 1;; *--killed*) kill -9 $$;; '
+                    'esac\n')
     stub.chmod(0o755)
     queue = tmp_path / "A.queue"
     queue.write_text(queue_text)

@@ -69,17 +69,16 @@ writing() {  # whether a process's command line holds `--out OUT/NAME`: a transf
   return 1
 }
 
-due() {  # whether NAME is still to run: no status yet, stopped at a cut-off, or interrupted,
-  # and not taken up by this call
+due() {  # whether NAME is still to run: no status yet, stopped at a cut-off, killed by a
+  # signal, or interrupted, and not taken up by this call
   local status="" pid=""
   [[ $ran == *" $1 "* ]] && return 1
   [ -e "$out/$1.status" ] || return 0
   read -r status < "$out/$1.status"
-  [[ $status == "exit $stopped" ]] && return 0
-  # killed by a signal (128 + its number: 137 for the kernel's out-of-memory kill, 143 for a
-  # kill's TERM): its runs keep their checkpoints as at a cut-off; a transfer's own failure
-  # (1, or 2 for a refused command) is not taken up again
-  [[ $status =~ ^exit\ ([0-9]+)$ ]] && (( BASH_REMATCH[1] > 128 )) && return 0
+  # stopped at its cut-off, or killed by a signal (128 + its number: 137 for the kernel's
+  # out-of-memory kill, 143 for a kill's TERM): its runs keep their checkpoints either way; a
+  # transfer's own failure (1, or 2 for a refused command) is not taken up again
+  [[ $status =~ ^exit\ ([0-9]+)$ ]] && (( BASH_REMATCH[1] == stopped || BASH_REMATCH[1] > 128 )) && return 0
   [[ $status == "started "* ]] || return 1  # finished or skipped (or an older part.sh's bare `started`)
   # interrupted: the part.sh that started it is gone (killed, or the machine restarted), and no
   # transfer it left (a part.sh killed alone) still writes to OUT/NAME

@@ -28,7 +28,10 @@ The readings come from two places:
   An item names one setting of the distilled methods (the task, the world's name, the
   learner regime and the transitions per run) and the distilled side's seeds at each
   reading. A count below the seeds the entry has today adds a reading, unless the records
-  already give one at that count; one at or above them is of runs not here. An entry pooled
+  already give one at that count; one at or above them is of runs not here. A reading where
+  only the scratch side had grown since (the distilled side then as today) is named by both
+  sides' seeds, ``[10, 20]``: a pair adds a reading unless it is today's or the records'
+  own, or either side is above today's. An entry pooled
   from several archives counts the items of each. An item that names no runs of its
   archive is refused (``check``), so a misspelt name cannot pass for a reading.
 
@@ -77,11 +80,16 @@ def read(path) -> list[dict]:
         if not item["methods"] or not all(isinstance(m, str) for m in item["methods"]):
             raise ValueError(f"{where}: methods must name the distilled methods read, got {item['methods']!r} "
                              '(e.g. "methods": ["td3-dynamic"])')
-        if not item["read_at"] or not all(isinstance(n, int) and not isinstance(n, bool) and n > 0
+        if not item["read_at"] or not all(_seeds(n) or (isinstance(n, list) and len(n) == 2 and all(map(_seeds, n)))
                                           for n in item["read_at"]):
-            raise ValueError(f"{where}: read_at must list the seeds (whole numbers above 0) at each reading, got "
-                             f'{item["read_at"]!r} (e.g. "read_at": [5, 10])')
+            raise ValueError(f"{where}: read_at must list the seeds (whole numbers above 0) at each reading, the "
+                             f'distilled side\'s or a pair (distilled, scratch), got {item["read_at"]!r} '
+                             '(e.g. "read_at": [5, 10] or [[10, 20]])')
     return items
+
+
+def _seeds(n) -> bool:
+    return isinstance(n, int) and not isinstance(n, bool) and n > 0
 
 
 def readings(entry, baseline) -> list[tuple[int, int | None]]:
@@ -91,10 +99,12 @@ def readings(entry, baseline) -> list[tuple[int, int | None]]:
     says which readings count)."""
     now = (len(entry.seeds), len(baseline.seeds))
     recorded = [state for state in _parts(entry, baseline) if state != now]
-    known = {x for x, _ in recorded}
-    named = {n for path in _paths(entry) for item in read(path) if _names(item, entry)
-             for n in item["read_at"] if n < now[0] and n not in known}
-    return sorted(recorded + [(n, None) for n in named], key=lambda s: (s[0], s[1] or 0)) + [now]
+    named = [n for path in _paths(entry) for item in read(path) if _names(item, entry) for n in item["read_at"]]
+    pairs = {tuple(n) for n in named if isinstance(n, list) and n[0] <= now[0] and n[1] <= now[1]
+             and tuple(n) != now and tuple(n) not in recorded}
+    known = {x for x, _ in recorded} | {x for x, _ in pairs}
+    counts = {n for n in named if isinstance(n, int) and n < now[0] and n not in known}
+    return sorted(recorded + list(pairs) + [(n, None) for n in counts], key=lambda s: (s[0], s[1] or 0)) + [now]
 
 
 def looks(entry, baseline) -> int:

@@ -88,6 +88,26 @@ def test_each_part_that_added_seeds_to_either_side_was_a_reading(archive):
     assert compare(e["td3-dynamic"], e["td3"], looks=looks(e["td3-dynamic"], e["td3"])).level == stats.shared_level(4)
 
 
+def test_a_reading_named_by_both_sides_seeds_counts_where_only_scratch_grew_since(archive):
+    # both sides' runs at one commit (a part read part way, as its scratch side grew): the
+    # records give today's reading alone, and a distilled count cannot name 10 at 10 today
+    sessions(archive, "td3", range(10), ("aaa", "2026-01-01T10:00:00+00:00"))
+    sessions(archive, "td3-dynamic", range(10), ("aaa", "2026-01-01T10:00:00+00:00"))
+    write(archive, [item(read_at=[10])])
+    e = entries(archive)
+    assert readings(e["td3-dynamic"], e["td3"]) == [(10, 10)]
+    # [10, 10]: today's; [10, 12] and [12, 5]: a side above today's; [5, 3] twice: one reading
+    write(archive, [item(read_at=[[10, 4], [5, 3], [5, 3], [10, 10], [10, 12], [12, 5]])])
+    e = entries(archive)
+    assert readings(e["td3-dynamic"], e["td3"]) == [(5, 3), (10, 4), (10, 10)]
+    # a pair the records give already, and a distilled count a pair gives, add nothing
+    sessions(archive, "td3", range(5, 10), ("bbb", "2026-01-02T10:00:00+00:00"))
+    write(archive, [item(read_at=[[10, 5], [7, 2], 7])])
+    e = entries(archive)
+    assert readings(e["td3-dynamic"], e["td3"]) == [(7, 2), (10, 5), (10, 10)]
+    assert compare(e["td3-dynamic"], e["td3"], looks=looks(e["td3-dynamic"], e["td3"])).level == stats.shared_level(3)
+
+
 def test_a_commit_shortened_or_marked_dirty_is_one_part_and_so_are_runs_naming_none(archive):
     # archiving a part's first runs dirties the tree, so the rest of that part names the commit
     # dirty, and records name 8, 10 or 40 digits of it: one part, one reading after it
@@ -156,6 +176,9 @@ def test_an_item_that_names_no_runs_is_refused_by_name(archive, named, problem):
     ([item(methods="td3-dynamic")], "item 0: methods must be a list"),
     ([item(read_at=[0])], "item 0: read_at must list the seeds (whole numbers above 0)"),
     ([item(read_at=[])], "item 0: read_at must list the seeds"),
+    ([item(read_at=[[10]])], "item 0: read_at must list the seeds (whole numbers above 0) at each reading, the "
+                              "distilled side's or a pair (distilled, scratch), got [[10]]"),
+    ([item(read_at=[[10, 0]])], "or a pair (distilled, scratch), got [[10, 0]]"),
 ])
 def test_a_bad_looks_file_is_named_by_its_item_and_field(tmp_path, items, problem):
     path = tmp_path / "looks.json"

@@ -95,8 +95,8 @@ def _seeds(n) -> bool:
 def readings(entry, baseline) -> list[tuple[int, int | None]]:
     """The seeds (distilled, scratch) at each reading of ``entry`` (a distilled method's
     ``board.Entry``) against ``baseline`` (its scratch counterpart), the page's own last; a
-    reading only ``looks.json`` names has None for the scratch side (the module's docstring
-    says which readings count)."""
+    reading ``looks.json`` names by the distilled side's seeds alone has None for the scratch
+    side (the module's docstring says which readings count)."""
     now = (len(entry.seeds), len(baseline.seeds))
     recorded = [state for state in _parts(entry, baseline) if state != now]
     named = [n for path in _paths(entry) for item in read(path) if _names(item, entry) for n in item["read_at"]]

@@ -28,11 +28,11 @@ The readings come from two places:
   An item names one setting of the distilled methods (the task, the world's name, the
   learner regime and the transitions per run) and the distilled side's seeds at each
   reading. A count below the seeds the entry has today adds a reading, unless the records
-  already give one at that count; one at or above them is of runs not here. A reading where
-  only the scratch side had grown since (the distilled side then as today) is named by both
-  sides' seeds, ``[10, 20]``: a pair adds a reading unless it is today's or the records'
-  own, or either side is above today's. An entry pooled
-  from several archives counts the items of each. An item that names no runs of its
+  or a pair already give one at that count; one at or above them is of runs not here. Any
+  reading may instead be named by both sides' seeds, ``[10, 20]``, and one where only the
+  scratch side has grown since (the distilled side then as today) must be: a pair adds a
+  reading unless it is today's or the records' own, or either side is above today's. An
+  entry pooled from several archives counts the items of each. An item that names no runs of its
   archive is refused (``check``), so a misspelt name cannot pass for a reading.
 
 The count (``looks``) is those readings and the page's own. A comparison whose runs name no
@@ -83,7 +83,7 @@ def read(path) -> list[dict]:
         if not item["read_at"] or not all(_seeds(n) or (isinstance(n, list) and len(n) == 2 and all(map(_seeds, n)))
                                           for n in item["read_at"]):
             raise ValueError(f"{where}: read_at must list the seeds (whole numbers above 0) at each reading, the "
-                             f'distilled side\'s or a pair (distilled, scratch), got {item["read_at"]!r} '
+                             f'distilled side\'s or a pair [distilled, scratch], got {item["read_at"]!r} '
                              '(e.g. "read_at": [5, 10] or [[10, 20]])')
     return items
 

@@ -177,8 +177,8 @@ def test_an_item_that_names_no_runs_is_refused_by_name(archive, named, problem):
     ([item(read_at=[0])], "item 0: read_at must list the seeds (whole numbers above 0)"),
     ([item(read_at=[])], "item 0: read_at must list the seeds"),
     ([item(read_at=[[10]])], "item 0: read_at must list the seeds (whole numbers above 0) at each reading, the "
-                              "distilled side's or a pair (distilled, scratch), got [[10]]"),
-    ([item(read_at=[[10, 0]])], "or a pair (distilled, scratch), got [[10, 0]]"),
+                              "distilled side's or a pair [distilled, scratch], got [[10]]"),
+    ([item(read_at=[[10, 0]])], "or a pair [distilled, scratch], got [[10, 0]]"),
 ])
 def test_a_bad_looks_file_is_named_by_its_item_and_field(tmp_path, items, problem):
     path = tmp_path / "looks.json"

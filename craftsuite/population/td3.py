@@ -118,7 +118,9 @@ class PopulationTD3:
         if self.n_updates % delay == 0:
             actor_loss = -self.critics[0](th.cat([obs, self.actor(obs)], dim=2)).mean(dim=(1, 2))
             self.actor_optimizer.zero_grad()
-            actor_loss.sum().backward()
+            # the actor's gradients only: the critic's weight gradients (a third of the
+            # critic's backward) would be computed only to be cleared by the next critic step
+            actor_loss.sum().backward(inputs=list(self.actor.parameters()))
             self.actor_optimizer.step()
             polyak_update(self.critics.parameters(), self.critics_target.parameters(), self.tau)
             polyak_update(self.actor.parameters(), self.actor_target.parameters(), self.tau)

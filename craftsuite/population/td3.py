@@ -118,8 +118,8 @@ class PopulationTD3:
         if self.n_updates % delay == 0:
             actor_loss = -self.critics[0](th.cat([obs, self.actor(obs)], dim=2)).mean(dim=(1, 2))
             self.actor_optimizer.zero_grad()
-            # the actor's gradients only: the critic's weight gradients (a third of the
-            # critic's backward) would be computed only to be cleared by the next critic step
+            # the actor's gradients only: the first critic's parameter gradients (half of its
+            # backward: the weight products) would be computed only for the next critic step to clear
             actor_loss.sum().backward(inputs=list(self.actor.parameters()))
             self.actor_optimizer.step()
             polyak_update(self.critics.parameters(), self.critics_target.parameters(), self.tau)

@@ -19,6 +19,7 @@ import sys
 from pathlib import Path
 
 from craftsuite.files import atomic_write
+from craftsuite.provenance import cpu
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGE = ROOT / "docs" / "performance.md"
@@ -51,14 +52,9 @@ def add_page_argument(parser: argparse.ArgumentParser) -> None:
 
 
 def machine() -> str:
-    """Cores, CPU model, memory, Python and the load average now, in one line."""
-    model = ""
-    try:
-        model = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
-                      if line.startswith("model name")), "")
-    except OSError:
-        pass
-    model = model or platform.processor() or platform.machine()
+    """Cores, CPU (model and vector instructions: ``provenance.cpu``), memory, Python and the
+    load average now, in one line."""
+    model = cpu() or platform.processor() or platform.machine()
     memory = ""
     try:
         kib = int(Path("/proc/meminfo").read_text().split()[1])  # MemTotal comes first
@@ -66,7 +62,7 @@ def machine() -> str:
     except (OSError, ValueError, IndexError):
         pass
     load = f", load average {os.getloadavg()[0]:.2f}" if hasattr(os, "getloadavg") else ""
-    return (f"{os.cpu_count()} cores ({model}){memory}, {platform.system()} {platform.release()}, "
+    return (f"{os.cpu_count()} cores of {model}{memory}, {platform.system()} {platform.release()}, "
             f"Python {platform.python_version()}{load}")
 
 

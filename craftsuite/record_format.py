@@ -57,7 +57,8 @@ RESULT = (
     Field("seconds_share", "number >= 0", False, "the run's share of its training's wall time since step 0, in "
           "seconds: each session's, to its last checkpoint or the finish, divided among its population's members"),
     Field("members", "integer > 0", False, "the runs trained together as one population"),
-    Field("machine", "string", False, "the machine it finished on (system, cores, memory, Python)"),
+    Field("machine", "string", False,
+          "the machine it finished on (system, CPU and its widest vector instructions, cores, memory, Python)"),
 )
 EVALS = (
     Field("step", "integer in [0, steps]", True, "the transitions at the evaluation"),

@@ -171,3 +171,16 @@ def test_sessions_written_at_once_into_one_directory_are_all_kept(tmp_path, monk
         w.join()
     assert sorted(s["command"] for s in real(tmp_path)) == sorted(f"writer {n} session {i}" for n in range(6)
                                                                   for i in range(5))
+
+
+def test_the_machine_names_its_cpu_and_its_widest_vector_instructions():
+    from craftsuite.provenance import cpu
+
+    two = "processor\t: 0\nmodel name\t: AMD EPYC\nflags\t\t: fpu sse2 avx avx2 fma\n\n" \
+          "processor\t: 1\nmodel name\t: AMD EPYC\nflags\t\t: fpu sse2 avx avx2 fma\n"
+    assert cpu(two) == "AMD EPYC (AVX2)"
+    assert cpu(two.replace("avx2 fma", "avx2 fma avx512f avx512bw")) == "AMD EPYC (AVX-512)"
+    assert cpu("model name\t: Some CPU\nflags\t\t: fpu sse2\n") == "Some CPU"  # no AVX: the model alone
+    assert cpu("processor\t: 0\nBogoMIPS\t: 50.00\nFeatures\t: fp asimd\n") == ""  # no model or flags: nothing
+    assert cpu("") == ""
+    assert cpu() in provenance.machine()  # this machine's, as its records name it

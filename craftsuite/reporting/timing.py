@@ -12,16 +12,22 @@ from ..runs import RunError, read_config, read_result
 from .board import Board
 
 
-def _cores(machine: str | None, unknown: str) -> str:
-    """``2 cores`` from a machine as provenance describes it (``Linux x86_64, 2 cores, ...``)."""
-    found = re.search(r"(\d+) cores?", machine or "")
-    return f"{found.group(1)} cores" if found else unknown
+def _machine_kind(machine: str | None, unknown: str) -> str:
+    """What a machine as provenance describes it is counted under: its cores (``2 cores``),
+    and its CPU where it names one (``2 cores of AMD EPYC (AVX2)``, ``provenance.cpu``),
+    since machines of one core count have trained at rates 2-3x apart."""
+    parts = [part.strip() for part in (machine or "").split(",")]
+    for i, part in enumerate(parts):
+        found = re.fullmatch(r"(\d+) cores?", part)
+        if found:  # the part before it names the CPU, unless it is the first (the system)
+            return f"{found.group(1)} cores" + (f" of {parts[i - 1]}" if i > 1 else "")
+    return unknown
 
 
 def wall_time_lines(sessions: list[dict]) -> list[str]:
     """The directory's training time as its sessions measured it, summed per kind of machine
-    (its cores): what running the suite's cells here took. Sessions that did not finish are
-    counted apart (their time is not known)."""
+    (its cores, and its CPU where recorded: ``_machine_kind``): what running the suite's cells
+    here took. Sessions that did not finish are counted apart (their time is not known)."""
     took: dict[str, float] = {}
     unfinished = 0
     for s in sessions:
@@ -30,7 +36,7 @@ def wall_time_lines(sessions: list[dict]) -> list[str]:
         if s.get("seconds") is None:
             unfinished += 1
             continue
-        kind = _cores(s.get("machine"), "machine unknown")
+        kind = _machine_kind(s.get("machine"), "machine unknown")
         took[kind] = took.get(kind, 0.0) + s["seconds"]
     if not took:
         return []
@@ -61,14 +67,14 @@ def _timed(board: Board):
 
 def training_time_lines(board: Board) -> list[str]:
     """The training time the board's runs record, per learner regime and per the machine
-    (its cores) and device each finished on: each run's share of its populations' wall time
+    (``_machine_kind``) and device each finished on: each run's share of its populations' wall time
     (``_timed``), so that a population counts once. On a machine that runs one population
     per core, the wall time is about this divided by the cores. Runs whose share covers
     only their last session are counted apart."""
     took: dict[str, dict[str, float]] = {}  # regime -> machine and device -> seconds
     runs = partial = 0
     for entry, result, share, whole in _timed(board):
-        kind = (f"{_cores(result.get('machine'), 'machine not recorded')}, "
+        kind = (f"{_machine_kind(result.get('machine'), 'machine not recorded')}, "
                 f"{result.get('device', 'device not recorded')}")
         mine = took.setdefault(entry.regime, {})
         mine[kind] = mine.get(kind, 0.0) + share

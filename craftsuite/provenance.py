@@ -48,7 +48,7 @@ def git_commit() -> str | None:
 
 
 def machine() -> str:
-    """e.g. ``Linux x86_64, AMD EPYC (AVX2), 2 cores, 23.4 GiB, Python 3.11.7``."""
+    """e.g. ``Linux x86_64, AMD EPYC (family 23 model 1, AVX2), 2 cores, 23.4 GiB, Python 3.11.7``."""
     memory = ""
     try:
         memory = f", {os.sysconf('SC_PAGE_SIZE') * os.sysconf('SC_PHYS_PAGES') / 2**30:.1f} GiB"
@@ -64,24 +64,27 @@ VECTOR_FLAGS = (("avx512f", "AVX-512"), ("avx2", "AVX2"), ("avx", "AVX"))
 
 
 def cpu(cpuinfo: str | None = None) -> str:
-    """The CPU's model and the widest vector instructions it offers, e.g. ``AMD EPYC (AVX2)``,
-    from ``/proc/cpuinfo`` (``cpuinfo``: its text); "" where there is none. Two machines
-    both described as 2 AMD EPYC cores have trained one population of TD3 students 2.7x
-    apart (1,264 s and about 3,460 s for FirstWood's five 250k-transition runs), so a record
-    names what tells such machines apart: the matrix products, most of a student's time,
-    run on the vector instructions."""
+    """The CPU as ``/proc/cpuinfo`` (``cpuinfo``: its text) describes its first processor:
+    its model, family and model numbers, and the widest vector instructions it offers, e.g.
+    ``AMD EPYC (family 23 model 1, AVX2)``; "" where there is no such file. Machines of one
+    core count train students at rates several times apart, and a virtual machine's model
+    name may be generic (``AMD EPYC``): the numbers tell its generation, and the vector
+    instructions what the matrix products, most of a student's time, run on."""
     if cpuinfo is None:
         try:
-            cpuinfo = Path("/proc/cpuinfo").read_text()
+            cpuinfo = Path("/proc/cpuinfo").read_text(errors="replace")
         except OSError:
             return ""
     fields = {}
     for line in cpuinfo.splitlines():
         key, _, value = line.partition(":")
         fields.setdefault(key.strip(), value.strip())  # the first processor's
-    model, flags = fields.get("model name", ""), set(fields.get("flags", "").split())
-    vector = next((name for flag, name in VECTOR_FLAGS if flag in flags), "")
-    return f"{model} ({vector})" if model and vector else model or vector
+    flags = set(fields.get("flags", "").split())
+    numbers = (f"family {fields['cpu family']} model {fields['model']}"
+               if fields.get("cpu family") and fields.get("model") else "")
+    details = ", ".join(filter(None, [numbers, next((name for flag, name in VECTOR_FLAGS if flag in flags), "")]))
+    model = fields.get("model name", "")
+    return f"{model} ({details})" if model and details else model or details
 
 
 def versions() -> dict[str, str]:

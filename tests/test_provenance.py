@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import os
+import platform
 from pathlib import Path
 import sys
 import pytest
@@ -175,12 +177,19 @@ def test_sessions_written_at_once_into_one_directory_are_all_kept(tmp_path, monk
 
 def test_the_machine_names_its_cpu_and_its_widest_vector_instructions():
     from craftsuite.provenance import cpu
+    from craftsuite.reporting.timing import _machine_kind
 
-    two = "processor\t: 0\nmodel name\t: AMD EPYC\nflags\t\t: fpu sse2 avx avx2 fma\n\n" \
-          "processor\t: 1\nmodel name\t: AMD EPYC\nflags\t\t: fpu sse2 avx avx2 fma\n"
-    assert cpu(two) == "AMD EPYC (AVX2)"
-    assert cpu(two.replace("avx2 fma", "avx2 fma avx512f avx512bw")) == "AMD EPYC (AVX-512)"
-    assert cpu("model name\t: Some CPU\nflags\t\t: fpu sse2\n") == "Some CPU"  # no AVX: the model alone
+    one = "model name\t: AMD EPYC\ncpu family\t: 23\nmodel\t\t: 1\nflags\t\t: fpu sse2 avx avx2 fma\n"
+    two = f"processor\t: 0\n{one}\nprocessor\t: 1\n{one.replace('avx2 fma', 'avx2 fma avx512f')}"
+    assert cpu(two) == "AMD EPYC (family 23 model 1, AVX2)"  # the first processor's
+    assert cpu(one.replace("avx2 fma", "avx2 fma avx512f avx512bw")) == "AMD EPYC (family 23 model 1, AVX-512)"
+    assert cpu("model name\t: Some CPU\nflags\t\t: fpu sse2\n") == "Some CPU"  # nothing more known: the model
     assert cpu("processor\t: 0\nBogoMIPS\t: 50.00\nFeatures\t: fp asimd\n") == ""  # no model or flags: nothing
     assert cpu("") == ""
-    assert cpu() in provenance.machine()  # this machine's, as its records name it
+    # as the records name it, and as the timing lines count it (a model may hold a comma)
+    here = provenance.machine()
+    assert here.startswith(f"{platform.system()} {platform.machine()}, ") and f", {os.cpu_count()} cores, " in here
+    assert _machine_kind(here, "?") == f"{os.cpu_count()} cores" + (f" of {cpu()}" if cpu() else "")
+    assert _machine_kind("Linux x86_64, Foo, Bar CPU (AVX), 2 cores, 8 GiB", "?") == "2 cores of Foo, Bar CPU (AVX)"
+    assert _machine_kind("Linux x86_64, 2 cores, 23.5 GiB, Python 3.11.7", "?") == "2 cores"  # an older record
+    assert _machine_kind("Linux", "?") == _machine_kind(None, "?") == "?"

@@ -14,13 +14,13 @@ from .board import Board
 
 def _machine_kind(machine: str | None, unknown: str) -> str:
     """What a machine as provenance describes it is counted under: its cores (``2 cores``),
-    and its CPU where it names one (``2 cores of AMD EPYC (AVX2)``, ``provenance.cpu``),
-    since machines of one core count have trained at rates 2-3x apart."""
+    and its CPU where it names one (``2 cores of AMD EPYC (family 23 model 1, AVX2)``,
+    ``provenance.cpu``), since machines of one core count train at rates several times apart."""
     parts = [part.strip() for part in (machine or "").split(",")]
     for i, part in enumerate(parts):
         found = re.fullmatch(r"(\d+) cores?", part)
-        if found:  # the part before it names the CPU, unless it is the first (the system)
-            return f"{found.group(1)} cores" + (f" of {parts[i - 1]}" if i > 1 else "")
+        if found:  # what lies between the system (the first part) and the cores names the CPU
+            return f"{found.group(1)} cores" + (f" of {', '.join(parts[1:i])}" if i > 1 else "")
     return unknown
 
 
@@ -42,7 +42,7 @@ def wall_time_lines(sessions: list[dict]) -> list[str]:
         return []
     parts = [f"{seconds / 3600:.1f} h on {kind}" for kind, seconds in sorted(took.items())]
     return [f"- Wall time of the sessions that trained these runs: {', '.join(parts)}"
-            + (f" ({unfinished} session{'s' if unfinished > 1 else ''} not finished, not counted)" if unfinished
+            + (f"; {unfinished} session{'s' if unfinished > 1 else ''} not finished, not counted" if unfinished
                else "")]
 
 

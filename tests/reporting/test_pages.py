@@ -188,11 +188,11 @@ def test_the_wall_time_is_summed_per_kind_of_machine():
                 {"command": "craftsuite transfer --suite standard", "seconds": None, "machine": "Linux, 2 cores"},
                 {"command": "craftsuite archive out --suite standard", "seconds": 0.0, "machine": "Linux, 2 cores"},
                 {"command": "craftsuite transfer --suite standard", "seconds": 720.0,
-                 "machine": "Linux x86_64, AMD EPYC (AVX2), 2 cores, 23.5 GiB, Python 3.11.7"}]
+                 "machine": "Linux x86_64, AMD EPYC (family 23 model 1, AVX2), 2 cores, 23.5 GiB, Python 3.11.7"}]
     # machines of one core count apart where their records name the CPU, together where not
     assert wall_time_lines(sessions) == ["- Wall time of the sessions that trained these runs: 0.1 h on 16 cores, "
-                                         "1.5 h on 2 cores, 0.2 h on 2 cores of AMD EPYC (AVX2) (1 session not "
-                                         "finished, not counted)"]
+                                         "1.5 h on 2 cores, 0.2 h on 2 cores of AMD EPYC (family 23 model 1, "
+                                         "AVX2); 1 session not finished, not counted"]
     assert wall_time_lines(sessions[4:5]) == []
 
 

@@ -29,9 +29,10 @@ The readings come from two places:
   learner regime and the transitions per run) and the distilled side's seeds at each
   reading. A count below the seeds the entry has today adds a reading, unless the records
   or a pair already give one at that count; one at or above them is of runs not here. Any
-  reading may instead be named by both sides' seeds, ``[10, 20]``, and one where only the
-  scratch side has grown since (the distilled side then as today) must be: a pair adds a
-  reading unless it is today's or the records' own, or either side is above today's. An
+  reading may instead be named by both sides' seeds, ``{"distilled": 10, "scratch": 20}``
+  (by name: a bare pair would not say which side is which), and one where only the scratch
+  side has grown since (the distilled side then as today) must be: a pair adds a reading
+  unless it is today's or the records' own, or either side is above today's. An
   entry pooled from several archives counts the items of each. An item that names no runs of its
   archive is refused (``check``), so a misspelt name cannot pass for a reading.
 
@@ -48,6 +49,8 @@ from pathlib import Path
 FILE = "looks.json"
 FIELDS = {"task": str, "world": str, "regime": str, "budget": int, "methods": list, "read_at": list}
 KINDS = {str: "a text", int: "a whole number", list: "a list"}
+SIDES = ("distilled", "scratch")  # a reading named by both sides' seeds: an object with these keys
+PAIR = '{"distilled": 10, "scratch": 20}'
 EXAMPLE = ('{"task": "ToolHome", "world": "Cont", "regime": "n-step-wide", "budget": 250000, '
            '"methods": ["td3-dynamic"], "read_at": [5, 10]}')
 
@@ -80,16 +83,20 @@ def read(path) -> list[dict]:
         if not item["methods"] or not all(isinstance(m, str) for m in item["methods"]):
             raise ValueError(f"{where}: methods must name the distilled methods read, got {item['methods']!r} "
                              '(e.g. "methods": ["td3-dynamic"])')
-        if not item["read_at"] or not all(_seeds(n) or (isinstance(n, list) and len(n) == 2 and all(map(_seeds, n)))
-                                          for n in item["read_at"]):
+        if not item["read_at"] or not all(_seeds(n) or _pair(n) for n in item["read_at"]):
             raise ValueError(f"{where}: read_at must list the seeds (whole numbers above 0) at each reading, the "
-                             f'distilled side\'s or a pair [distilled, scratch], got {item["read_at"]!r} '
-                             '(e.g. "read_at": [5, 10] or [[10, 20]])')
+                             f'distilled side\'s or both sides\' by name, got {item["read_at"]!r} '
+                             f'(e.g. "read_at": [5, 10] or [{PAIR}])')
     return items
 
 
 def _seeds(n) -> bool:
     return isinstance(n, int) and not isinstance(n, bool) and n > 0
+
+
+def _pair(n) -> bool:
+    """Whether ``n`` names a reading by both sides' seeds, ``{"distilled": 10, "scratch": 20}``."""
+    return isinstance(n, dict) and set(n) == set(SIDES) and all(_seeds(n[side]) for side in SIDES)
 
 
 def readings(entry, baseline) -> list[tuple[int, int | None]]:
@@ -100,8 +107,8 @@ def readings(entry, baseline) -> list[tuple[int, int | None]]:
     now = (len(entry.seeds), len(baseline.seeds))
     recorded = [state for state in _parts(entry, baseline) if state != now]
     named = [n for path in _paths(entry) for item in read(path) if _names(item, entry) for n in item["read_at"]]
-    pairs = {tuple(n) for n in named if isinstance(n, list) and n[0] <= now[0] and n[1] <= now[1]
-             and tuple(n) != now and tuple(n) not in recorded}
+    pairs = {(n["distilled"], n["scratch"]) for n in named if isinstance(n, dict)}
+    pairs = {n for n in pairs if n[0] <= now[0] and n[1] <= now[1] and n != now and n not in recorded}
     known = {x for x, _ in recorded} | {x for x, _ in pairs}
     counts = {n for n in named if isinstance(n, int) and n < now[0] and n not in known}
     return sorted(recorded + list(pairs) + [(n, None) for n in counts], key=lambda s: (s[0], s[1] or 0)) + [now]

@@ -45,6 +45,11 @@ def sessions(root, method, seeds, *parts):
         (run / "config.json").write_text(json.dumps(config))
 
 
+def pair(distilled, scratch):
+    """A reading named by both sides' seeds, as looks.json names it."""
+    return {"distilled": distilled, "scratch": scratch}
+
+
 def item(method="td3-dynamic", read_at=(5,), **changes):
     """A looks.json item naming the fixture's ToolHome runs (one-step, 1,000 transitions)."""
     return {"task": "ToolHome", "world": "Cont", "regime": "one-step", "budget": 1000, "methods": [method],
@@ -97,12 +102,12 @@ def test_a_reading_named_by_both_sides_seeds_counts_where_only_scratch_grew_sinc
     e = entries(archive)
     assert readings(e["td3-dynamic"], e["td3"]) == [(10, 10)]
     # [10, 10]: today's; [10, 12] and [12, 5]: a side above today's; [5, 3] twice: one reading
-    write(archive, [item(read_at=[[10, 4], [5, 3], [5, 3], [10, 10], [10, 12], [12, 5]])])
+    write(archive, [item(read_at=[pair(10, 4), pair(5, 3), pair(5, 3), pair(10, 10), pair(10, 12), pair(12, 5)])])
     e = entries(archive)
     assert readings(e["td3-dynamic"], e["td3"]) == [(5, 3), (10, 4), (10, 10)]
     # a pair the records give already, and a distilled count a pair gives, add nothing
     sessions(archive, "td3", range(5, 10), ("bbb", "2026-01-02T10:00:00+00:00"))
-    write(archive, [item(read_at=[[10, 5], [7, 2], 7])])
+    write(archive, [item(read_at=[pair(10, 5), pair(7, 2), 7])])
     e = entries(archive)
     assert readings(e["td3-dynamic"], e["td3"]) == [(7, 2), (10, 5), (10, 10)]
     assert compare(e["td3-dynamic"], e["td3"], looks=looks(e["td3-dynamic"], e["td3"])).level == stats.shared_level(3)
@@ -176,9 +181,12 @@ def test_an_item_that_names_no_runs_is_refused_by_name(archive, named, problem):
     ([item(methods="td3-dynamic")], "item 0: methods must be a list"),
     ([item(read_at=[0])], "item 0: read_at must list the seeds (whole numbers above 0)"),
     ([item(read_at=[])], "item 0: read_at must list the seeds"),
-    ([item(read_at=[[10]])], "item 0: read_at must list the seeds (whole numbers above 0) at each reading, the "
-                              "distilled side's or a pair [distilled, scratch], got [[10]]"),
-    ([item(read_at=[[10, 0]])], "or a pair [distilled, scratch], got [[10, 0]]"),
+    ([item(read_at=[[10, 20]])], "item 0: read_at must list the seeds (whole numbers above 0) at each reading, the "
+                                  "distilled side's or both sides' by name, got [[10, 20]] (e.g. \"read_at\": [5, 10] "
+                                  'or [{"distilled": 10, "scratch": 20}])'),
+    ([item(read_at=[pair(10, 0)])], "or both sides' by name, got [{'distilled': 10, 'scratch': 0}]"),
+    ([item(read_at=[{"distilled": 10}])], "or both sides' by name, got [{'distilled': 10}]"),
+    ([item(read_at=[{**pair(10, 20), "baseline": 20}])], "or both sides' by name"),
 ])
 def test_a_bad_looks_file_is_named_by_its_item_and_field(tmp_path, items, problem):
     path = tmp_path / "looks.json"

@@ -84,8 +84,8 @@ def scratch_success(results) -> dict[str, list[str]]:
 
     out: dict[str, list[str]] = {}
     for students in sorted(Path(results).glob("*/students")) if results is not None else []:
-        for e in build(students):
-            if e.method == "td3" and e.world == CONT and not e.world_kwargs:
+        for e in build(students, keep=lambda config: config.get("method") == "td3"):
+            if e.world == CONT and not e.world_kwargs:
                 s = e.stats["success"]
                 interval = f" [{s.low:.2f}, {s.high:.2f}]" if s.has_interval else ""
                 out.setdefault(e.task, []).append(f"{s.value:.2f}{interval} at {e.budget / 1e6:g}M "

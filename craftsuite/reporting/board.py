@@ -274,13 +274,16 @@ class Board:
         return Board([e for e in self.entries if e.regime in mine], [u for u in self.unfinished if u.regime in mine])
 
 
-def build(students_root, *more, apart=None) -> Board:
+def build(students_root, *more, apart=None, keep=None) -> Board:
     """The leaderboard of the runs under ``students_root`` (and the ``more`` directories of
     runs beside it: one board of them all): one entry per task, world, method and setting
     (runs that differ in more than the seed are never pooled). A run whose record is
     damaged is left out and named in ``Board.unreadable``, as is a run found twice.
     ``apart``: a test of a run's ``config.json``; the runs it holds true for make a board of
-    their own, ``Board.apart`` (e.g. a suite's runs at a budget it no longer asks for)."""
+    their own, ``Board.apart`` (e.g. a suite's runs at a budget it no longer asks for).
+    ``keep``: a test of a run's ``config.json``; the runs it holds false for are not read
+    further, nor named if their logs are damaged or they are unfinished (a page about one
+    method reads its runs alone: a run's logs take far longer to read than its config)."""
     groups: dict[tuple, list[tuple[dict, dict]]] = {}
     set_apart: dict[tuple, list[tuple[dict, dict]]] = {}
     board = Board([])
@@ -306,8 +309,14 @@ def build(students_root, *more, apart=None) -> Board:
                                         "the run's record is damaged")
             continue
         try:
-            m = run_metrics(run)
             config = read_config(run)
+        except RunError as err:
+            board.unreadable.append(str(err))
+            continue
+        if keep is not None and not keep(config):  # outside the try: a test that fails is no damaged record
+            continue
+        try:
+            m = run_metrics(run)
             away = apart is not None and apart(config)
             if m is None:
                 if not (run / "result.json").exists() and run.name.startswith("student-"):

@@ -100,6 +100,22 @@ def test_unfinished_and_damaged_runs_are_listed_not_averaged(runs):
     assert damaged.joinpath("config.json").read_text() == "{torn"  # nothing on disk is touched
 
 
+def test_a_board_kept_to_some_runs_reads_no_other(runs):
+    damaged = fake_run(runs, "td3-dynamic", 8, [(1000, 1.0)], [(995, 1.0)])
+    (damaged / "evals.csv").write_text("step,success,return,episodes\nlate,1.0,0.0,10\n")
+    unfinished = runs / "student-BlindCraftsman-Cont-td3-dynamic-s9"
+    unfinished.mkdir()
+    (unfinished / "config.json").write_text(json.dumps({"task": "BlindCraftsman", "world": "Cont",
+                                                        "method": "td3-dynamic", "seed": 9, "steps": 1000}))
+    everything = build(runs)
+    assert len(everything.unreadable) == 1 and [u.seed for u in everything.unfinished] == [9]
+    kept = build(runs, keep=lambda config: config.get("method") == "td3")  # a teacher's config names none
+    assert [(e.method, e.seeds) for e in kept] == [("td3", [0, 1])]
+    assert not kept.unreadable and not kept.unfinished
+    [td3] = [e for e in everything if e.method == "td3"]
+    assert kept.entries[0].values == td3.values  # the runs kept read as on the whole board
+
+
 def test_a_run_recorded_by_an_older_version_loads_beside_new_ones_but_is_not_pooled_with_them(runs):
     # the fixture's runs are records without effective settings (format 1); these two are format 2
     for seed in (0, 1):

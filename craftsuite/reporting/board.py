@@ -282,8 +282,10 @@ def build(students_root, *more, apart=None, keep=None) -> Board:
     ``apart``: a test of a run's ``config.json``; the runs it holds true for make a board of
     their own, ``Board.apart`` (e.g. a suite's runs at a budget it no longer asks for).
     ``keep``: a test of a run's ``config.json``; the runs it holds false for are not read
-    further, nor named if their logs are damaged or they are unfinished (a page about one
-    method reads its runs alone: a run's logs take far longer to read than its config)."""
+    further, nor listed as unfinished or with damaged logs (a page about one method reads its
+    runs alone: a run's logs take far longer to read than its config); a config that does not
+    read, or a run found twice, is still named. Unlike ``apart``, whose failure names the run
+    damaged, a ``keep`` that raises raises: it is the caller's test that is at fault."""
     groups: dict[tuple, list[tuple[dict, dict]]] = {}
     set_apart: dict[tuple, list[tuple[dict, dict]]] = {}
     board = Board([])

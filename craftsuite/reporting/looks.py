@@ -50,7 +50,7 @@ FILE = "looks.json"
 FIELDS = {"task": str, "world": str, "regime": str, "budget": int, "methods": list, "read_at": list}
 KINDS = {str: "a text", int: "a whole number", list: "a list"}
 SIDES = ("distilled", "scratch")  # a reading named by both sides' seeds: an object with these keys
-PAIR = '{"distilled": 10, "scratch": 20}'
+PAIR = json.dumps(dict(zip(SIDES, (10, 20))))
 EXAMPLE = ('{"task": "ToolHome", "world": "Cont", "regime": "n-step-wide", "budget": 250000, '
            '"methods": ["td3-dynamic"], "read_at": [5, 10]}')
 
@@ -83,9 +83,13 @@ def read(path) -> list[dict]:
         if not item["methods"] or not all(isinstance(m, str) for m in item["methods"]):
             raise ValueError(f"{where}: methods must name the distilled methods read, got {item['methods']!r} "
                              '(e.g. "methods": ["td3-dynamic"])')
+        for n in item["read_at"]:
+            if isinstance(n, list) and len(n) == 2 and all(map(_seeds, n)):
+                raise ValueError(f"{where}: read_at's reading {json.dumps(n)} does not say which side is which; "
+                                 f"write it {json.dumps(dict(zip(SIDES, n)))}")
         if not item["read_at"] or not all(_seeds(n) or _pair(n) for n in item["read_at"]):
             raise ValueError(f"{where}: read_at must list the seeds (whole numbers above 0) at each reading, the "
-                             f'distilled side\'s or both sides\' by name, got {item["read_at"]!r} '
+                             f'distilled side\'s or both sides\' by name, got {json.dumps(item["read_at"])} '
                              f'(e.g. "read_at": [5, 10] or [{PAIR}])')
     return items
 
@@ -107,7 +111,7 @@ def readings(entry, baseline) -> list[tuple[int, int | None]]:
     now = (len(entry.seeds), len(baseline.seeds))
     recorded = [state for state in _parts(entry, baseline) if state != now]
     named = [n for path in _paths(entry) for item in read(path) if _names(item, entry) for n in item["read_at"]]
-    pairs = {(n["distilled"], n["scratch"]) for n in named if isinstance(n, dict)}
+    pairs = {tuple(n[side] for side in SIDES) for n in named if isinstance(n, dict)}
     pairs = {n for n in pairs if n[0] <= now[0] and n[1] <= now[1] and n != now and n not in recorded}
     known = {x for x, _ in recorded} | {x for x, _ in pairs}
     counts = {n for n in named if isinstance(n, int) and n < now[0] and n not in known}

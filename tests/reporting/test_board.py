@@ -114,6 +114,8 @@ def test_a_board_kept_to_some_runs_reads_no_other(runs):
     assert not kept.unreadable and not kept.unfinished
     [td3] = [e for e in everything if e.method == "td3"]
     assert kept.entries[0].values == td3.values  # the runs kept read as on the whole board
+    with pytest.raises(KeyError, match="method"):  # the caller's test at fault, not a record
+        build(runs, keep=lambda config: config["method"] == "td3")
 
 
 def test_a_run_recorded_by_an_older_version_loads_beside_new_ones_but_is_not_pooled_with_them(runs):

@@ -181,11 +181,13 @@ def test_an_item_that_names_no_runs_is_refused_by_name(archive, named, problem):
     ([item(methods="td3-dynamic")], "item 0: methods must be a list"),
     ([item(read_at=[0])], "item 0: read_at must list the seeds (whole numbers above 0)"),
     ([item(read_at=[])], "item 0: read_at must list the seeds"),
-    ([item(read_at=[[10, 20]])], "item 0: read_at must list the seeds (whole numbers above 0) at each reading, the "
-                                  "distilled side's or both sides' by name, got [[10, 20]] (e.g. \"read_at\": [5, 10] "
-                                  'or [{"distilled": 10, "scratch": 20}])'),
-    ([item(read_at=[pair(10, 0)])], "or both sides' by name, got [{'distilled': 10, 'scratch': 0}]"),
-    ([item(read_at=[{"distilled": 10}])], "or both sides' by name, got [{'distilled': 10}]"),
+    ([item(read_at=[5, [10, 20]])], "item 0: read_at's reading [10, 20] does not say which side is which; write it "
+                                     '{"distilled": 10, "scratch": 20}'),
+    ([item(read_at=[[10]])], "item 0: read_at must list the seeds (whole numbers above 0) at each reading, the "
+                              "distilled side's or both sides' by name, got [[10]] (e.g. \"read_at\": [5, 10] "
+                              'or [{"distilled": 10, "scratch": 20}])'),
+    ([item(read_at=[pair(10, 0)])], 'or both sides\' by name, got [{"distilled": 10, "scratch": 0}]'),
+    ([item(read_at=[{"distilled": 10}])], 'or both sides\' by name, got [{"distilled": 10}]'),
     ([item(read_at=[{**pair(10, 20), "baseline": 20}])], "or both sides' by name"),
 ])
 def test_a_bad_looks_file_is_named_by_its_item_and_field(tmp_path, items, problem):

@@ -502,6 +502,12 @@ class Comparison:
         word = self.verdict.split(",")[0]
         return word if word in ("ahead", "behind") else None
 
+    @property
+    def small(self) -> bool:
+        """An *ahead* or *behind* whose gap is real but smaller than ``SMALLEST_DIFFERENCE``
+        (the verdict says *, by less than 0.2*): a tally that counts it says so."""
+        return self.side is not None and self.verdict.endswith(f"by less than {SMALLEST_DIFFERENCE:g}")
+
 
 def probability_side(improvement: stats.Estimate, n: int, m: int) -> str | None:
     """"ahead" or "behind" where the probability of improvement's interval excludes one half,

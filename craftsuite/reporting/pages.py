@@ -314,24 +314,35 @@ def _pairs(board: Board) -> list[tuple[Entry, Entry]]:
 
 def decided_by_regime(pairs) -> dict[str, dict[str, int]]:
     """Per learner regime (a regime's runs are never pooled with another's), in the regimes'
-    order: the comparisons, how many say *ahead*, *behind* and *no difference*, and how many
-    of those were decided only because every seed of both sat at 0 or at 1."""
+    order: the comparisons, how many say *ahead*, *behind* and *no difference*, how many of
+    the *ahead* and *behind* by less than the smallest difference ("ahead by less", "behind
+    by less"), and how many were decided only because every seed of both sat at 0 or at 1."""
     tally: dict[str, dict[str, int]] = {}
     for entry, base, c in pairs:
         mine = tally.setdefault(entry.regime, {**dict.fromkeys(("comparisons", "ahead", "behind", "no difference",
-                                                                "trivial"), 0), "seeds to decide": []})
+                                                                "ahead by less", "behind by less", "trivial"), 0),
+                                               "seeds to decide": []})
         mine["comparisons"] += 1
         need = None if c is None else needed(c, entry, base)
         if need is not None:
             mine["seeds to decide"].append(need)
         if c is not None and c.decided:
             mine[c.side or "no difference"] += 1
+            if c.small:
+                mine[f"{c.side} by less"] += 1
             mine["trivial"] += c.trivial
     return {regime: tally[regime] for regime in sorted(tally, key=regime_order)}
 
 
 def _decided(t: dict[str, int]) -> int:
     return t["ahead"] + t["behind"] + t["no difference"]
+
+
+def _sided(t: dict[str, int], side: str) -> str:
+    """How many of a tally say ``side`` ("ahead" or "behind"), and how many of those by less
+    than the smallest difference: "7 (5 of them by less than 0.2)"."""
+    small = t[f"{side} by less"]
+    return f"{t[side]}" + (f" ({small} of them by less than {SMALLEST_DIFFERENCE:g})" if small else "")
 
 
 def _seeds_to_decide(c: Comparison, entry: Entry, base: Entry) -> str:
@@ -354,8 +365,8 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
                             if c is None else f"| {entry.budget:,} | {_cells(c, entry, base)} | "
                             f"{_cells(in_auc, entry, base)} |"))
     return ["| rung | world | learner regime | distilled − scratch | transitions per run "
-            "| difference in success [Welch t, 95% unless the verdict says] | P(distilled > scratch) [bootstrap] "
-            "| verdict | difference in AUC [Welch t] | P(distilled > scratch) in AUC | verdict in AUC |",
+            "| difference in success [Welch t] | P(distilled > scratch) [bootstrap] "
+            "| verdict | difference in AUC [Welch t] | P(distilled > scratch) in AUC [bootstrap] | verdict in AUC |",
             "|---|---|---|---|---|---|---|---|---|---|---|", *rows, "",
             f"Decided in final greedy success (ahead, behind, or no difference of {SMALLEST_DIFFERENCE:g} or more) "
             f"{_tally_text(pairs)}: *ahead*/*behind* where the two t-intervals are apart, or where the "
@@ -691,8 +702,9 @@ def _verdicts_text(pairs, metric: str = "success") -> str:
     """Per learner regime, how many of ``pairs`` (read in ``metric``) say each verdict, and
     what the undecided ones would need."""
     return "; ".join(
-        f"`{regime}` {t['comparisons']} comparison{'s' if t['comparisons'] > 1 else ''}: ahead on {t['ahead']}, "
-        f"behind on {t['behind']}, no difference of {SMALLEST_DIFFERENCE:g} or more on {t['no difference']} "
+        f"`{regime}` {t['comparisons']} comparison{'s' if t['comparisons'] > 1 else ''}: ahead on "
+        f"{_sided(t, 'ahead')}, behind on {_sided(t, 'behind')}, no difference of {SMALLEST_DIFFERENCE:g} or more "
+        f"on {t['no difference']} "
         f"({t['trivial']} of them only {_all_same(metric)}), undecided on "
         f"{t['comparisons'] - _decided(t)}" + _needed_range(t["seeds to decide"])
         for regime, t in decided_by_regime(pairs).items())
@@ -709,7 +721,7 @@ def _by_method_lines(pairs) -> list[str]:
         for regime, t in decided_by_regime([p for p in pairs if p[0].method == method]).items():
             rows.setdefault(regime, []).append(
                 f"`{method}` ({t['comparisons']} comparison{'s' if t['comparisons'] > 1 else ''}): ahead "
-                f"{t['ahead']}, behind {t['behind']}, no difference "
+                f"{_sided(t, 'ahead')}, behind {_sided(t, 'behind')}, no difference "
                 f"{t['no difference']} ({t['trivial']} only at all-0/all-1), "
                 f"undecided {t['comparisons'] - _decided(t)}")
     return [f"  - per distilled method, `{regime}`: " + "; ".join(parts)

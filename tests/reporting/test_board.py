@@ -486,11 +486,13 @@ def test_the_probability_of_improvement_alone_does_not_decide(tmp_path):
 
 def test_a_decided_gap_smaller_than_the_smallest_difference_is_named_as_small(tmp_path):
     from craftsuite.reporting.board import compare
-    from craftsuite.reporting.pages import comparisons, decided_by_regime
+    from craftsuite.reporting.pages import comparisons, decided_by_regime, summary_markdown
 
     for seed in range(5):  # every seed of scratch at 1; the distilled student a little short on most
         fake_run(tmp_path, "td3", seed, [(1000, 1.0)], [(950, 1.0)], task="ToolHome", world="Cont")
         fake_run(tmp_path, "td3-dynamic", seed, [(1000, (1.0, 0.9, 0.85, 0.95, 0.9)[seed])], [(950, 1.0)],
+                 task="ToolHome", world="Cont")
+        fake_run(tmp_path, "td3-static", seed, [(1000, (1.0, 0.9, 0.85, 0.95, 0.9)[seed])], [(950, 1.0)],
                  task="ToolHome", world="Cont")
         fake_run(tmp_path, "td3", seed, [(1000, 0.1)], [(950, 1.0)], task="FirstTool", world="Cont")  # a wide gap
         fake_run(tmp_path, "td3-dynamic", seed, [(1000, 0.9)], [(950, 1.0)], task="FirstTool", world="Cont")
@@ -499,9 +501,18 @@ def test_a_decided_gap_smaller_than_the_smallest_difference_is_named_as_small(tm
     small = compare(e["ToolHome", "td3-dynamic"], e["ToolHome", "td3"])
     assert small.verdict == "behind, by less than 0.2"
     assert -0.2 < small.difference.low and small.difference.high < 0.2 and small.improvement.high < 0.5
-    assert compare(e["FirstTool", "td3-dynamic"], e["FirstTool", "td3"]).verdict == "ahead"  # 0.8: no qualifier
-    [tally] = decided_by_regime(comparisons([board])).values()
-    assert (tally["ahead"], tally["behind"], tally["no difference"]) == (1, 1, 0)
+    wide = compare(e["FirstTool", "td3-dynamic"], e["FirstTool", "td3"])
+    assert wide.verdict == "ahead" and not wide.small and small.small  # 0.8: no qualifier
+    pairs = comparisons([board])
+    [tally] = decided_by_regime(pairs).values()
+    assert (tally["ahead"], tally["behind"], tally["no difference"]) == (1, 2, 0)
+    assert (tally["ahead by less"], tally["behind by less"]) == (0, 2)
+    # the summary's counts say which sided verdicts are small gaps, so that "behind on N" is not read as N large
+    # ones: in all, and per distilled method
+    short = "\n".join(summary_markdown(pairs, [], {}))
+    assert "ahead on 1, behind on 2 (2 of them by less than 0.2), no difference" in short
+    assert "`td3-dynamic` (2 comparisons): ahead 1, behind 1 (1 of them by less than 0.2)," in short
+    assert "`td3-static` (1 comparison): ahead 0, behind 1 (1 of them by less than 0.2)," in short
 
 
 def test_the_summary_says_how_many_seeds_the_undecided_comparisons_would_need(tmp_path):

@@ -340,9 +340,13 @@ def _decided(t: dict[str, int]) -> int:
 
 def _sided(t: dict[str, int], side: str) -> str:
     """How many of a tally say ``side`` ("ahead" or "behind"), and how many of those by less
-    than the smallest difference: "7 (5 of them by less than 0.2)"."""
-    small = t[f"{side} by less"]
-    return f"{t[side]}" + (f" ({small} of them by less than {SMALLEST_DIFFERENCE:g})" if small else "")
+    than the smallest difference, in words a reader does not take for *no difference*: "8 (5
+    of them a real gap under 0.2)"."""
+    small, n = t[f"{side} by less"], t[side]
+    if not small:
+        return f"{n}"
+    which = "a" if n == 1 else "all of them a" if small == n else f"{small} of them a"
+    return f"{n} ({which} real gap under {SMALLEST_DIFFERENCE:g})"
 
 
 def _seeds_to_decide(c: Comparison, entry: Entry, base: Entry) -> str:

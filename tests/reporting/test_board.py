@@ -498,11 +498,11 @@ def test_a_decided_gap_smaller_than_the_smallest_difference_is_named_as_small(tm
         fake_run(tmp_path, "td3-dynamic", seed, [(1000, 0.9)], [(950, 1.0)], task="FirstTool", world="Cont")
     board = build(tmp_path)
     e = {(x.task, x.method): x for x in board}
-    small = compare(e["ToolHome", "td3-dynamic"], e["ToolHome", "td3"])
-    assert small.verdict == "behind, by less than 0.2"
-    assert -0.2 < small.difference.low and small.difference.high < 0.2 and small.improvement.high < 0.5
+    close = compare(e["ToolHome", "td3-dynamic"], e["ToolHome", "td3"])
+    assert close.verdict == "behind, by less than 0.2"
+    assert -0.2 < close.difference.low and close.difference.high < 0.2 and close.improvement.high < 0.5
     wide = compare(e["FirstTool", "td3-dynamic"], e["FirstTool", "td3"])
-    assert wide.verdict == "ahead" and not wide.small and small.small  # 0.8: no qualifier
+    assert wide.verdict == "ahead" and not wide.small and close.small  # 0.8: no qualifier
     pairs = comparisons([board])
     [tally] = decided_by_regime(pairs).values()
     assert (tally["ahead"], tally["behind"], tally["no difference"]) == (1, 2, 0)
@@ -510,9 +510,12 @@ def test_a_decided_gap_smaller_than_the_smallest_difference_is_named_as_small(tm
     # the summary's counts say which sided verdicts are small gaps, so that "behind on N" is not read as N large
     # ones: in all, and per distilled method
     short = "\n".join(summary_markdown(pairs, [], {}))
-    assert "ahead on 1, behind on 2 (2 of them by less than 0.2), no difference" in short
-    assert "`td3-dynamic` (2 comparisons): ahead 1, behind 1 (1 of them by less than 0.2)," in short
-    assert "`td3-static` (1 comparison): ahead 0, behind 1 (1 of them by less than 0.2)," in short
+    assert "ahead on 1, behind on 2 (all of them a real gap under 0.2), no difference" in short
+    assert "`td3-dynamic` (2 comparisons): ahead 1, behind 1 (a real gap under 0.2)," in short
+    assert "`td3-static` (1 comparison): ahead 0, behind 1 (a real gap under 0.2)," in short
+    from craftsuite.reporting.pages import _sided
+
+    assert _sided({"behind": 8, "behind by less": 5}, "behind") == "8 (5 of them a real gap under 0.2)"
 
 
 def test_the_summary_says_how_many_seeds_the_undecided_comparisons_would_need(tmp_path):

@@ -486,7 +486,7 @@ def test_the_probability_of_improvement_alone_does_not_decide(tmp_path):
 
 def test_a_decided_gap_smaller_than_the_smallest_difference_is_named_as_small(tmp_path):
     from craftsuite.reporting.board import compare
-    from craftsuite.reporting.pages import comparisons, decided_by_regime, summary_markdown
+    from craftsuite.reporting.pages import _sided, comparisons, decided_by_regime, summary_markdown
 
     for seed in range(5):  # every seed of scratch at 1; the distilled student a little short on most
         fake_run(tmp_path, "td3", seed, [(1000, 1.0)], [(950, 1.0)], task="ToolHome", world="Cont")
@@ -513,8 +513,6 @@ def test_a_decided_gap_smaller_than_the_smallest_difference_is_named_as_small(tm
     assert "ahead on 1, behind on 2 (all of them a real gap under 0.2), no difference" in short
     assert "`td3-dynamic` (2 comparisons): ahead 1, behind 1 (a real gap under 0.2)," in short
     assert "`td3-static` (1 comparison): ahead 0, behind 1 (a real gap under 0.2)," in short
-    from craftsuite.reporting.pages import _sided
-
     assert _sided({"behind": 8, "behind by less": 5}, "behind") == "8 (5 of them a real gap under 0.2)"
 
 

@@ -477,7 +477,9 @@ class Comparison:
     # "undecided", "too few seeds"
     verdict: str
     trivial: bool = False  # decided only because every seed of both sat at 0 (or at 1)
-    note: str = ""  # what a trivial verdict rests on, "every seed of both at 1", said beside it
+    # what the verdict rests on where the row's cells do not show it, said beside it: "every
+    # seed of both at 1" (trivial), "the two methods' t-intervals apart"
+    note: str = ""
     # undecided: the seeds a side that would decide it at its next look (one more reading) if
     # the difference and spreads held (``stats.seeds_to_resolve``); None where decided or not to be said
     seeds_to_decide: int | None = None
@@ -536,6 +538,7 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
     mine, theirs = entry.values[metric], baseline.values[metric]
     level = stats.shared_level(looks)
     diff = stats.difference(mine, theirs, level)
+    note = ""
     try:
         better = stats.probability_of_improvement([mine], [theirs], level)
     except ValueError:  # fewer than 2 runs on a side
@@ -547,6 +550,11 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
         said = "too few seeds"
     elif apart in ("ahead", "behind"):
         said = apart
+        # the row's cells show the difference and the probability, not the two t-intervals:
+        # where those two would not have decided it, the row says what did
+        shown = probability_side(better, len(mine), len(theirs)) == apart and (
+            diff.low > 0 if apart == "ahead" else diff.high < 0)
+        note = "" if shown else "the two methods' t-intervals apart"
     # the probability's route alone errs up to twice its nominal 5% at 5-10 seeds a side
     # (benchmarks/verdict_error.py): it decides only where Welch's interval agrees
     elif probability_side(better, len(mine), len(theirs)) == "ahead" and diff.low > 0:
@@ -563,7 +571,7 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
             mine, theirs, SMALLEST_DIFFERENCE, stats.shared_level(looks + 1)))
     if said in ("ahead", "behind") and -SMALLEST_DIFFERENCE < diff.low and diff.high < SMALLEST_DIFFERENCE:
         said += f", by less than {SMALLEST_DIFFERENCE:g}"
-    return Comparison(diff, better, said, looks=looks)
+    return Comparison(diff, better, said, looks=looks, note=note)
 
 
 def distilled_against_scratch(rows: list[Entry], self_reported: bool = False) -> list[tuple[Entry, Entry]]:

@@ -88,13 +88,20 @@ def _fmt(estimate: stats.Estimate, digits: int = 2, signed: bool = False) -> str
 
 
 def _difference_text(estimate: stats.Estimate) -> str:
-    """A difference with its interval, to as many decimals (up to 4) as keep a bound that lies
-    either side of the smallest difference from printing as it: the verdicts read the bounds
-    unrounded, so "+0.20" could stand for an interval inside the band or one reaching past it."""
+    """A difference with its interval, to as many decimals (up to 4) as keep a bound from
+    printing as a line it does not sit on: the verdicts read the bounds unrounded, so "+0.20"
+    could stand for an interval inside the band or one reaching past it, and "-0.00" for an
+    interval that excludes zero (a real gap) or one that touches it."""
     digits = 2
     bounds = (estimate.low, estimate.high) if estimate.has_interval else ()
-    while digits < 4 and any(abs(b) != SMALLEST_DIFFERENCE and round(abs(b), digits) == SMALLEST_DIFFERENCE
-                             for b in bounds):
+    one_side = estimate.has_interval and (estimate.low > 0 or estimate.high < 0)
+
+    def blurred(b: float) -> bool:
+        at_band = abs(b) != SMALLEST_DIFFERENCE and round(abs(b), digits) == SMALLEST_DIFFERENCE
+        at_zero = one_side and round(b, digits) == 0
+        return at_band or at_zero
+
+    while digits < 4 and any(blurred(b) for b in bounds):
         digits += 1
     return _fmt(estimate, digits, signed=True)
 
@@ -373,7 +380,8 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
             "| verdict | difference in AUC [Welch t] | P(distilled > scratch) in AUC [bootstrap] | verdict in AUC |",
             "|---|---|---|---|---|---|---|---|---|---|---|", *rows, "",
             f"Decided in final greedy success (ahead, behind, or no difference of {SMALLEST_DIFFERENCE:g} or more) "
-            f"{_tally_text(pairs)}: *ahead*/*behind* where the two t-intervals are apart, or where the "
+            f"{_tally_text(pairs)}: *ahead*/*behind* where the two t-intervals are apart (a row that only they "
+            "decide says so), or where the "
             "probability's interval excludes one half and the difference's excludes 0 on the same side (the "
             "probability's interval alone errs up to twice its 5% at 5-10 seeds a side: docs/performance.md; "
             f"*by less than {SMALLEST_DIFFERENCE:g}* added where the difference's interval lies within "

@@ -370,6 +370,7 @@ def test_distilled_against_scratch_is_decided_only_where_the_seeds_say_so(tmp_pa
         return compare(e[task, "td3-dynamic"], e[task, "td3"])
 
     assert said("ToolHome").verdict == "behind" and said("ToolHome").difference.high < 0
+    assert said("ToolHome").note == ""  # the probability and the difference, as the row shows them, agree
     assert compare(e["ToolHome", "td3"], e["ToolHome", "td3-dynamic"]).verdict == "ahead"
     assert said("FirstTool").verdict == "no difference of 0.2 or more" and not said("FirstTool").trivial
     assert said("TwoToolsHome").verdict == "undecided" and not said("TwoToolsHome").decided
@@ -514,6 +515,23 @@ def test_a_decided_gap_smaller_than_the_smallest_difference_is_named_as_small(tm
     assert "`td3-dynamic` (2 comparisons): ahead 1, behind 1 (a real gap under 0.2)," in short
     assert "`td3-static` (1 comparison): ahead 0, behind 1 (a real gap under 0.2)," in short
     assert _sided({"behind": 8, "behind by less": 5}, "behind") == "8 (5 of them a real gap under 0.2)"
+
+
+def test_a_verdict_its_row_cannot_show_says_what_decided_it(tmp_path):
+    from craftsuite.reporting.board import compare
+
+    # 3 seeds a side: the probability does not count, so only the two t-intervals, apart, decide
+    for seed in range(3):
+        fake_run(tmp_path, "td3", seed, [(1000, 0.9 + seed / 100)], [(950, 1.0)], task="Reach", world="Cont")
+        fake_run(tmp_path, "td3-dynamic", seed, [(1000, 0.1 + seed / 100)], [(950, 1.0)], task="Reach", world="Cont")
+    e = {x.method: x for x in build(tmp_path)}
+    behind = compare(e["td3-dynamic"], e["td3"])
+    assert behind.said == "behind (the two methods' t-intervals apart)" and behind.improvement.high == 0.0
+    for seed in range(3, 5):  # at 5 a side the probability and the difference, as the row shows them, agree
+        fake_run(tmp_path, "td3", seed, [(1000, 0.9 + seed / 100)], [(950, 1.0)], task="Reach", world="Cont")
+        fake_run(tmp_path, "td3-dynamic", seed, [(1000, 0.1 + seed / 100)], [(950, 1.0)], task="Reach", world="Cont")
+    e = {x.method: x for x in build(tmp_path)}
+    assert compare(e["td3-dynamic"], e["td3"]).said == "behind"
 
 
 def test_the_summary_says_how_many_seeds_the_undecided_comparisons_would_need(tmp_path):

@@ -347,6 +347,17 @@ def test_a_difference_whose_bound_rounds_to_the_smallest_difference_prints_it_ap
     assert _difference_text(Estimate(-0.1, -0.2, 0.0)) == "-0.10 [-0.20, +0.00]"  # exactly on it reads as it is
 
 
+def test_a_difference_whose_interval_excludes_zero_never_prints_a_bound_of_zero():
+    from craftsuite.reporting.pages import _difference_text
+    from craftsuite.stats import Estimate
+
+    # a real gap (the interval one side of 0) shows the side its near bound lies on
+    assert _difference_text(Estimate(-0.01, -0.02, -0.003)) == "-0.010 [-0.020, -0.003]"
+    assert _difference_text(Estimate(0.04, 0.0004, 0.08)) == "+0.0400 [+0.0004, +0.0800]"
+    # an interval across 0 keeps two decimals: its bound near 0 says nothing the verdict reads
+    assert _difference_text(Estimate(-0.004, -0.01, 0.002)) == "-0.00 [-0.01, +0.00]"
+
+
 def test_a_page_of_two_directories_projects_at_one_rate_per_regime_and_world(tmp_path):
     """Each directory's coverage reads the rate of every directory's runs, not its own: the
     page's projections then agree with each other and with its planning table."""

@@ -478,7 +478,7 @@ class Comparison:
     verdict: str
     trivial: bool = False  # decided only because every seed of both sat at 0 (or at 1)
     # what the verdict rests on where the row's cells do not show it, said beside it: "every
-    # seed of both at 1" (trivial), "the two methods' t-intervals apart"
+    # seed of both at 1" (trivial), "the two means' t-intervals apart"
     note: str = ""
     # undecided: the seeds a side that would decide it at its next look (one more reading) if
     # the difference and spreads held (``stats.seeds_to_resolve``); None where decided or not to be said
@@ -554,7 +554,7 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
         # where those two would not have decided it, the row says what did
         shown = probability_side(better, len(mine), len(theirs)) == apart and (
             diff.low > 0 if apart == "ahead" else diff.high < 0)
-        note = "" if shown else "the two methods' t-intervals apart"
+        note = "" if shown else "the two means' t-intervals apart"
     # the probability's route alone errs up to twice its nominal 5% at 5-10 seeds a side
     # (benchmarks/verdict_error.py): it decides only where Welch's interval agrees
     elif probability_side(better, len(mine), len(theirs)) == "ahead" and diff.low > 0:

@@ -380,9 +380,10 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
             "| verdict | difference in AUC [Welch t] | P(distilled > scratch) in AUC [bootstrap] | verdict in AUC |",
             "|---|---|---|---|---|---|---|---|---|---|---|", *rows, "",
             f"Decided in final greedy success (ahead, behind, or no difference of {SMALLEST_DIFFERENCE:g} or more) "
-            f"{_tally_text(pairs)}: *ahead*/*behind* where the two t-intervals are apart (a row that only they "
-            "decide says so), or where the "
-            "probability's interval excludes one half and the difference's excludes 0 on the same side (the "
+            f"{_tally_text(pairs)}: *ahead*/*behind* where the two means' t-intervals are apart (a row its own "
+            "cells would not decide says so), or where the "
+            "probability's interval (counted from 5 seeds a side) excludes one half and the difference's excludes 0 "
+            "on the same side (the "
             "probability's interval alone errs up to twice its 5% at 5-10 seeds a side: docs/performance.md; "
             f"*by less than {SMALLEST_DIFFERENCE:g}* added where the difference's interval lies within "
             f"±{SMALLEST_DIFFERENCE:g} as well); "

@@ -544,6 +544,10 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
     except ValueError:  # fewer than 2 runs on a side
         better = stats.Estimate(math.nan)
     apart = _apart(*(stats.t_interval(values, level, bounds=METRICS[metric]) for values in (mine, theirs)))
+    # the probability's route alone errs up to twice its nominal 5% at 5-10 seeds a side
+    # (benchmarks/verdict_error.py): it decides only where Welch's interval agrees
+    side = probability_side(better, len(mine), len(theirs))
+    by_probability = side if (side == "ahead" and diff.low > 0) or (side == "behind" and diff.high < 0) else None
     if math.isnan(diff.value):
         said = "not measured"
     elif not (diff.has_interval and better.has_interval):
@@ -552,15 +556,9 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
         said = apart
         # the row's cells show the difference and the probability, not the two t-intervals:
         # where those two would not have decided it, the row says what did
-        shown = probability_side(better, len(mine), len(theirs)) == apart and (
-            diff.low > 0 if apart == "ahead" else diff.high < 0)
-        note = "" if shown else "the two means' t-intervals apart"
-    # the probability's route alone errs up to twice its nominal 5% at 5-10 seeds a side
-    # (benchmarks/verdict_error.py): it decides only where Welch's interval agrees
-    elif probability_side(better, len(mine), len(theirs)) == "ahead" and diff.low > 0:
-        said = "ahead"
-    elif probability_side(better, len(mine), len(theirs)) == "behind" and diff.high < 0:
-        said = "behind"
+        note = "" if by_probability == apart else "the two means' t-intervals apart"
+    elif by_probability:
+        said = by_probability
     elif -SMALLEST_DIFFERENCE < diff.low and diff.high < SMALLEST_DIFFERENCE:
         said = f"no difference of {SMALLEST_DIFFERENCE:g} or more"
         if {*mine, *theirs} in ({0.0}, {1.0}):  # said plainly: no comparison tells methods apart there

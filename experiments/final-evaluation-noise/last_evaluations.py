@@ -42,7 +42,7 @@ def at_last(entry: Entry, k: int) -> Entry:
 
 def word(verdict: str) -> str:
     """A verdict's word, its ", by less than 0.2" set aside."""
-    return next(w for w in WORDS if verdict.startswith(w)) if verdict.startswith(WORDS) else verdict
+    return next((w for w in WORDS if verdict.startswith(w)), verdict)
 
 
 def change(before: str, after: str) -> str | None:
@@ -69,7 +69,10 @@ def main(argv=None) -> None:
     if any(k < 1 for k in args.k):
         parser.error("--k: each k must be 1 or more (1 is the page's own read)")
 
-    boards = [read_runs(path, suite_cells=True).board for path in args.archives]
+    try:
+        boards = [read_runs(path, suite_cells=True).board for path in args.archives]
+    except (FileNotFoundError, ValueError) as err:  # a missing archive, or one with no finished run
+        parser.error(f"{err}: give suite archives such as results/standard")
 
     # 1. runs whose last evaluation stands apart from the mean of their last three
     apart: dict[str, list[int]] = {}

@@ -122,6 +122,11 @@ def main() -> None:
             runs = sorted(args.students.glob(f"student-{args.task}-{args.world}-{method}-s*"))
             if not runs:
                 sys.exit(f"no {method} runs of {args.task} {args.world} in {args.students}")
+            bare = [r.name for r in runs if not (r / "checkpoint" / "population.pt").is_file()]
+            if bare:  # an archive keeps records only: the runs of a transfer's --out have checkpoints
+                sys.exit(f"{len(bare)} {method} runs in {args.students} hold no checkpoint ({bare[0]}, ...: an "
+                         "archive keeps none); "
+                         "give the students directory of a transfer's --out whose runs still have theirs")
             found.append(measure(runs, args.rounds, args.updates, Path(scratch)))
             print(json.dumps(found[-1]), flush=True)
     if args.out:

@@ -25,6 +25,7 @@ GPU population; ``--only n-step-wide`` keeps the rows whose label holds that tex
 from __future__ import annotations
 
 import argparse
+import contextlib
 import multiprocessing
 import os
 import queue
@@ -68,6 +69,7 @@ def measure_population(method, env_id, n_envs, settings, env_kwargs, members: in
     from craftsuite.population import Population
     from craftsuite.population.engine import sparse_width
     from craftsuite.population.envs import make_envs
+    from craftsuite.population.train import cpu_settings
     from craftsuite.task_registry import resolve_task
 
     spec = resolve_task("BlindCraftsman")
@@ -84,23 +86,22 @@ def measure_population(method, env_id, n_envs, settings, env_kwargs, members: in
         obs = pop.step(envs, obs)[0]
         pop.train()
 
-    while pop.num_timesteps <= pop.learning_starts + 1_000:  # the warm-up, then some learning
-        step()
-    if ready is not None:
-        ready()
-    transitions, updates, start = pop.num_timesteps, pop.learner.n_updates, time.perf_counter()
-    while time.perf_counter() - start < seconds:
-        for _ in range(50):
+    # as the engine trains on the CPU: one thread, subnormals flushed
+    with cpu_settings() if device == "cpu" else contextlib.nullcontext():
+        while pop.num_timesteps <= pop.learning_starts + 1_000:  # the warm-up, then some learning
             step()
-    total = time.perf_counter() - start
+        if ready is not None:
+            ready()
+        transitions, updates, start = pop.num_timesteps, pop.learner.n_updates, time.perf_counter()
+        while time.perf_counter() - start < seconds:
+            for _ in range(50):
+                step()
+        total = time.perf_counter() - start
     envs.close()
     return members * (pop.num_timesteps - transitions) / total, members * (pop.learner.n_updates - updates) / total
 
 
 def _measure_in_process(row: tuple, members: int, seconds: float, start, results) -> None:
-    import torch
-
-    torch.set_num_threads(1)  # a spawned process starts with torch's default, one thread per core
     results.put(measure_population(*row, members, seconds, "cpu", ready=start.wait))
 
 

@@ -323,3 +323,25 @@ def test_an_experiment_sees_each_evaluation_through_the_hook(tmp_path):
     assert [s for s, _, _ in seen] == [400, 800, 1200] and all(k == 2 for _, k, _ in seen)
     for k, path in enumerate(paths):  # the results the hook saw are the ones each run recorded
         assert [round(float(r["success"]), 2) for r in read_csv(path / "evals.csv")] == [s[2][k] for s in seen]
+
+
+def test_a_cpu_population_trains_on_one_thread_with_subnormals_flushed_and_restores_both(tmp_path, monkeypatch):
+    # late in a run a sixth of the Adam moments are subnormal, slow to compute with on x86
+    seen, build = [], population_train.build_population
+
+    def spy(*args, **kwargs):
+        seen.append((th.get_num_threads(), population_train.flushing_subnormals()))
+        return build(*args, **kwargs)
+
+    monkeypatch.setattr(population_train, "build_population", spy)
+    threads = th.get_num_threads()
+    th.set_num_threads(2)
+    try:
+        assert not population_train.flushing_subnormals()  # torch's default: subnormals kept
+        train_population(_cell(seeds=(0,), steps=400), tmp_path, progress=False)
+        assert seen == [(1, th.set_flush_denormal(True))]  # False where the CPU cannot flush
+        th.set_flush_denormal(False)
+        assert (th.get_num_threads(), population_train.flushing_subnormals()) == (2, False)
+    finally:
+        th.set_flush_denormal(False)
+        th.set_num_threads(threads)

@@ -74,31 +74,35 @@ def measure_population(method, env_id, n_envs, settings, env_kwargs, members: in
 
     spec = resolve_task("BlindCraftsman")
     product = METHODS[method].product
-    envs = make_envs(env_id, members * n_envs, env_kwargs, product)
-    pop = Population(method, algorithm_settings(METHODS[method].algorithm, {**settings, "buffer_size": 200_000}),
-                     list(range(members)), n_envs, envs.single_observation_space.shape[0], envs.single_action_space,
-                     spec.automaton, spec.completion_reward, 10**7, device=device,
-                     sparse_width=sparse_width(spec, world_kind(parse_id(env_id)[1]), product))
-    obs, _ = envs.reset(seed=list(range(members * n_envs)))
-
-    def step():
-        nonlocal obs
-        obs = pop.step(envs, obs)[0]
-        pop.train()
-
     # as the engine trains on the CPU: one thread, subnormals flushed
     with cpu_settings() if device == "cpu" else contextlib.nullcontext():
-        while pop.num_timesteps <= pop.learning_starts + 1_000:  # the warm-up, then some learning
-            step()
-        if ready is not None:
-            ready()
-        transitions, updates, start = pop.num_timesteps, pop.learner.n_updates, time.perf_counter()
-        while time.perf_counter() - start < seconds:
-            for _ in range(50):
-                step()
-        total = time.perf_counter() - start
-    envs.close()
-    return members * (pop.num_timesteps - transitions) / total, members * (pop.learner.n_updates - updates) / total
+        envs = make_envs(env_id, members * n_envs, env_kwargs, product)
+        try:
+            algorithm = algorithm_settings(METHODS[method].algorithm, {**settings, "buffer_size": 200_000})
+            pop = Population(method, algorithm, list(range(members)), n_envs, envs.single_observation_space.shape[0],
+                             envs.single_action_space, spec.automaton, spec.completion_reward, 10**7, device=device,
+                             sparse_width=sparse_width(spec, world_kind(parse_id(env_id)[1]), product))
+            return _timed(pop, envs, seconds, ready)
+        finally:
+            envs.close()
+
+
+def _timed(pop, envs, seconds: float, ready) -> tuple[float, float]:
+    """``pop`` acting, stepping ``envs`` and learning: its warm-up, then about ``seconds`` timed;
+    transitions and updates per second, over all its members."""
+    obs, _ = envs.reset(seed=list(range(envs.num_envs)))
+    while pop.num_timesteps <= pop.learning_starts + 1_000:  # the warm-up, then some learning
+        obs = pop.step(envs, obs)[0]
+        pop.train()
+    if ready is not None:
+        ready()
+    transitions, updates, start = pop.num_timesteps, pop.learner.n_updates, time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        for _ in range(50):
+            obs = pop.step(envs, obs)[0]
+            pop.train()
+    total = time.perf_counter() - start
+    return pop.K * (pop.num_timesteps - transitions) / total, pop.K * (pop.learner.n_updates - updates) / total
 
 
 def _measure_in_process(row: tuple, members: int, seconds: float, start, results) -> None:

@@ -150,8 +150,8 @@ def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=No
 
 
 def flushing_subnormals() -> bool:
-    """Whether torch flushes subnormal floats to zero on this thread now (it has no getter)."""
-    return th.tensor(1e-40).mul(1.0).item() == 0.0
+    """Whether torch flushes subnormal float32s to zero on this thread now (it has no getter)."""
+    return th.tensor(1e-40, dtype=th.float32).mul(1.0).item() == 0.0
 
 
 @contextlib.contextmanager
@@ -159,12 +159,14 @@ def cpu_settings():
     """A CPU population's settings while it trains, the caller's restored after: one thread
     (small nets: one is fastest, and leaves the other cores to other cells) and subnormal
     floats flushed to zero. Late in a run about a sixth of the Adam moments are subnormal,
-    and arithmetic on them is slow on x86: flushed, an update costs a fifth less, and the
-    weights after a hundred of them were bit-identical (experiments/flush-denormal)."""
+    and arithmetic on them is slow on x86: flushed, an update costs a fifth less and leaves
+    the weights of 100 updates bit-identical (experiments/flush-denormal). The flush is a
+    setting of the calling thread, which with one torch thread does all the training's work
+    (the worlds' stepping too, in float64, where it changes nothing)."""
     threads, flushing = th.get_num_threads(), flushing_subnormals()
-    th.set_num_threads(1)
-    th.set_flush_denormal(True)  # False where the CPU cannot (not x86): then nothing changes
     try:
+        th.set_num_threads(1)
+        th.set_flush_denormal(True)  # False where the CPU cannot (not x86): then nothing changes
         yield
     finally:
         th.set_flush_denormal(flushing)

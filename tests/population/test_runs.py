@@ -335,13 +335,14 @@ def test_a_cpu_population_trains_on_one_thread_with_subnormals_flushed_and_resto
 
     monkeypatch.setattr(population_train, "build_population", spy)
     threads = th.get_num_threads()
-    th.set_num_threads(2)
+    can_flush = th.set_flush_denormal(True)  # False where the CPU cannot: then nothing is flushed
     try:
+        th.set_flush_denormal(False)
+        th.set_num_threads(2)
         assert not population_train.flushing_subnormals()  # torch's default: subnormals kept
         train_population(_cell(seeds=(0,), steps=400), tmp_path, progress=False)
-        assert seen == [(1, th.set_flush_denormal(True))]  # False where the CPU cannot flush
-        th.set_flush_denormal(False)
-        assert (th.get_num_threads(), population_train.flushing_subnormals()) == (2, False)
+        assert seen == [(1, can_flush)]
+        assert (th.get_num_threads(), population_train.flushing_subnormals()) == (2, False)  # the caller's again
     finally:
         th.set_flush_denormal(False)
         th.set_num_threads(threads)

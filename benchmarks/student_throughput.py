@@ -3,23 +3,27 @@
 Usage: python benchmarks/student_throughput.py [--seconds 10] [--members 5 10] [--at-once 2] [--only TEXT]
        [--device cpu] [--page PATH | --no-page]
 
-One process, one torch thread, Blind Craftsman: TD3 in the MuJoCo world and on the
-kinematic board, DQN on the 10x10 grid. Each row (``craftsuite.population``): the suites'
-regimes (``craftsuite.suites.TD3_REGIME`` / ``DQN_REGIME``: several envs per update, small
-networks) for ``--members`` seeds in one process (5: a suite's cell; 10: as many as the
-engines were compared with), collecting from one vector env, counted over all members,
-after the warm-up of random actions (``learning_starts``). The rows named after the learner
-regime add the standard and hard suites' regime (``craftsuite.regimes``: n-step targets,
-wider networks) to those settings: what the suites train now. Each row trains for about
-``--seconds``. The reference column is each row's target. On CPU the learner-regime rows are
-also measured as ``--at-once`` processes at once (default 2, a campaign's process per core
-here, or the machine's cores if fewer), each a fresh process, timed over the same window after
-every one's warm-up: the rate of each process while the others run, which is what a campaign
-on these cores gets (processes can slow one another through shared caches and memory, by an
-amount that differs between machines). Under the table, the standard and hard suites' student
-time projected from those rates at the suite's seeds per population (or the nearest population
-size measured), from a whole run on CPU only. With ``--device cuda --members 20`` it measures a
-GPU population; ``--only n-step-wide`` keeps the rows whose label holds that text.
+One process, one torch thread with subnormal floats flushed to zero (as the engine trains on
+a CPU), Blind Craftsman: TD3 in the MuJoCo world and on the kinematic board, DQN on the
+10x10 grid. Each row (``craftsuite.population``): the suites' regimes
+(``craftsuite.suites.TD3_REGIME`` / ``DQN_REGIME``: several envs per update, small networks)
+for ``--members`` seeds in one process (5: a suite's cell; 10: as many as the engines were
+compared with), collecting from one vector env, counted over all members, after the warm-up
+of random actions (``learning_starts``). The rows named after the learner regime add the
+standard and hard suites' regime (``craftsuite.regimes``: n-step targets, wider networks) to
+those settings: what the suites train now. Each row trains for about ``--seconds``. The
+reference column is each row's target. On CPU the learner-regime rows are also measured as
+``--at-once`` processes at once (default 2, a campaign's process per core here, or the
+machine's cores if fewer), each a fresh process, timed over the same window after every
+one's warm-up: the rate of each process while the others run, which is what a campaign on
+these cores gets (processes can slow one another through shared caches and memory, by an
+amount that differs between machines). Under the table, the standard and hard suites'
+student time projected from those rates at the suite's seeds per population (or the nearest
+population size measured), from a whole run on CPU only. Those rates are a run's first
+minutes: a long run slows as it goes (an Intel Xeon's fell to about half within an hour
+before subnormals were flushed; experiments/flush-denormal), so the projection is the
+least time a suite takes. With ``--device cuda --members 20`` it measures a GPU population;
+``--only n-step-wide`` keeps the rows whose label holds that text.
 """
 
 from __future__ import annotations

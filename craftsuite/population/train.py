@@ -119,9 +119,9 @@ def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=No
     stack = contextlib.ExitStack()
     envs = make_envs(config.env_id, K * n, config.env_kwargs, config.product)
     stack.callback(envs.close)
-    if device.type == "cpu":
-        stack.enter_context(cpu_settings())
     try:
+        if device.type == "cpu":
+            stack.enter_context(cpu_settings())
         pop = build_population(config, [c.seed for c in configs], settings, spec, table, device, envs)
         earlier = _resume(pop, runs)
 

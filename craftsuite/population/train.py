@@ -162,7 +162,7 @@ def cpu_settings():
     and arithmetic on them is slow on x86: flushed, an update costs a fifth less and leaves
     the weights of 100 updates bit-identical (experiments/flush-denormal). The flush is a
     setting of the calling thread, which with one torch thread does all the training's work
-    (the worlds' stepping too, in float64, where it changes nothing)."""
+    (the worlds' stepping too: MuJoCo's float64 physics runs under it as well)."""
     threads, flushing = th.get_num_threads(), flushing_subnormals()
     try:
         th.set_num_threads(1)

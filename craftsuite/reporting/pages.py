@@ -91,7 +91,8 @@ def _difference_text(estimate: stats.Estimate) -> str:
     """A difference with its interval, to as many decimals (up to 4) as keep a bound from
     printing as a line it does not sit on: the verdicts read the bounds unrounded, so "+0.20"
     could stand for an interval inside the band or one reaching past it, and "-0.00" for an
-    interval that excludes zero (a real gap) or one that touches it."""
+    interval that excludes zero (a real gap) or one that touches it. A real gap's bound too
+    near zero for 4 decimals prints in powers of ten (+3.0e-05)."""
     digits = 2
     bounds = (estimate.low, estimate.high) if estimate.has_interval else ()
     one_side = estimate.has_interval and (estimate.low > 0 or estimate.high < 0)
@@ -103,7 +104,11 @@ def _difference_text(estimate: stats.Estimate) -> str:
 
     while digits < 4 and any(blurred(b) for b in bounds):
         digits += 1
-    return _fmt(estimate, digits, signed=True)
+    if not any(one_side and round(b, digits) == 0 for b in bounds):
+        return _fmt(estimate, digits, signed=True)
+    # a real gap's near bound under 0.00005 still rounds to zero: that bound in powers of ten
+    low, high = (f"{b:+.1e}" if round(b, digits) == 0 else f"{b:+.{digits}f}" for b in bounds)
+    return f"{estimate.value:+.{digits}f} [{low}, {high}]"
 
 
 def ranked(rows: list[Entry]) -> list[Entry]:

@@ -20,12 +20,13 @@ these cores gets (processes can slow one another through shared caches and memor
 amount that differs between machines). Under the table, the standard and hard suites'
 student time projected from those rates at the suite's seeds per population (or the nearest
 population size measured), from a whole run on CPU only. Those rates are a run's first
-minutes. Before subnormals were flushed a long run slowed as it went (an Intel Xeon's fell
-to about half within an hour; experiments/flush-denormal); flushed, the suites' TD3
-populations on that machine held their rate over runs of an hour and more (five-minute
-windows of 1,000-1,420 transitions/s a core, with no steady fall; the suite campaign's parts
-53-54, experiments/suite-campaign). With ``--device cuda --members 20`` it measures a GPU
-population; ``--only n-step-wide`` keeps the rows whose label holds that text.
+minutes, and a long run trains slower, so the projection is the least time a suite takes.
+On an Intel Xeon this benchmark measured TD3 populations at 1,600-1,900 transitions/s alone;
+before subnormals were flushed a long run there fell to about half within an hour
+(experiments/flush-denormal); flushed, the campaign's populations there ran at 1,000-1,700/s
+a core over five-minute windows, with no steady fall over runs of 40-85 minutes (the suite
+campaign's parts 52-55, experiments/suite-campaign). With ``--device cuda --members 20`` it
+measures a GPU population; ``--only n-step-wide`` keeps the rows whose label holds that text.
 """
 
 from __future__ import annotations

@@ -104,11 +104,13 @@ def _difference_text(estimate: stats.Estimate) -> str:
 
     while digits < 4 and any(blurred(b) for b in bounds):
         digits += 1
-    if not any(one_side and round(b, digits) == 0 for b in bounds):
+    if math.isnan(estimate.value) or not any(one_side and round(b, digits) == 0 for b in bounds):
         return _fmt(estimate, digits, signed=True)
-    # a real gap's near bound under 0.00005 still rounds to zero: that bound in powers of ten
-    low, high = (f"{b:+.1e}" if round(b, digits) == 0 else f"{b:+.{digits}f}" for b in bounds)
-    return f"{estimate.value:+.{digits}f} [{low}, {high}]"
+
+    def text(x: float) -> str:  # past 4 decimals a real gap's figures near zero read in powers of ten
+        return f"{x:+.1e}" if round(x, digits) == 0 else f"{x:+.{digits}f}"
+
+    return f"{text(estimate.value)} [{text(estimate.low)}, {text(estimate.high)}]"
 
 
 def ranked(rows: list[Entry]) -> list[Entry]:

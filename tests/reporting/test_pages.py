@@ -355,6 +355,7 @@ def test_a_difference_whose_interval_excludes_zero_never_prints_a_bound_of_zero(
     assert _difference_text(Estimate(-0.01, -0.02, -0.003)) == "-0.010 [-0.020, -0.003]"
     assert _difference_text(Estimate(0.04, 0.0004, 0.08)) == "+0.0400 [+0.0004, +0.0800]"
     assert _difference_text(Estimate(-0.04, -0.08, -0.00003)) == "-0.0400 [-0.0800, -3.0e-05]"  # past 4 decimals
+    assert _difference_text(Estimate(2e-5, 1e-5, 3e-5)) == "+2.0e-05 [+1.0e-05, +3.0e-05]"
     # an interval across 0 keeps two decimals: its bound near 0 says nothing the verdict reads
     assert _difference_text(Estimate(-0.004, -0.01, 0.002)) == "-0.00 [-0.01, +0.00]"
 

@@ -20,12 +20,12 @@ these cores gets (processes can slow one another through shared caches and memor
 amount that differs between machines). Under the table, the standard and hard suites'
 student time projected from those rates at the suite's seeds per population (or the nearest
 population size measured), from a whole run on CPU only. Those rates are a run's first
-minutes, and a long run trains slower, so the projection is the least time a suite takes.
-On an Intel Xeon this benchmark measured TD3 populations at 1,600-2,100 transitions/s, alone
-and two at once; before subnormals were flushed a long run there fell to about half within
-an hour (experiments/flush-denormal); flushed, the campaign's populations there averaged
-1,200-1,700/s a core over calls of 40-85 minutes, in five-minute windows of 1,150-1,900/s
-with no steady fall (the suite campaign's parts 52-55, experiments/suite-campaign). With
+minutes, and a long run trains slower, so the projection is the least time a suite takes:
+on an Intel Xeon, with subnormals flushed, the campaign's TD3 populations averaged
+1,200-1,700 transitions/s a core over calls of 40-85 minutes (five-minute windows of
+1,150-1,900/s, with no steady fall; the suite campaign's parts 52-55,
+experiments/suite-campaign), slower than this benchmark's TD3 rows there; before the flush a
+long run there fell to about half within an hour (experiments/flush-denormal). With
 ``--device cuda --members 20`` it measures a GPU population; ``--only n-step-wide`` keeps the
 rows whose label holds that text.
 """

@@ -104,10 +104,10 @@ def _difference_text(estimate: stats.Estimate) -> str:
 
     while digits < 4 and any(blurred(b) for b in bounds):
         digits += 1
-    if math.isnan(estimate.value) or not any(one_side and round(b, digits) == 0 for b in bounds):
+    if math.isnan(estimate.value) or not one_side:
         return _fmt(estimate, digits, signed=True)
 
-    def text(x: float) -> str:  # past 4 decimals a real gap's figures near zero read in powers of ten
+    def text(x: float) -> str:  # as _fmt, but a figure still rounding to zero in powers of ten
         return f"{x:+.1e}" if round(x, digits) == 0 else f"{x:+.{digits}f}"
 
     return f"{text(estimate.value)} [{text(estimate.low)}, {text(estimate.high)}]"

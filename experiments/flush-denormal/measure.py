@@ -24,24 +24,29 @@ import craftsuite  # noqa: F401  (registers the ids)
 from craftsuite.configs import StudentConfig
 from craftsuite.population.envs import make_envs
 from craftsuite.population.td3 import delay_at
-from craftsuite.population.train import build_population
-from craftsuite.runs import load_config
+from craftsuite.population.train import CHECKPOINT, STEP, build_population
+from craftsuite.runs import RunDir, load_config
 from craftsuite.task_registry import resolve_task
 
 TINY = np.finfo(np.float32).tiny  # the smallest normal float32: below it (and not 0), subnormal
 
 
+def last_checkpoint(run: Path) -> Path | None:
+    """The run's last complete checkpoint, as a resume would pick it."""
+    return RunDir(run, load_config(StudentConfig, run)).last_checkpoint((CHECKPOINT, STEP))
+
+
 def copy_checkpoints(runs: list[Path], into: Path) -> list[Path]:
-    """Each run's committed checkpoint, copied; again until every copy is at one step (a
+    """Each run's last complete checkpoint, copied; again until every copy is at one step (a
     population commits its members one after another)."""
     for _ in range(20):
         copies, steps = [], set()
         for run in runs:
             folder = into / run.name
             shutil.rmtree(folder, ignore_errors=True)
-            shutil.copytree(run / "checkpoint", folder)
-            steps.add(json.loads((folder / "step.json").read_text())["num_timesteps"])
-            copies.append(folder / "population.pt")
+            shutil.copytree(last_checkpoint(run), folder)
+            steps.add(json.loads((folder / STEP).read_text())["num_timesteps"])
+            copies.append(folder / CHECKPOINT)
         if len(steps) == 1:
             return copies
         time.sleep(10)
@@ -122,7 +127,7 @@ def main() -> None:
             runs = sorted(args.students.glob(f"student-{args.task}-{args.world}-{method}-s*"))
             if not runs:
                 sys.exit(f"no {method} runs of {args.task} {args.world} in {args.students}")
-            bare = [r.name for r in runs if not (r / "checkpoint" / "population.pt").is_file()]
+            bare = [r.name for r in runs if last_checkpoint(r) is None]
             if bare:  # an archive keeps records only: the runs of a transfer's --out have checkpoints
                 sys.exit(f"{len(bare)} {method} runs in {args.students} hold no checkpoint ({bare[0]}, ...: an "
                          "archive keeps none); "

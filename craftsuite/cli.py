@@ -332,7 +332,7 @@ def _transfer(args) -> int:
     from .ids import CONT, KINEMATIC, world_kind
     from .methods import resolve_method
     from .provenance import command_line
-    from .suite_runner import TimeLimitReached, transfer
+    from .suite_runner import TimeLimitReached, WorkerLost, transfer
     from .suites import SUITES
 
     if args.suite not in SUITES:
@@ -395,6 +395,9 @@ def _transfer(args) -> int:
         print(f"{stopped}; the finished runs are in {out}" + (f" and kept in {Path(archive) / suite.name}"
                                                              if archive else ""))
         return TIME_LIMIT_STATUS
+    except WorkerLost as lost:  # not a refused command (2): its status says a signal, as a killed process's would
+        print(f"craftsuite transfer: {lost}", file=sys.stderr)
+        return lost.status
     print(f"leaderboard: {result.leaderboard} (and .csv)")
     for plot in result.plots:
         print(f"learning curves: {plot}")

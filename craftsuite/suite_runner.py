@@ -20,8 +20,10 @@ import contextlib
 import dataclasses
 import json
 import os
+import signal
 import time
 from concurrent.futures import Future
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,6 +41,30 @@ from .worker_pool import WorkerPool
 class TimeLimitReached(Exception):
     """A transfer's time limit passed with runs still training: they were stopped, each to
     resume from its newest checkpoint when asked for again, and the finished ones are kept."""
+
+
+class WorkerLost(Exception):
+    """A transfer's worker process died while it trained (killed by a signal: most often
+    the kernel's out-of-memory killer, whose SIGKILL no process can catch): the rest were
+    stopped, each run resumes from its newest checkpoint when asked for again, and the
+    finished ones are kept. ``status`` is a shell's for a process that signal killed (128 +
+    its number: 137 for SIGKILL), so that a campaign's part takes the transfer up again as
+    it would one killed itself; 1 where no signal is known."""
+
+    def __init__(self, signals: list[int]):
+        self.signals = signals
+        self.signal = signal.SIGKILL if signal.SIGKILL in signals else (signals[0] if signals else None)
+        self.status = 1 if self.signal is None else 128 + self.signal
+        if self.signal is None:
+            how = "a worker process ended abruptly"
+        else:
+            name = signal.Signals(self.signal).name
+            how = f"a worker process was killed by {name}" + (
+                " (the kernel's out-of-memory killer, or a kill -9)" if self.signal == signal.SIGKILL else "")
+        memory = ("; fewer seeds to a population (--members) or fewer populations at once (--workers) hold less "
+                  "memory" if self.signal == signal.SIGKILL else "")
+        super().__init__(f"{how}: the runs still training were stopped; run the same command again and each "
+                         f"unfinished run resumes from its newest checkpoint{memory}")
 
 
 def _population_job(configs: list[dict], root: str, task: str | dict | None = None, device: str = "cpu") -> list[str]:
@@ -291,7 +317,8 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     later failure, or a kill that leaves no time to clean up, loses only what was training.
     ``time_limit``: seconds from the start after which the runs still training are stopped
     (``TimeLimitReached``; they resume when the same transfer runs again), the session
-    recorded with the time it ran.
+    recorded with the time it ran. A worker process killed meanwhile (``WorkerLost``: the
+    kernel's out-of-memory killer, say) stops the rest the same way.
 
     Bad input (a budget too small to train, a device this machine lacks, an output
     directory or archive that cannot be one, a Ray cluster out of reach, an sb3 run
@@ -357,6 +384,9 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         pool.close(abort=True)
         record_session(out, session, time.perf_counter() - clock)  # it ran its time: not a kill
         raise
+    except BrokenProcessPool as err:  # a local worker died (run_students has stopped the rest already)
+        pool.close(abort=True)
+        raise WorkerLost(pool.lost) from err
     except BaseException:
         pool.close(abort=True)  # (run_students closes it too, but not if it failed before its jobs; twice is harmless)
         raise

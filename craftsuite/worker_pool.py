@@ -104,6 +104,7 @@ class WorkerPool:
 
     def __init__(self, jobs: int, workers: int | None = None, ray: str | None = None):
         self.ray, self.started, self._task = None, False, None
+        self.lost: list[int] = []  # the signals that ended local workers before an abort (close says)
         if ray is not None:
             self.ray, self.started = connect_ray(ray)
             self._rows = external_rows()
@@ -132,6 +133,7 @@ class WorkerPool:
         if self.ray is None:
             if abort:
                 self._stopping.set()  # before the pids are read: a worker that reports later exits itself
+                self.lost = self.lost or self._signalled()
             self.pool.shutdown(wait=not abort, cancel_futures=True)
             if abort:  # shutdown alone would still let each running job finish (hours, in a suite)
                 workers = self._workers()
@@ -145,6 +147,20 @@ class WorkerPool:
                     self.ray.cancel(ref, force=True)  # a finished task's is nothing; a running one's worker is killed
             if self.started:
                 self.ray.shutdown()
+
+    def _signalled(self) -> list[int]:
+        """The signals that ended workers of the pool (a worker the kernel's out-of-memory
+        killer took: SIGKILL), read before the abort stops the rest; those the executor
+        stopped itself on seeing one die (SIGTERM) may be among them. The executor's processes
+        and threads are its own attributes: where a Python has them not, nothing is known."""
+        manager = getattr(self.pool, "_executor_manager_thread", None)
+        if getattr(self.pool, "_broken", False) and manager is not None:
+            # a broken pool's manager reaps its workers as it ends: until then a read of an
+            # exit code can race its reaping and find none
+            manager.join(timeout=30)
+        processes = getattr(self.pool, "_processes", None) or {}
+        codes = [p.exitcode for p in list(processes.values())]
+        return sorted({-code for code in codes if code is not None and code < 0})
 
     def _workers(self) -> list[mp.process.BaseProcess]:
         """The live local workers: this process's children whose pids the workers reported."""

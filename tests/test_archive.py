@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import signal
 
 import pytest
 
@@ -275,6 +276,39 @@ def test_a_transfer_archives_each_population_as_it_finishes(tmp_path, monkeypatc
     assert held["runs"] == [held["first"]]
     [session] = held["sessions"]  # the session that trained it is named beside it, its time still open
     assert session["seconds"] is None and session["command"].startswith("python: craftsuite.suite_runner.transfer")
+
+
+def test_a_transfer_whose_worker_was_killed_keeps_what_finished_and_exits_as_a_killed_process(tmp_path, monkeypatch,
+                                                                                               capsys):
+    """A worker the kernel's out-of-memory killer took breaks the process pool: the transfer
+    says so in one line with the way on, keeps what finished, and exits 137 (not 2, a refused
+    command), which a campaign's part takes up again."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    import craftsuite.suite_runner as suite_runner
+
+    class KilledPool(_InProcessPool):
+        lost = [signal.SIGTERM, signal.SIGKILL]  # the one killed, and one the executor stopped on seeing it
+
+    monkeypatch.setattr(suite_runner, "WorkerPool", KilledPool)
+
+    def one_population_then_a_kill(configs, root, finished=None, **kwargs):
+        first = configs[0]
+        _finished_record(root, first, {"kind": "student", "steps": first.steps, "task": first.task,
+                                       "method": first.method, "seed": first.seed, "model": "model.zip"})
+        finished("students", [root / first.run_name()])
+        raise BrokenProcessPool("A process in the process pool was terminated abruptly")
+
+    monkeypatch.setattr(suite_runner, "run_students", one_population_then_a_kill)
+    monkeypatch.chdir(tmp_path)
+    status = main(["transfer", "--suite", "standard", "--worlds", "Grid10", "--tasks", "Reach", "--methods", "dqn",
+                   "--seeds", "2", "--members", "1", "--no-video", "--out", "runs"])
+    assert status == 128 + signal.SIGKILL
+    said = capsys.readouterr().err.strip().splitlines()
+    assert len(said) == 1 and said[0].startswith("craftsuite transfer: a worker process was killed by SIGKILL (the "
+                                                 "kernel's out-of-memory killer")
+    assert "run the same command again" in said[0] and "--members" in said[0]
+    assert len(list((tmp_path / "results" / "standard" / "students").iterdir())) == 1
 
 
 def test_a_transfer_stopped_by_its_time_limit_keeps_what_finished_and_records_its_time(tmp_path, monkeypatch,

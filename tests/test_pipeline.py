@@ -392,6 +392,23 @@ class _JoinedRay:
         self.shut = True
 
 
+def test_the_pool_names_the_signal_that_killed_a_worker():
+    """A worker killed by a signal (SIGKILL: what the kernel's out-of-memory killer sends)
+    breaks the pool; the pool says which signal, for the transfer's exit status."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    pool = worker_pool.WorkerPool(1, workers=1)
+    try:
+        future = pool.submit(signal.raise_signal, signal.SIGKILL)
+        with pytest.raises(BrokenProcessPool):
+            future.result(timeout=300)
+    finally:
+        pool.close(abort=True)
+    assert pool.lost == [signal.SIGKILL]
+    pool.close(abort=True)  # (run_students closes it, then the transfer: the second keeps what the first read)
+    assert pool.lost == [signal.SIGKILL]
+
+
 def test_an_abort_cancels_the_tasks_sent_to_a_joined_ray_cluster(monkeypatch):
     """A cluster joined at an address outlives the driver: an abort (a failed job, the time
     limit, an interrupt) has to stop its tasks by name, and leaves the cluster up."""

@@ -20,7 +20,8 @@
 # amendment edits the lines not yet started (and the resume of a stopped one: keep its ARGS,
 # or it trains something else into the same OUT/NAME). A started or skipped NAME leaves
 # OUT/NAME.status and is not run again, except one the cut-off stopped (`exit 3`, the status
-# of a transfer its --time-limit stopped), one killed by a signal (`exit 137`, say: memory)
+# of a transfer its --time-limit stopped), one killed by a signal, or whose worker was (`exit 137`,
+# say: memory)
 # or one interrupted (`started PID START BOOT` whose part.sh is gone: killed, or the machine
 # restarted): the next part.sh over the same OUT and queue resumes it first, from its runs'
 # checkpoints (a later session's part, from the same TREE so that its runs keep one commit;

@@ -396,7 +396,7 @@ def _transfer(args) -> int:
                                                              if archive else ""))
         return TIME_LIMIT_STATUS
     except WorkerLost as lost:  # not a refused command (2): its status says a signal, as a killed process's would
-        print(f"craftsuite transfer: {lost}", file=sys.stderr)
+        print(f"craftsuite transfer: error: {lost}", file=sys.stderr)
         return lost.status
     print(f"leaderboard: {result.leaderboard} (and .csv)")
     for plot in result.plots:

@@ -44,9 +44,9 @@ class TimeLimitReached(Exception):
 
 
 class WorkerLost(Exception):
-    """A transfer's worker process died while it trained (killed by a signal: most often
-    the kernel's out-of-memory killer, whose SIGKILL no process can catch): the rest were
-    stopped, each run resumes from its newest checkpoint when asked for again, and the
+    """A transfer's local worker process died while it trained (killed by a signal: most
+    often the kernel's out-of-memory killer, whose SIGKILL no process can catch): the rest
+    were stopped, each run resumes from its newest checkpoint when asked for again, and the
     finished ones are kept. ``status`` is a shell's for a process that signal killed (128 +
     its number: 137 for SIGKILL), so that a campaign's part takes the transfer up again as
     it would one killed itself; 1 where no signal is known."""
@@ -57,14 +57,16 @@ class WorkerLost(Exception):
         self.status = 1 if self.signal is None else 128 + self.signal
         if self.signal is None:
             how = "a worker process ended abruptly"
+        elif self.signal == signal.SIGKILL:
+            how = ("a worker process was killed by SIGKILL, most likely out of memory: fewer seeds to a population "
+                   "(--members) or populations at once (--workers) use less")
         else:
-            name = signal.Signals(self.signal).name
-            how = f"a worker process was killed by {name}" + (
-                " (the kernel's out-of-memory killer, or a kill -9)" if self.signal == signal.SIGKILL else "")
-        memory = ("; fewer seeds to a population (--members) or fewer populations at once (--workers) hold less "
-                  "memory" if self.signal == signal.SIGKILL else "")
-        super().__init__(f"{how}: the runs still training were stopped; run the same command again and each "
-                         f"unfinished run resumes from its newest checkpoint{memory}")
+            try:
+                name = signal.Signals(self.signal).name
+            except ValueError:  # a real-time signal, say: no name
+                name = f"signal {self.signal}"
+            how = f"a worker process was killed by {name}"
+        super().__init__(f"{how}; the same command resumes the unfinished runs from their checkpoints")
 
 
 def _population_job(configs: list[dict], root: str, task: str | dict | None = None, device: str = "cpu") -> list[str]:
@@ -317,8 +319,8 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     later failure, or a kill that leaves no time to clean up, loses only what was training.
     ``time_limit``: seconds from the start after which the runs still training are stopped
     (``TimeLimitReached``; they resume when the same transfer runs again), the session
-    recorded with the time it ran. A worker process killed meanwhile (``WorkerLost``: the
-    kernel's out-of-memory killer, say) stops the rest the same way.
+    recorded with the time it ran. A local worker process killed meanwhile (``WorkerLost``:
+    the kernel's out-of-memory killer, say) stops the rest the same way.
 
     Bad input (a budget too small to train, a device this machine lacks, an output
     directory or archive that cannot be one, a Ray cluster out of reach, an sb3 run

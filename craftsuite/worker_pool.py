@@ -14,6 +14,7 @@ import os
 import threading
 import time
 from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 
 from .methods import external_rows, register_rows
 
@@ -104,7 +105,7 @@ class WorkerPool:
 
     def __init__(self, jobs: int, workers: int | None = None, ray: str | None = None):
         self.ray, self.started, self._task = None, False, None
-        self.lost: list[int] = []  # the signals that ended local workers before an abort (close says)
+        self.lost: list[int] = []  # the signals that had killed local workers when the pool broke
         if ray is not None:
             self.ray, self.started = connect_ray(ray)
             self._rows = external_rows()
@@ -125,7 +126,21 @@ class WorkerPool:
             ref = self._task.remote(self._rows, job, *args)
             self._refs.append(ref)
             return ref.future()
-        return self.pool.submit(job, *args)
+        future = self.pool.submit(job, *args)
+        future.add_done_callback(self._note_lost)
+        return future
+
+    def _note_lost(self, future: Future) -> None:
+        """Once a job has failed because the pool broke (a worker died), the signals that had
+        killed workers by then (SIGKILL: the kernel's out-of-memory killer, say). The executor
+        fails its jobs before it stops the workers still alive (SIGTERM), so those are not
+        among them; its processes are its own attribute: where a Python has it not, none is
+        known."""
+        if self.lost or future.cancelled() or not isinstance(future.exception(), BrokenProcessPool):
+            return
+        processes = getattr(self.pool, "_processes", None) or {}
+        codes = [p.exitcode for p in list(processes.values())]
+        self.lost = sorted({-code for code in codes if code is not None and code < 0})
 
     def close(self, abort: bool = False) -> None:
         """Wait for the jobs; or, with ``abort`` (a job failed, or the driver was interrupted),
@@ -133,7 +148,9 @@ class WorkerPool:
         if self.ray is None:
             if abort:
                 self._stopping.set()  # before the pids are read: a worker that reports later exits itself
-                self.lost = self.lost or self._signalled()
+                manager = getattr(self.pool, "_executor_manager_thread", None)  # (the executor's own)
+                if getattr(self.pool, "_broken", False) and manager is not None:
+                    manager.join(timeout=30)  # it ends once it has failed every job: `lost` is read by then
             self.pool.shutdown(wait=not abort, cancel_futures=True)
             if abort:  # shutdown alone would still let each running job finish (hours, in a suite)
                 workers = self._workers()
@@ -147,20 +164,6 @@ class WorkerPool:
                     self.ray.cancel(ref, force=True)  # a finished task's is nothing; a running one's worker is killed
             if self.started:
                 self.ray.shutdown()
-
-    def _signalled(self) -> list[int]:
-        """The signals that ended workers of the pool (a worker the kernel's out-of-memory
-        killer took: SIGKILL), read before the abort stops the rest; those the executor
-        stopped itself on seeing one die (SIGTERM) may be among them. The executor's processes
-        and threads are its own attributes: where a Python has them not, nothing is known."""
-        manager = getattr(self.pool, "_executor_manager_thread", None)
-        if getattr(self.pool, "_broken", False) and manager is not None:
-            # a broken pool's manager reaps its workers as it ends: until then a read of an
-            # exit code can race its reaping and find none
-            manager.join(timeout=30)
-        processes = getattr(self.pool, "_processes", None) or {}
-        codes = [p.exitcode for p in list(processes.values())]
-        return sorted({-code for code in codes if code is not None and code < 0})
 
     def _workers(self) -> list[mp.process.BaseProcess]:
         """The live local workers: this process's children whose pids the workers reported."""

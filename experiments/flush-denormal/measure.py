@@ -32,22 +32,25 @@ TINY = np.finfo(np.float32).tiny  # the smallest normal float32: below it (and n
 
 
 def last_checkpoint(run: Path) -> Path | None:
-    """The run's last complete checkpoint, as a resume would pick it."""
+    """The run's newest complete checkpoint folder (``RunDir``'s rule: both files written)."""
     return RunDir(run, load_config(StudentConfig, run)).last_checkpoint((CHECKPOINT, STEP))
 
 
 def copy_checkpoints(runs: list[Path], into: Path) -> list[Path]:
-    """Each run's last complete checkpoint, copied; again until every copy is at one step (a
-    population commits its members one after another)."""
+    """Each run's newest complete checkpoint, copied; again until every copy is at one step
+    (a population commits its members one after another)."""
     for _ in range(20):
         copies, steps = [], set()
         for run in runs:
             folder = into / run.name
             shutil.rmtree(folder, ignore_errors=True)
-            shutil.copytree(last_checkpoint(run), folder)
-            steps.add(json.loads((folder / STEP).read_text())["num_timesteps"])
+            try:
+                shutil.copytree(last_checkpoint(run), folder)
+                steps.add(json.loads((folder / STEP).read_text())["num_timesteps"])
+            except (TypeError, OSError):  # none yet, or renamed by the run's commit while copied: again
+                steps.add(-1)
             copies.append(folder / CHECKPOINT)
-        if len(steps) == 1:
+        if len(steps) == 1 and -1 not in steps:
             return copies
         time.sleep(10)
     sys.exit(f"the checkpoints of {runs[0].parent} stayed at different steps ({sorted(steps)}); try again")

@@ -20,14 +20,13 @@
 # amendment edits the lines not yet started (and the resume of a stopped one: keep its ARGS,
 # or it trains something else into the same OUT/NAME). A started or skipped NAME leaves
 # OUT/NAME.status and is not run again, except one the cut-off stopped (`exit 3`, the status
-# of a transfer its --time-limit stopped), one killed by a signal, or whose worker was (`exit 137`,
-# say: memory)
-# or one interrupted (`started PID START BOOT` whose part.sh is gone: killed, or the machine
-# restarted): the next part.sh over the same OUT and queue resumes it first, from its runs'
-# checkpoints (a later session's part, from the same TREE so that its runs keep one commit;
-# each start's line in the log names the commit it ran). One whose part.sh, or its transfer,
-# still runs is left to it. (Telling which runs takes Linux's /proc: elsewhere the status is a
-# bare `started`, run again only once it is deleted.)
+# of a transfer its --time-limit stopped), one killed by a signal, or whose worker was
+# (`exit 137`, say: memory), or one interrupted (`started PID START BOOT` whose part.sh is
+# gone: killed, or the machine restarted): the next part.sh over the same OUT and queue
+# resumes it first, from its runs' checkpoints (a later session's part, from the same TREE
+# so that its runs keep one commit; each start's line in the log names the commit it ran).
+# One whose part.sh, or its transfer, still runs is left to it. (Telling which runs takes
+# Linux's /proc: elsewhere the status is a bare `started`, run again only once it is deleted.)
 # To run another NAME again, delete its status file. One part.sh runs over an OUT at a time:
 # a second call over it is refused while the first runs (with flock, which Linux has).
 # Runs land in OUT/NAME (log OUT/NAME.log, each start appended) and in ./results, recording

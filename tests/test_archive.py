@@ -288,7 +288,7 @@ def test_a_transfer_whose_worker_was_killed_keeps_what_finished_and_exits_as_a_k
     import craftsuite.suite_runner as suite_runner
 
     class KilledPool(_InProcessPool):
-        lost = [signal.SIGTERM, signal.SIGKILL]  # the one killed, and one the executor stopped on seeing it
+        lost = [signal.SIGTERM, signal.SIGKILL]  # two workers killed: SIGKILL, the out-of-memory killer's, is named
 
     monkeypatch.setattr(suite_runner, "WorkerPool", KilledPool)
 

@@ -99,6 +99,9 @@ def _check_reachable(address: str, timeout: float = 5.0) -> None:
                            "--ray local") from None
 
 
+LOST_WAIT = 2.0  # seconds a broken pool waits for its dead worker's exit code
+
+
 class WorkerPool:
     """``workers`` local processes (None: one per job, up to the cores), or with ``ray`` a
     Ray cluster (``"local"`` starts one in this process, an address joins one)."""
@@ -135,12 +138,18 @@ class WorkerPool:
         killed workers by then (SIGKILL: the kernel's out-of-memory killer, say). The executor
         fails its jobs before it stops the workers still alive (SIGTERM), so those are not
         among them; its processes are its own attribute: where a Python has it not, none is
-        known."""
+        known. The executor can see the dead worker's pipe close before the kernel has made it
+        reapable (its exit code still None), so it is polled for a moment (LOST_WAIT seconds at
+        most, on the executor's own thread, the pool being broken already)."""
         if self.lost or future.cancelled() or not isinstance(future.exception(), BrokenProcessPool):
             return
-        processes = getattr(self.pool, "_processes", None) or {}
-        codes = [p.exitcode for p in list(processes.values())]
-        self.lost = sorted({-code for code in codes if code is not None and code < 0})
+        processes = list((getattr(self.pool, "_processes", None) or {}).values())
+        deadline = time.monotonic() + LOST_WAIT
+        while True:
+            self.lost = sorted({-p.exitcode for p in processes if p.exitcode is not None and p.exitcode < 0})
+            if self.lost or not processes or time.monotonic() > deadline:
+                return
+            time.sleep(0.01)
 
     def close(self, abort: bool = False) -> None:
         """Wait for the jobs; or, with ``abort`` (a job failed, or the driver was interrupted),

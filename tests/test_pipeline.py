@@ -407,6 +407,29 @@ def test_the_pool_names_the_signal_that_killed_a_worker():
     assert pool.lost == [signal.SIGKILL]
 
 
+def test_a_broken_pool_waits_for_its_dead_workers_exit_code():
+    """Under load the executor can see a killed worker's pipe close before the kernel has
+    made the worker reapable (its exit code still None): the pool polls for the code rather
+    than reporting no signal (which would make a transfer killed for memory exit 1, a status a
+    campaign does not resume)."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    class NotYetReaped:  # the dead worker: its exit code shows only on the fifth look
+        looks = 0
+
+        @property
+        def exitcode(self):
+            self.looks += 1
+            return None if self.looks < 5 else -signal.SIGKILL
+
+    pool = object.__new__(worker_pool.WorkerPool)  # its bookkeeping alone: no processes start
+    pool.lost, pool.pool = [], SimpleNamespace(_processes={1: NotYetReaped()})
+    failed = Future()
+    failed.set_exception(BrokenProcessPool("a worker died"))
+    pool._note_lost(failed)
+    assert pool.lost == [signal.SIGKILL]
+
+
 def test_an_abort_cancels_the_tasks_sent_to_a_joined_ray_cluster(monkeypatch):
     """A cluster joined at an address outlives the driver: an abort (a failed job, the time
     limit, an interrupt) has to stop its tasks by name, and leaves the cluster up."""

@@ -10,6 +10,7 @@ asked for again.
 from __future__ import annotations
 
 import multiprocessing as mp
+import multiprocessing.connection  # mp.connection.wait: which workers have ended
 import os
 import threading
 import time
@@ -99,7 +100,7 @@ def _check_reachable(address: str, timeout: float = 5.0) -> None:
                            "--ray local") from None
 
 
-LOST_WAIT = 2.0  # seconds a broken pool waits for its dead worker's exit code
+LOST_WAIT = 2.0  # seconds a broken pool waits for a dead worker to be reapable
 
 
 class WorkerPool:
@@ -109,6 +110,7 @@ class WorkerPool:
     def __init__(self, jobs: int, workers: int | None = None, ray: str | None = None):
         self.ray, self.started, self._task = None, False, None
         self.lost: list[int] = []  # the signals that had killed local workers when the pool broke
+        self._looked = False  # whether a break's workers have been looked at
         if ray is not None:
             self.ray, self.started = connect_ray(ray)
             self._rows = external_rows()
@@ -138,18 +140,20 @@ class WorkerPool:
         killed workers by then (SIGKILL: the kernel's out-of-memory killer, say). The executor
         fails its jobs before it stops the workers still alive (SIGTERM), so those are not
         among them; its processes are its own attribute: where a Python has it not, none is
-        known. The executor can see the dead worker's pipe close before the kernel has made it
-        reapable (its exit code still None), so it is polled for a moment (LOST_WAIT seconds at
-        most, on the executor's own thread, the pool being broken already)."""
-        if self.lost or future.cancelled() or not isinstance(future.exception(), BrokenProcessPool):
+        known. Looked at once a break. The executor can see a dead worker's pipe close before
+        the kernel has made it reapable (its exit code still None), so each worker already
+        ended is waited for (LOST_WAIT seconds at most); the live ones are not."""
+        if (self._looked or future.cancelled() or not isinstance(future.exception(), BrokenProcessPool)
+                or not getattr(self.pool, "_broken", True)):  # a job's own BrokenProcessPool: the pool is whole
             return
+        self._looked = True
         processes = list((getattr(self.pool, "_processes", None) or {}).values())
-        deadline = time.monotonic() + LOST_WAIT
-        while True:
-            self.lost = sorted({-p.exitcode for p in processes if p.exitcode is not None and p.exitcode < 0})
-            if self.lost or not processes or time.monotonic() > deadline:
-                return
-            time.sleep(0.01)
+        ended = set(mp.connection.wait([p.sentinel for p in processes], timeout=LOST_WAIT)) if processes else set()
+        for process in processes:
+            if process.sentinel in ended:
+                process.join(LOST_WAIT)
+        codes = [process.exitcode for process in processes]
+        self.lost = sorted({-code for code in codes if code is not None and code < 0})
 
     def close(self, abort: bool = False) -> None:
         """Wait for the jobs; or, with ``abort`` (a job failed, or the driver was interrupted),

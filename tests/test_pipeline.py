@@ -407,27 +407,54 @@ def test_the_pool_names_the_signal_that_killed_a_worker():
     assert pool.lost == [signal.SIGKILL]
 
 
-def test_a_broken_pool_waits_for_its_dead_workers_exit_code():
-    """Under load the executor can see a killed worker's pipe close before the kernel has
-    made the worker reapable (its exit code still None): the pool polls for the code rather
-    than reporting no signal (which would make a transfer killed for memory exit 1, a status a
-    campaign does not resume)."""
+class _Worker:
+    """A worker process as the executor holds it: its sentinel is ready once it has ended,
+    and ``join`` reaps it (``code``: the exit code it then shows)."""
+
+    def __init__(self, ended: bool, code=None):
+        read, self._write = os.pipe()
+        if ended:
+            os.close(self._write)
+        self.sentinel, self.code, self.exitcode, self.joined = read, code, None, False
+
+    def join(self, timeout=None):
+        self.joined, self.exitcode = True, self.code
+
+
+def _broken_pool(*workers):
+    """A ``WorkerPool``'s bookkeeping over a broken executor holding ``workers``, and a job
+    failed by the break (no process starts)."""
     from concurrent.futures.process import BrokenProcessPool
 
-    class NotYetReaped:  # the dead worker: its exit code shows only on the fifth look
-        looks = 0
-
-        @property
-        def exitcode(self):
-            self.looks += 1
-            return None if self.looks < 5 else -signal.SIGKILL
-
-    pool = object.__new__(worker_pool.WorkerPool)  # its bookkeeping alone: no processes start
-    pool.lost, pool.pool = [], SimpleNamespace(_processes={1: NotYetReaped()})
+    pool = object.__new__(worker_pool.WorkerPool)
+    pool.lost, pool._looked = [], False
+    pool.pool = SimpleNamespace(_broken="a child process terminated abruptly",
+                                _processes=dict(enumerate(workers)))
     failed = Future()
     failed.set_exception(BrokenProcessPool("a worker died"))
+    return pool, failed
+
+
+def test_a_broken_pool_waits_for_its_dead_worker_to_be_reapable():
+    """Under load the executor can see a killed worker's pipe close before the kernel has made
+    the worker reapable (its exit code still None): the pool waits for it rather than report
+    no signal (which would make a transfer killed for memory exit 1, a status a campaign does
+    not resume), and leaves the live worker alone."""
+    killed, alive = _Worker(ended=True, code=-signal.SIGKILL), _Worker(ended=False)
+    pool, failed = _broken_pool(killed, alive)
     pool._note_lost(failed)
-    assert pool.lost == [signal.SIGKILL]
+    assert pool.lost == [signal.SIGKILL] and killed.joined and not alive.joined
+
+
+def test_a_pool_broken_without_a_signal_is_looked_at_once_and_at_once():
+    """A worker that exited by itself (status 1) names no signal, and the jobs failed with it
+    do not each wait for the live workers."""
+    exited = _Worker(ended=True, code=1)
+    pool, failed = _broken_pool(exited, _Worker(ended=False))
+    start = time.monotonic()
+    for _ in range(5):
+        pool._note_lost(failed)
+    assert pool.lost == [] and time.monotonic() - start < worker_pool.LOST_WAIT
 
 
 def test_an_abort_cancels_the_tasks_sent_to_a_joined_ray_cluster(monkeypatch):

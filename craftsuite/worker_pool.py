@@ -100,7 +100,7 @@ def _check_reachable(address: str, timeout: float = 5.0) -> None:
                            "--ray local") from None
 
 
-LOST_WAIT = 2.0  # seconds a broken pool waits for a dead worker to be reapable
+LOST_WAIT = 2.0  # seconds a broken pool waits for a worker to have ended
 
 
 class WorkerPool:
@@ -141,8 +141,9 @@ class WorkerPool:
         fails its jobs before it stops the workers still alive (SIGTERM), so those are not
         among them; its processes are its own attribute: where a Python has it not, none is
         known. Looked at once a break. The executor can see a dead worker's pipe close before
-        the kernel has made it reapable (its exit code still None), so each worker already
-        ended is waited for (LOST_WAIT seconds at most); the live ones are not."""
+        the kernel has made it reapable (its exit code still None), so each worker that has
+        ended (its sentinel ready; LOST_WAIT seconds at most for one to be) is reaped first;
+        the live ones are not waited for."""
         if (self._looked or future.cancelled() or not isinstance(future.exception(), BrokenProcessPool)
                 or not getattr(self.pool, "_broken", True)):  # a job's own BrokenProcessPool: the pool is whole
             return
@@ -164,6 +165,8 @@ class WorkerPool:
                 manager = getattr(self.pool, "_executor_manager_thread", None)  # (the executor's own)
                 if getattr(self.pool, "_broken", False) and manager is not None:
                     manager.join(timeout=30)  # it ends once it has failed every job: `lost` is read by then
+                else:
+                    self._looked = True  # the SIGTERMs below are this pool's own, not what broke it
             self.pool.shutdown(wait=not abort, cancel_futures=True)
             if abort:  # shutdown alone would still let each running job finish (hours, in a suite)
                 workers = self._workers()

@@ -415,21 +415,20 @@ class _Worker:
         read, self._write = os.pipe()
         if ended:
             os.close(self._write)
-        self.sentinel, self.code, self.exitcode, self.joined = read, code, None, False
+        self.sentinel, self.code, self.exitcode, self.joins = read, code, None, 0
 
     def join(self, timeout=None):
-        self.joined, self.exitcode = True, self.code
+        self.joins, self.exitcode = self.joins + 1, self.code
 
 
-def _broken_pool(*workers):
+def _broken_pool(*workers, broken="a child process terminated abruptly"):
     """A ``WorkerPool``'s bookkeeping over a broken executor holding ``workers``, and a job
     failed by the break (no process starts)."""
     from concurrent.futures.process import BrokenProcessPool
 
     pool = object.__new__(worker_pool.WorkerPool)
     pool.lost, pool._looked = [], False
-    pool.pool = SimpleNamespace(_broken="a child process terminated abruptly",
-                                _processes=dict(enumerate(workers)))
+    pool.pool = SimpleNamespace(_broken=broken, _processes=dict(enumerate(workers)))
     failed = Future()
     failed.set_exception(BrokenProcessPool("a worker died"))
     return pool, failed
@@ -443,7 +442,7 @@ def test_a_broken_pool_waits_for_its_dead_worker_to_be_reapable():
     killed, alive = _Worker(ended=True, code=-signal.SIGKILL), _Worker(ended=False)
     pool, failed = _broken_pool(killed, alive)
     pool._note_lost(failed)
-    assert pool.lost == [signal.SIGKILL] and killed.joined and not alive.joined
+    assert pool.lost == [signal.SIGKILL] and killed.joins == 1 and alive.joins == 0
 
 
 def test_a_pool_broken_without_a_signal_is_looked_at_once_and_at_once():
@@ -454,7 +453,15 @@ def test_a_pool_broken_without_a_signal_is_looked_at_once_and_at_once():
     start = time.monotonic()
     for _ in range(5):
         pool._note_lost(failed)
-    assert pool.lost == [] and time.monotonic() - start < worker_pool.LOST_WAIT
+    assert pool.lost == [] and exited.joins == 1 and time.monotonic() - start < worker_pool.LOST_WAIT
+
+
+def test_a_jobs_own_broken_pool_error_is_not_a_break():
+    """A job that raised BrokenProcessPool itself, its pool whole, leaves the workers unread."""
+    worker = _Worker(ended=True, code=-signal.SIGKILL)
+    pool, failed = _broken_pool(worker, broken=False)
+    pool._note_lost(failed)
+    assert pool.lost == [] and worker.joins == 0 and not pool._looked
 
 
 def test_an_abort_cancels_the_tasks_sent_to_a_joined_ray_cluster(monkeypatch):

@@ -47,6 +47,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/vector_envs.py
 	$(PY) benchmarks/student_throughput.py
 	$(PY) benchmarks/crm_memory.py
+	$(PY) benchmarks/checkpoint_memory.py
 	$(PY) benchmarks/engine_equivalence.py
 	$(PY) benchmarks/teachers.py --quick
 	$(PY) benchmarks/interval_coverage.py

@@ -27,7 +27,8 @@ PAGE = ROOT / "docs" / "performance.md"
 # The page's order: the package's own speed first (automata, worlds, training), then its statistics
 # and the cost of reporting them.
 SECTIONS = ("automata", "grid_steps", "cont_steps", "vector_envs", "student_throughput", "crm_memory",
-            "engine_equivalence", "teachers", "interval_coverage", "verdict_error", "results_page", "code_size")
+            "checkpoint_memory", "engine_equivalence", "teachers", "interval_coverage", "verdict_error", "results_page",
+            "code_size")
 
 HEADER = """\
 # Performance

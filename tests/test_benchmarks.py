@@ -83,6 +83,7 @@ def test_every_benchmark_has_a_section_and_a_line_in_make_bench(page_module):
 # each benchmark's smallest run (minutes at full size), for a test that it writes its section
 TINY = {"automata": ["--tasks", "Reach", "--flloat-timeout", "5"], "code_size": ["--reference", "HEAD"],
         "cont_steps": ["--steps", "100", "--no-render"],
+        "checkpoint_memory": ["--rows", "400", "--members", "2"],
         "crm_memory": ["--steps", "300"], "engine_equivalence": [], "grid_steps": ["--steps", "200"],
         "interval_coverage": ["--trials", "20"], "verdict_error": ["--trials", "4"],
         "results_page": ["results/shaping-in-mujoco/standard", "--reference", "HEAD"],
@@ -182,6 +183,12 @@ def test_the_throughput_benchmark_refuses_a_bad_process_count_before_measuring(p
                                                                                monkeypatch, capsys):
     last = refusal("student_throughput", argv, "measure_population", tmp_path, monkeypatch, capsys)
     assert problem in last and "give" in last
+
+
+def test_the_checkpoint_memory_benchmark_refuses_too_small_a_replay_before_measuring(page_module, tmp_path,
+                                                                                    monkeypatch, capsys):
+    last = refusal("checkpoint_memory", ["--rows", "2"], "measure", tmp_path, monkeypatch, capsys)
+    assert "--rows 2" in last and "give at least 8 rows" in last
 
 
 def test_the_suite_projection_runs_at_the_rates_of_processes_at_once(page_module):

@@ -32,6 +32,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+import torch as th
 
 from ..automata import Automaton
 
@@ -402,17 +403,25 @@ class PopulationReplay:
         return self._observation_arrays + self._ARRAYS + (("ended",) if self.ended is not None else ())
 
     def member_state(self, k: int) -> dict:
-        """Member ``k``'s filled rows, priorities and sampling position (for its checkpoint)."""
+        """Member ``k``'s filled rows, priorities and sampling position (for its checkpoint).
+
+        The rows are tensors sharing the arrays' memory: ``torch.save`` writes a tensor's
+        storage straight to the file, whereas it pickles a NumPy array whole in memory first
+        (its bytes, then the pickle's string of them), so a large replay would be held several
+        times over while it is saved."""
         n = self.size
-        state = {name: getattr(self, name)[k, :n] for name in self._arrays}  # views: saving copies them once
+        state = {name: th.from_numpy(getattr(self, name)[k, :n]) for name in self._arrays}
         state.update(pos=self.pos, full=self.full, max_priority=float(self.max_priority[k]))
         if self.trees is not None:
-            state["priorities"] = self.trees.tree[k, self.trees.leaves:self.trees.leaves + n * self.per_step]
+            priorities = self.trees.tree[k, self.trees.leaves:self.trees.leaves + n * self.per_step]
+            state["priorities"] = th.from_numpy(priorities)
         return state
 
     def load_member(self, k: int, state: dict) -> None:
         """Member ``k`` from its ``member_state``, to resume from: its envs start fresh
-        episodes, so an n-step replay ends each env's stored stream at its newest step."""
+        episodes, so an n-step replay ends each env's stored stream at its newest step.
+        Its rows may be tensors on the CPU or (an older checkpoint's) NumPy arrays."""
+        state = {name: np.asarray(value) for name, value in state.items()}
         n = len(state["rewards"])
         for name in self._arrays:
             getattr(self, name)[k, :n] = state[name]

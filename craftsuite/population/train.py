@@ -383,7 +383,9 @@ def _load_step(pop: Population, runs, found, step: int, failed: list) -> list[di
     for run, steps in zip(runs, found):
         path = steps[step]
         try:
-            states.append(th.load(path, weights_only=False, map_location=pop.learner.device))
+            # on the CPU: the replay's rows are copied into NumPy arrays; load_states moves the
+            # networks' and optimizers' tensors to the learner's device
+            states.append(th.load(path, weights_only=False, map_location="cpu"))
         except machine_errors():
             raise  # the machine's limits, not the file's fault
         except Exception as err:  # a damaged file

@@ -120,3 +120,53 @@ def test_crm_memory_holds_each_step_once():
     replay = PopulationReplay(1, 1000, 1, 10, (2,), crm=view)
     assert replay.observations.shape == (1, 1000, 10)  # not 1000 x the live states
     assert replay.trees.leaves >= 1000 * view.n_live
+
+
+def _filled(members: int, steps: int, seed: int) -> PopulationReplay:
+    """A prioritized n-step replay of sparse observations, ``steps`` steps of 2 envs each."""
+    rng = np.random.default_rng(seed)
+    replay = PopulationReplay(members, 4_000, 2, 30, (), np.int64, sparse_width=12, n_steps=3, seed=seed)
+    for _ in range(steps):
+        obs = (rng.random((members, 2, 30)) < 0.05) * rng.random((members, 2, 30))
+        obs[..., 12:] = 0  # at most the replay's sparse width of nonzeros
+        replay.add(obs, obs[:, :, ::-1], rng.integers(0, 4, (members, 2)), rng.random((members, 2)),
+                   rng.random((members, 2)) < 0.1, rng.integers(0, 3, (members, 2)), rng.integers(0, 5, (members, 2)),
+                   ended=rng.random((members, 2)) < 0.2)
+    replay.update_priorities(rng.integers(0, 2 * steps, (members, 16)), rng.random((members, 16)))
+    return replay
+
+
+def test_a_member_state_saves_its_rows_as_the_replay_memory_itself(tmp_path):
+    """A checkpoint's rows are tensors over the replay's own arrays, which ``torch.save``
+    writes as they are: a NumPy array would be pickled whole in memory first (several
+    copies of a member's replay, and a larger file)."""
+    import torch as th
+
+    replay = _filled(2, 1_500, seed=4)
+    state = replay.member_state(1)
+    rows = {name: value for name, value in state.items() if name not in ("pos", "full", "max_priority")}
+    assert rows and all(th.is_tensor(value) for value in rows.values())
+    for name in replay._arrays:  # the member's slice of the array, not a copy
+        assert rows[name].data_ptr() == getattr(replay, name)[1].ctypes.data
+    th.save(state, tmp_path / "member.pt")
+    row_bytes = sum(value.numel() * value.element_size() for value in rows.values())
+    assert (tmp_path / "member.pt").stat().st_size < 1.02 * row_bytes + 20_000  # a pickled copy: about 1.3x
+
+
+@pytest.mark.parametrize("form", ["tensors", "numpy"])
+def test_a_member_resumes_the_rows_it_saved_from_tensors_and_from_an_older_checkpoints_arrays(tmp_path, form):
+    import torch as th
+
+    replay = _filled(2, 1_500, seed=5)
+    state = replay.member_state(1)
+    if form == "numpy":  # as checkpoints were written before their rows became tensors
+        state = {name: value.numpy() if th.is_tensor(value) else value for name, value in state.items()}
+    th.save(state, tmp_path / "member.pt")
+    resumed = PopulationReplay(1, 4_000, 2, 30, (), np.int64, sparse_width=12, n_steps=3, seed=0)
+    resumed.load_member(0, th.load(tmp_path / "member.pt", weights_only=False))
+    n = replay.size
+    assert resumed.size == n == 3_000 and resumed.pos == replay.pos
+    for name in replay._ARRAYS + replay._observation_arrays:
+        np.testing.assert_array_equal(getattr(resumed, name)[0, :n], getattr(replay, name)[1, :n])
+    np.testing.assert_array_equal(resumed.trees.tree[0], replay.trees.tree[1])
+    assert resumed.max_priority[0] == replay.max_priority[1]

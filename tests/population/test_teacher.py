@@ -53,8 +53,9 @@ def test_the_table_is_the_mean_q_of_the_taken_actions_as_the_saved_sb3_teacher_r
     taken = q[np.arange(len(obs)), np.asarray(state["actions"]).astype(int)]
     automaton = resolve_task("Reach").automaton
     sums, counts = np.zeros(automaton.delta.shape), np.zeros(automaton.delta.shape, dtype=int)
-    np.add.at(sums, (state["w"], state["sigma"]), taken)
-    np.add.at(counts, (state["w"], state["sigma"]), 1)
+    w, sigma = np.asarray(state["w"]), np.asarray(state["sigma"])
+    np.add.at(sums, (w, sigma), taken)
+    np.add.at(counts, (w, sigma), 1)
     table = AutomatonQTable.load(teacher_run / "table.npz", automaton)
     assert table.kind == "dynamic" and (table.counts == counts).all() and counts.sum() == len(obs)
     seen = counts > 0

@@ -7,7 +7,7 @@ with ``torch.save``. A replay is sized to the run's budget (1M transitions of th
 so a member's rows reach gigabytes. ``torch.save`` writes a tensor's storage straight to the
 file, but pickles a NumPy array whole in memory first. The engine saves the replay's rows as
 tensors sharing the arrays' memory (``PopulationReplay.member_state``); the reference row saves
-the same states with the rows as NumPy arrays, as the engine once did.
+the same states with the rows as NumPy arrays (as older checkpoints hold them).
 
 Each row builds a hard-suite population of Diamond Mine (DQN on Grid10, TD3 in MuJoCo) in a
 fresh process, fills each member's replay with ``--rows`` transitions of random values, and

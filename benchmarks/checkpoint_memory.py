@@ -1,6 +1,6 @@
 """Checkpoint memory: how far a population's resident memory rises while it saves its checkpoints.
 
-Usage: python benchmarks/checkpoint_memory.py [--rows 200000] [--members 3] [--page PATH | --no-page]
+Usage: python benchmarks/checkpoint_memory.py [--rows 1000000] [--members 1] [--page PATH | --no-page]
 
 At each evaluation every member of a population saves its whole state, its replay included,
 with ``torch.save``. A replay is sized to the run's budget (1M transitions of the hard suite),
@@ -10,10 +10,12 @@ tensors sharing the arrays' memory (``PopulationReplay.member_state``); the refe
 the same states with the rows as NumPy arrays (as older checkpoints hold them).
 
 Each row builds a hard-suite population of Diamond Mine (DQN on Grid10, TD3 in MuJoCo) in a
-fresh process, fills each member's replay with ``--rows`` transitions of random values, and
-saves every member's state as a checkpoint does. It reads the process's peak resident set
-(Linux's ``VmHWM``, reset just before) above its level before the saving. The target: a
-rise of at most a tenth of one member's rows.
+fresh process, fills each member's replay with ``--rows`` transitions of random values (by
+default one member's whole replay in the hard suite, 1M), and saves every member's state as a
+checkpoint does. It reads the process's peak resident set (Linux's ``VmHWM``, reset just
+before) above its level before the saving. The target: a rise of at most a tenth of one
+member's rows. Members save one after another, so a population pauses at each evaluation for
+about its members times the seconds shown.
 """
 
 from __future__ import annotations
@@ -89,8 +91,8 @@ def measure(world: str, method: str, members: int, rows: int, form: str) -> dict
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--rows", type=int, default=200_000, help="transitions in each member's replay")
-    parser.add_argument("--members", type=int, default=3, help="the population's members")
+    parser.add_argument("--rows", type=int, default=1_000_000, help="transitions in each member's replay")
+    parser.add_argument("--members", type=int, default=1, help="the population's members")
     add_page_argument(parser)
     args = parser.parse_args()
     if args.rows < 8 or args.members < 1:

@@ -188,7 +188,7 @@ def test_the_throughput_benchmark_refuses_a_bad_process_count_before_measuring(p
 def test_the_checkpoint_memory_benchmark_refuses_too_small_a_replay_before_measuring(page_module, tmp_path,
                                                                                     monkeypatch, capsys):
     last = refusal("checkpoint_memory", ["--rows", "2"], "measure", tmp_path, monkeypatch, capsys)
-    assert "--rows 2" in last and "give at least 8 rows" in last
+    assert "--rows 2" in last and "give at least 10 rows" in last
 
 
 def test_the_suite_projection_runs_at_the_rates_of_processes_at_once(page_module):

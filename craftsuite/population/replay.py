@@ -420,8 +420,9 @@ class PopulationReplay:
     def load_member(self, k: int, state: dict) -> None:
         """Member ``k`` from its ``member_state``, to resume from: its envs start fresh
         episodes, so an n-step replay ends each env's stored stream at its newest step.
-        Its rows may be tensors on the CPU or (an older checkpoint's) NumPy arrays."""
-        state = {name: np.asarray(value) for name, value in state.items()}
+        Its rows may be tensors or (an older checkpoint's) NumPy arrays."""
+        state = {name: value.cpu().numpy() if th.is_tensor(value) else np.asarray(value)
+                 for name, value in state.items()}
         n = len(state["rewards"])
         for name in self._arrays:
             getattr(self, name)[k, :n] = state[name]

@@ -150,7 +150,8 @@ def test_a_member_state_saves_its_rows_as_the_replay_memory_itself(tmp_path):
         assert rows[name].data_ptr() == getattr(replay, name)[1].ctypes.data
     th.save(state, tmp_path / "member.pt")
     row_bytes = sum(value.numel() * value.element_size() for value in rows.values())
-    assert (tmp_path / "member.pt").stat().st_size < 1.02 * row_bytes + 20_000  # a pickled copy: about 1.3x
+    # the member's rows alone, not the whole arrays' storage (about 2.7x here)
+    assert (tmp_path / "member.pt").stat().st_size < 1.02 * row_bytes + 20_000
 
 
 @pytest.mark.parametrize("form", ["tensors", "numpy"])

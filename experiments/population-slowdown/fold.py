@@ -15,16 +15,16 @@ import argparse
 import re
 from collections import Counter
 
-# (part, pattern on a frame "function (file:line)"): the first that a stack's frames match,
+# (part, pattern on a frame "[Class.]function (file:line)"): the first that a stack's frames match,
 # from the outermost in, names its part
 PARTS = (
     ("checkpoint", r"^_checkpoint \(.*population/train\.py"),
     ("evaluation", r"^(_evaluate|evaluate_members) \("),
-    ("sampling", r"^sample \(.*population/replay\.py"),
-    ("priorities", r"^update_priorities \(.*population/replay\.py"),
-    ("update", r"^update \(.*population/(dqn|td3)\.py"),
-    ("acting", r"^actions \(.*population/engine\.py"),
-    ("storing", r"^add \(.*population/replay\.py"),
+    ("sampling", r"^(\w+\.)?sample \(.*population/replay\.py"),
+    ("priorities", r"^(\w+\.)?update_priorities \(.*population/replay\.py"),
+    ("update", r"^(\w+\.)?update \(.*population/(dqn|td3)\.py"),
+    ("acting", r"^(\w+\.)?actions \(.*population/engine\.py"),
+    ("storing", r"^(\w+\.)?add \(.*population/replay\.py"),
     ("world", r"(gymnasium/|craftsuite/envs/|craftsuite/worlds/|mujoco|dm_control)"),
 )
 ORDER = [name for name, _ in PARTS] + ["rest"]

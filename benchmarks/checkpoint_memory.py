@@ -78,7 +78,8 @@ with tempfile.TemporaryDirectory() as out:
         th.save(state(k), Path(out) / f"member{k}.pt")
     seconds, rise = time.perf_counter() - start, vm("VmHWM") - level
     size = os.path.getsize(Path(out) / "member0.pt")
-print(json.dumps({"rows": rows, "level": level, "rise": rise, "row_bytes": row_bytes, "file": size, "seconds": seconds}))
+print(json.dumps({"rows": rows, "level": level, "rise": rise, "row_bytes": row_bytes, "file": size,
+                  "seconds": seconds}))
 """
 CELLS = (("Grid10", "dqn"), ("Cont", "td3"))
 FORMS = {"tensor": "tensors (the engine's)", "numpy": "NumPy arrays (reference)"}

@@ -262,6 +262,13 @@ class PopulationReplay:
         self._rows = np.arange(K)[:, None]
 
     @property
+    def nbytes(self) -> int:
+        """The bytes every member's replay holds once full: its arrays get their memory as
+        transitions are written, so a run's memory grows to this over its budget."""
+        held = sum(getattr(self, name).nbytes for name in self._arrays)
+        return held + (self.trees.flat.nbytes if self.trees is not None else 0)
+
+    @property
     def size(self) -> int:
         """Transitions stored per member."""
         return self.capacity if self.full else self.pos

@@ -18,6 +18,7 @@ import contextlib
 import json
 import shutil
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -123,6 +124,7 @@ def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=No
         if device.type == "cpu":
             stack.enter_context(cpu_settings())
         pop = build_population(config, [c.seed for c in configs], settings, spec, table, device, envs)
+        warn_if_replay_exceeds_memory(pop)
         earlier = _resume(pop, runs)
 
         def shares() -> list[float | None]:
@@ -147,6 +149,31 @@ def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=No
                 finish(pop, k, c, run, (session, share[k]))
     finally:
         stack.close()
+
+
+def warn_if_replay_exceeds_memory(pop: Population, available: int | None = None) -> None:
+    """Warn, as SB3's replay buffer does, where the population's replays once full would
+    hold more than the machine has available now (``available`` bytes; Linux's
+    ``MemAvailable`` by default, nothing said where it is unknown): they fill as the run goes,
+    so such a run would be killed for memory hours in, not at its start."""
+    if available is None:
+        available = _available_memory()
+    needed = pop.replay.nbytes
+    if available is not None and needed > available:
+        warnings.warn(f"this population's replay will hold {needed / 2**30:.1f} GiB once full ({pop.K} members x "
+                      f"{pop.replay.capacity:,} transitions), more than the {available / 2**30:.1f} GiB this "
+                      "machine has available: train fewer seeds a population (--members) or fewer populations "
+                      "at once (--workers)", RuntimeWarning, stacklevel=2)
+
+
+def _available_memory() -> int | None:
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
 
 
 def flushing_subnormals() -> bool:
@@ -330,8 +357,6 @@ def _resume(pop: Population, runs) -> list[float | None]:
     from); when no step loads, the error names each file, why, and what to do, and nothing
     is moved or deleted. So is a population whose members share no step. Returns each
     member's share of the wall time its checkpoint records (``_saved_share``; 0 from step 0)."""
-    import warnings
-
     from ..runs import CheckpointError
 
     found = [_saved_steps(run) for run in runs]

@@ -171,3 +171,13 @@ def test_a_member_resumes_the_rows_it_saved_from_tensors_and_from_an_older_check
         np.testing.assert_array_equal(getattr(resumed, name)[0, :n], getattr(replay, name)[1, :n])
     np.testing.assert_array_equal(resumed.trees.tree[0], replay.trees.tree[1])
     assert resumed.max_priority[0] == replay.max_priority[1]
+
+
+def test_a_replay_counts_the_bytes_it_holds_once_full():
+    replay = PopulationReplay(2, 4_000, 2, 30, (), np.int64, sparse_width=12, n_steps=3)
+    # a row: observation and next observation as 12 int64 indexes and 12 float32 values each,
+    # an int64 action, float32 reward and terminal, int64 automaton state and label, a bool end
+    row = 2 * 12 * (8 + 4) + 8 + 4 + 4 + 8 + 8 + 1
+    assert replay.nbytes == 2 * 4_000 * row + 2 * 2 * replay.trees.leaves * 8  # and one sum tree a member
+    uniform = PopulationReplay(2, 4_000, 2, 30, (2,), prioritized=False)
+    assert uniform.nbytes == 2 * 4_000 * (2 * 30 * 4 + 2 * 4 + 4 + 4 + 8 + 8)

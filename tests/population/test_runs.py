@@ -4,6 +4,7 @@ from its checkpoint, and bad input is refused before anything is written."""
 
 import dataclasses
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -346,3 +347,17 @@ def test_a_cpu_population_trains_on_one_thread_with_subnormals_flushed_and_resto
     finally:
         th.set_flush_denormal(False)
         th.set_num_threads(threads)
+
+
+def test_a_population_whose_full_replay_exceeds_the_available_memory_is_warned_of_as_sb3_does(monkeypatch):
+    from types import SimpleNamespace
+
+    pop = SimpleNamespace(K=10, replay=SimpleNamespace(nbytes=12 * 2**30, capacity=1_000_000))
+    with pytest.warns(RuntimeWarning, match=r"12\.0 GiB once full \(10 members x 1,000,000 transitions\), more "
+                                            r"than the 8\.0 GiB .*--members.*--workers"):
+        population_train.warn_if_replay_exceeds_memory(pop, available=8 * 2**30)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        population_train.warn_if_replay_exceeds_memory(pop, available=16 * 2**30)  # fits: nothing said
+        monkeypatch.setattr(population_train, "_available_memory", lambda: None)
+        population_train.warn_if_replay_exceeds_memory(pop)  # not known: nothing said

@@ -22,7 +22,7 @@ from ..reached import check_automaton
 from ..runs import RunDir, last_success
 from .engine import Population, check_supported
 from .replay import SparseRows
-from .train import CHECKPOINT, STEP, _train, build_population, check_device, save_member
+from .train import CHECKPOINT, STEP, _train, build_population, check_device, read_member_state, save_member
 
 
 def train_teacher(config: TeacherConfig, root, progress: bool = True, device: str = "cpu") -> Path:
@@ -94,5 +94,5 @@ def distill_run(path) -> tuple[AutomatonQTable, object]:
     spec = resolve_task(config.task)
     with contextlib.closing(make_envs(config.env_id, 1, config.env_kwargs, True)) as envs:
         pop = build_population(config, [config.seed], config.effective()["hyperparameters"], spec, None, "cpu", envs)
-    pop.load_states([th.load(saved / CHECKPOINT, weights_only=False, map_location="cpu")])
+    pop.load_states([read_member_state(saved / CHECKPOINT)])
     return distill(pop, spec.automaton)[0], spec.automaton

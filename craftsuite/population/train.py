@@ -324,6 +324,15 @@ def _checkpoint(pop: Population, runs, shares: list[float | None]) -> None:
         run.commit_checkpoint()
 
 
+def read_member_state(path: Path) -> dict:
+    """A member's checkpoint (``population.pt``), for ``Population.load_states``: on the CPU,
+    since the replay's rows go into NumPy arrays (``load_states`` moves the networks' and
+    optimizers' tensors to the learner's device), and mapped from the file rather than read,
+    so that a resume, which loads every member before copying their rows into the replay,
+    does not hold every member's rows twice."""
+    return th.load(path, weights_only=False, map_location="cpu", mmap=True)
+
+
 def _saved_steps(run: RunDir) -> dict[int, Path]:
     """A member's complete checkpoints by step, newest directory first for each step."""
     found = {}
@@ -408,9 +417,7 @@ def _load_step(pop: Population, runs, found, step: int, failed: list) -> list[di
     for run, steps in zip(runs, found):
         path = steps[step]
         try:
-            # on the CPU: the replay's rows are copied into NumPy arrays; load_states moves the
-            # networks' and optimizers' tensors to the learner's device
-            states.append(th.load(path, weights_only=False, map_location="cpu"))
+            states.append(read_member_state(path))
         except machine_errors():
             raise  # the machine's limits, not the file's fault
         except Exception as err:  # a damaged file

@@ -5,6 +5,7 @@ from its checkpoint, and bad input is refused before anything is written."""
 import dataclasses
 import json
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -361,3 +362,25 @@ def test_a_population_whose_full_replay_exceeds_the_available_memory_is_warned_o
         population_train.warn_if_replay_exceeds_memory(pop, available=16 * 2**30)  # fits: nothing said
         monkeypatch.setattr(population_train, "_available_memory", lambda: None)
         population_train.warn_if_replay_exceeds_memory(pop)  # not known: nothing said
+
+
+def test_a_checkpoint_is_read_mapped_so_that_a_resume_holds_no_member_rows_twice(tmp_path):
+    """A resume reads every member's state before copying its rows into the replay: read
+    into memory, every member's rows would be held twice until then."""
+    status = Path("/proc/self/status")
+    if not status.exists():
+        pytest.skip("reads the process's anonymous memory from Linux's /proc")
+
+    def anonymous() -> int:
+        return next(int(line.split()[1]) * 1024 for line in status.read_text().splitlines()
+                    if line.startswith("RssAnon:"))
+
+    rows = np.random.default_rng(0).random(25_000_000, dtype=np.float32)  # 100 MB
+    th.save({"replay": {"rewards": th.from_numpy(rows)}}, tmp_path / "population.pt")
+    replay = np.zeros_like(rows)
+    replay[:] = 1.0  # resident already, as a population's replay is when it resumes
+    before = anonymous()
+    state = population_train.read_member_state(tmp_path / "population.pt")
+    replay[:] = state["replay"]["rewards"].numpy()
+    assert (replay == rows).all()
+    assert anonymous() - before < 0.1 * rows.nbytes  # read into memory: about 1.0x

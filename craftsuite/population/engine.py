@@ -280,7 +280,8 @@ class Population:
                                         for key in module.state_dict()})
         for name, opt in self.learner.optimizers().items():
             saved = [s["optimizers"][name] for s in states]
-            # a 0-d value (Adam's step) copied: the optimizer increments it in place
+            # a 0-d value (Adam's step) copied: the optimizer keeps it for the run, and a tensor
+            # of a mapped checkpoint (read_member_state) would keep the whole file mapped
             state = {i: {key: (th.stack([s["state"][i][key] for s in saved]) if v.dim() > 0 else v.clone())
                          for key, v in saved[0]["state"][i].items()} for i in saved[0]["state"]}
             opt.load_state_dict({"state": state, "param_groups": saved[0]["param_groups"]})

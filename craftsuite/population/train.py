@@ -152,28 +152,37 @@ def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=No
 
 
 def warn_if_replay_exceeds_memory(pop: Population, available: int | None = None) -> None:
-    """Warn, as SB3's replay buffer does, where the population's replays once full would
-    hold more than the machine has available now (``available`` bytes; Linux's
-    ``MemAvailable`` by default, nothing said where it is unknown): they fill as the run goes,
-    so such a run would be killed for memory hours in, not at its start."""
+    """Warn, as SB3's replay buffer does, where the population's replays at its budget would
+    hold more than the machine has available now (``available`` bytes; by default Linux's
+    ``MemAvailable``, within a container's memory limit; nothing said where it is unknown):
+    they fill as the run goes, so such a run would be killed for memory hours in, not at its
+    start. Each population sees only itself: others started beside it have filled little yet."""
     if available is None:
         available = _available_memory()
-    needed = pop.replay.nbytes
+    rows = min(pop.replay.capacity, pop.total_steps)
+    needed = pop.replay.nbytes * rows // pop.replay.capacity
     if available is not None and needed > available:
-        warnings.warn(f"this population's replay will hold {needed / 2**30:.1f} GiB once full ({pop.K} members x "
-                      f"{pop.replay.capacity:,} transitions), more than the {available / 2**30:.1f} GiB this "
-                      "machine has available: train fewer seeds a population (--members) or fewer populations "
-                      "at once (--workers)", RuntimeWarning, stacklevel=2)
+        warnings.warn(f"this population's replay will hold {needed / 2**30:.1f} GiB at its budget ({pop.K} members x "
+                      f"{rows:,} transitions), more than the {available / 2**30:.1f} GiB this machine has "
+                      "available: train fewer seeds a population (--members) or fewer populations at once "
+                      "(--workers)", RuntimeWarning, stacklevel=2)
 
 
 def _available_memory() -> int | None:
+    """Linux's ``MemAvailable``, or less where a cgroup (v2) limits this process's memory."""
     try:
-        for line in Path("/proc/meminfo").read_text().splitlines():
-            if line.startswith("MemAvailable:"):
-                return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
+        available = next(int(line.split()[1]) * 1024 for line in Path("/proc/meminfo").read_text().splitlines()
+                         if line.startswith("MemAvailable:"))
+    except (OSError, ValueError, IndexError, StopIteration):
+        return None
+    try:
+        limit = Path("/sys/fs/cgroup/memory.max").read_text().strip()
+        if limit != "max":
+            used = int(Path("/sys/fs/cgroup/memory.current").read_text())
+            available = min(available, max(int(limit) - used, 0))
+    except (OSError, ValueError):
         pass
-    return None
+    return available
 
 
 def flushing_subnormals() -> bool:
@@ -329,8 +338,11 @@ def read_member_state(path: Path) -> dict:
     since the replay's rows go into NumPy arrays (``load_states`` moves the networks' and
     optimizers' tensors to the learner's device), and mapped from the file rather than read,
     so that a resume, which loads every member before copying their rows into the replay,
-    does not hold every member's rows twice."""
-    return th.load(path, weights_only=False, map_location="cpu", mmap=True)
+    does not hold every member's rows twice. A file that is not a zip archive (damaged: every
+    checkpoint is one) is read, so that its error says what is wrong with it."""
+    with open(path, "rb") as f:
+        archive = f.read(4) == b"PK\x03\x04"
+    return th.load(path, weights_only=False, map_location="cpu", mmap=archive)
 
 
 def _saved_steps(run: RunDir) -> dict[int, Path]:

@@ -353,10 +353,13 @@ def test_a_cpu_population_trains_on_one_thread_with_subnormals_flushed_and_resto
 def test_a_population_whose_full_replay_exceeds_the_available_memory_is_warned_of_as_sb3_does(monkeypatch):
     from types import SimpleNamespace
 
-    pop = SimpleNamespace(K=10, replay=SimpleNamespace(nbytes=12 * 2**30, capacity=1_000_000))
-    with pytest.warns(RuntimeWarning, match=r"12\.0 GiB once full \(10 members x 1,000,000 transitions\), more "
-                                            r"than the 8\.0 GiB .*--members.*--workers"):
+    pop = SimpleNamespace(K=10, total_steps=1_000_000, replay=SimpleNamespace(nbytes=12 * 2**30, capacity=1_000_000))
+    with pytest.warns(RuntimeWarning, match=r"12\.0 GiB at its budget \(10 members x 1,000,000 transitions\), "
+                                            r"more than the 8\.0 GiB .*--members.*--workers"):
         population_train.warn_if_replay_exceeds_memory(pop, available=8 * 2**30)
+    short = SimpleNamespace(K=10, total_steps=500_000, replay=pop.replay)  # fills half its replay
+    with pytest.warns(RuntimeWarning, match=r"6\.0 GiB at its budget \(10 members x 500,000 transitions\)"):
+        population_train.warn_if_replay_exceeds_memory(short, available=5 * 2**30)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         population_train.warn_if_replay_exceeds_memory(pop, available=16 * 2**30)  # fits: nothing said
@@ -382,5 +385,25 @@ def test_a_checkpoint_is_read_mapped_so_that_a_resume_holds_no_member_rows_twice
     before = anonymous()
     state = population_train.read_member_state(tmp_path / "population.pt")
     replay[:] = state["replay"]["rewards"].numpy()
+    held = anonymous() - before  # before the comparison below allocates
     assert (replay == rows).all()
-    assert anonymous() - before < 0.1 * rows.nbytes  # read into memory: about 1.0x
+    assert held < 0.1 * rows.nbytes  # read into memory: about 1.0x
+
+
+def test_a_resumed_population_keeps_no_checkpoint_mapped(tmp_path, monkeypatch):
+    """Nothing of the states read at a resume outlives it: a tensor kept from a mapped
+    checkpoint would keep the whole file mapped (and its disk space, once rotated away)."""
+    maps = Path("/proc/self/maps")
+    if not maps.exists():
+        pytest.skip("reads the process's mappings from Linux's /proc")
+    configs = _cell(seeds=(0, 1))
+    _killed_at_the_second_evaluation(configs, tmp_path, monkeypatch)
+    mapped, evaluate = [], population_train._evaluate
+
+    def looks(*args):
+        mapped.append([line for line in maps.read_text().splitlines() if population_train.CHECKPOINT in line])
+        return evaluate(*args)
+
+    monkeypatch.setattr(population_train, "_evaluate", looks)
+    train_population(configs, tmp_path, progress=False)
+    assert mapped and all(lines == [] for lines in mapped)

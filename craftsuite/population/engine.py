@@ -273,7 +273,8 @@ class Population:
                 "num_timesteps": self.num_timesteps, "n_calls": self.n_calls, "n_updates": self.learner.n_updates}
 
     def load_states(self, states: list[dict]) -> None:
-        """Resume every member from its ``member_state``; all at one step."""
+        """Resume every member from its ``member_state``; all at one step. Nothing of
+        ``states`` is kept: they may be mapped from their files (``train.read_member_state``)."""
         with th.no_grad():
             for name, module in self.learner.modules().items():
                 module.load_state_dict({key: th.stack([s["modules"][name][key] for s in states])
@@ -281,7 +282,7 @@ class Population:
         for name, opt in self.learner.optimizers().items():
             saved = [s["optimizers"][name] for s in states]
             # a 0-d value (Adam's step) copied: the optimizer keeps it for the run, and a tensor
-            # of a mapped checkpoint (read_member_state) would keep the whole file mapped
+            # of a mapped checkpoint would keep the whole file mapped
             state = {i: {key: (th.stack([s["state"][i][key] for s in saved]) if v.dim() > 0 else v.clone())
                          for key, v in saved[0]["state"][i].items()} for i in saved[0]["state"]}
             opt.load_state_dict({"state": state, "param_groups": saved[0]["param_groups"]})

@@ -168,17 +168,18 @@ def warn_if_replay_exceeds_memory(pop: Population, available: int | None = None)
                       "(--workers)", RuntimeWarning, stacklevel=2)
 
 
-def _available_memory() -> int | None:
-    """Linux's ``MemAvailable``, or less where a cgroup (v2) limits this process's memory."""
+def _available_memory(root: Path = Path("/")) -> int | None:
+    """Linux's ``MemAvailable``, or less within a container's memory limit (cgroup v2's
+    ``memory.max`` as the container sees it, less its ``memory.current``); None where unknown."""
     try:
-        available = next(int(line.split()[1]) * 1024 for line in Path("/proc/meminfo").read_text().splitlines()
+        available = next(int(line.split()[1]) * 1024 for line in (root / "proc/meminfo").read_text().splitlines()
                          if line.startswith("MemAvailable:"))
     except (OSError, ValueError, IndexError, StopIteration):
         return None
     try:
-        limit = Path("/sys/fs/cgroup/memory.max").read_text().strip()
+        limit = (root / "sys/fs/cgroup/memory.max").read_text().strip()
         if limit != "max":
-            used = int(Path("/sys/fs/cgroup/memory.current").read_text())
+            used = int((root / "sys/fs/cgroup/memory.current").read_text())
             available = min(available, max(int(limit) - used, 0))
     except (OSError, ValueError):
         pass

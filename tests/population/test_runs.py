@@ -178,7 +178,9 @@ def test_a_damaged_checkpoint_is_passed_over_for_the_populations_step_before(tmp
         load(self, states)
 
     monkeypatch.setattr(population_train.Population, "load_states", spy)
-    with pytest.warns(RuntimeWarning, match="resuming from step 400.*population.pt cannot be loaded"):
+    # the file's own error (not mapped: it is no zip archive), not torch's advice on mapping
+    with pytest.warns(RuntimeWarning, match=r"resuming from step 400.*population.pt cannot be loaded "
+                                            r"\(UnpicklingError"):
         paths = train_population(configs, tmp_path, progress=False)
     assert loaded["steps"] == [400, 400]
     assert loaded["folders"] == [["checkpoint-old"], ["checkpoint-old", "checkpoint-unloadable"]]
@@ -348,6 +350,22 @@ def test_a_cpu_population_trains_on_one_thread_with_subnormals_flushed_and_resto
     finally:
         th.set_flush_denormal(False)
         th.set_num_threads(threads)
+
+
+def test_the_available_memory_is_the_machines_within_a_containers_limit(tmp_path):
+    (tmp_path / "proc").mkdir()
+    (tmp_path / "proc" / "meminfo").write_text("MemTotal:       24000000 kB\nMemAvailable:   16000000 kB\n")
+    assert population_train._available_memory(tmp_path) == 16_000_000 * 1024  # no cgroup files: the machine's
+    cgroup = tmp_path / "sys" / "fs" / "cgroup"
+    cgroup.mkdir(parents=True)
+    (cgroup / "memory.max").write_text("max\n")
+    (cgroup / "memory.current").write_text("1000\n")
+    assert population_train._available_memory(tmp_path) == 16_000_000 * 1024  # no limit
+    (cgroup / "memory.max").write_text(f"{8 * 2**30}\n")
+    (cgroup / "memory.current").write_text(f"{2**30}\n")
+    assert population_train._available_memory(tmp_path) == 7 * 2**30  # the container's limit, less its use
+    (tmp_path / "proc" / "meminfo").write_text("MemTotal:       24000000 kB\n")
+    assert population_train._available_memory(tmp_path) is None  # not said: not known
 
 
 def test_a_population_whose_full_replay_exceeds_the_available_memory_is_warned_of_as_sb3_does(monkeypatch):

@@ -339,8 +339,8 @@ def read_member_state(path: Path) -> dict:
     since the replay's rows go into NumPy arrays (``load_states`` moves the networks' and
     optimizers' tensors to the learner's device), and mapped from the file rather than read,
     so that a resume, which loads every member before copying their rows into the replay,
-    does not hold every member's rows twice. A file that is not a zip archive (damaged: every
-    checkpoint is one) is read, so that its error says what is wrong with it."""
+    does not hold every member's rows twice. A file that is not a zip archive, as every
+    checkpoint is, is damaged: it is read, so that its error says what is wrong with it."""
     with open(path, "rb") as f:
         archive = f.read(4) == b"PK\x03\x04"
     return th.load(path, weights_only=False, map_location="cpu", mmap=archive)

@@ -51,7 +51,7 @@ with contextlib.closing(make_envs(config.env_id, 1, config.env_kwargs, config.pr
     pop = build_population(config, list(range(members)), config.effective()["hyperparameters"], spec, None,
                            "cpu", envs)
 replay, rng = pop.replay, np.random.default_rng(0)
-rows = min(rows, replay.capacity) - min(rows, replay.capacity) % replay.n_envs
+rows = min(rows, replay.capacity) // replay.n_envs * replay.n_envs  # whole steps of the envs
 for name in replay._arrays:  # every page written, as a run's transitions write them
     array = getattr(replay, name)[:, :rows]
     array[...] = rng.integers(0, 2, size=array.shape) if array.dtype.kind in "biu" else rng.random(array.shape)

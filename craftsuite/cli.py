@@ -9,9 +9,10 @@ from pathlib import Path
 TIME_LIMIT_STATUS = 3  # the exit status of a transfer its --time-limit stopped: runs are left to resume
 
 
-def _task(argument: str) -> str:
+def _task(argument: str, world_flag: str | None = None) -> str:
     """A task argument's task name: a known task's, or a spec file's (``*.toml``, read and
-    registered here, with its ids). Called before anything is written.
+    registered here, with its ids). Called before anything is written. ``world_flag``: the
+    command's option that picks a world (e.g. ``--world``), named where an id was given.
 
     Raises:
         KeyError: an unknown task name, listing the known ones.
@@ -24,7 +25,8 @@ def _task(argument: str) -> str:
 
     if str(argument).startswith(f"{NAMESPACE}/"):  # an id where a task goes: not a path to look for
         task, _ = parse_id(argument)  # a malformed one: the id format, named
-        raise ValueError(f"{argument} is an id; give its task ({task}) and the world with --world")
+        world = f" and the world with {world_flag}" if world_flag else ""
+        raise ValueError(f"{argument} is an id; give its task ({task}){world}")
     if is_spec_file(argument):
         return parse_id(register_task(Path(argument))[0])[0]
     return resolve_task(argument).name
@@ -91,11 +93,13 @@ def _tasks(args) -> int:
     from .task_registry import ladder
 
     if args.markdown:
+        from .files import file_to_write
         from .references import write_tasks_page
 
         if args.tag:
             raise ValueError("--markdown writes the page of every rung; --tag selects rungs to list: "
                              "use one or the other")
+        file_to_write(args.markdown, "--markdown", "tasks.md")  # before minutes of rollouts
         path = write_tasks_page(args.markdown, episodes=args.episodes)
         print(f"wrote {path}")
         return 0
@@ -113,9 +117,13 @@ def _tasks(args) -> int:
 
 
 def _automaton(args) -> int:
-    from .automata import write_image
+    from .automata import image_format, write_image
+    from .files import file_to_write
     from .task_registry import resolve_task
 
+    if args.out:
+        image_format(args.out)
+        file_to_write(args.out, "--out", f"{args.task}.png")
     spec = resolve_task(args.task)
     if args.describe:
         print(spec.automaton.describe())
@@ -132,6 +140,7 @@ def _scripted(args) -> int:
     import numpy as np
 
     from .automata import write_image
+    from .files import directory_to_write
     from .ids import CONT, file_stem, parse_id
     from .progress import progress_iter
     from .registration import registered_ids
@@ -140,7 +149,7 @@ def _scripted(args) -> int:
     from .task_registry import tasks
 
     ids = [i for i in registered_ids() if args.task in (None, parse_id(i)[0])]
-    out = Path(args.out)
+    out = directory_to_write(args.out, "--out")
     out.mkdir(parents=True, exist_ok=True)
     rows = []
     for env_id in progress_iter(ids, "scripted rollouts", "env"):
@@ -233,8 +242,10 @@ def _hyper(text: str | None, algorithm: str, flag: str = "--hyper") -> dict:
 
 def _teacher(args) -> int:
     from .configs import TeacherConfig
+    from .files import directory_to_write
     from .training import train_teacher
 
+    directory_to_write(args.out, "--out")
     config = TeacherConfig(task=args.task, size=args.size,
                            layout_seed=None if args.layout_seed < 0 else args.layout_seed,
                            seed=args.seed, max_steps=args.max_steps, target_success=args.target_success,
@@ -248,8 +259,14 @@ def _teacher(args) -> int:
 
 def _distill(args) -> int:
     from .agents.distillation import static_distillation
+    from .automata import image_format
+    from .files import file_to_write
     from .task_registry import resolve_task
 
+    file_to_write(args.out, "--out", "table.npz")  # where it writes, before it distils
+    if args.draw:
+        image_format(args.draw)
+        file_to_write(args.draw, "--draw", "values.png")
     if args.static:
         spec = resolve_task(_task(args.source))
         table = static_distillation(spec.automaton, completion_reward=spec.completion_reward)
@@ -258,6 +275,15 @@ def _distill(args) -> int:
         from .agents.factory import distill_from_replay, load_agent
 
         source = Path(args.source)
+        if not source.exists():
+            try:  # a task's name: its automaton alone is distilled statically
+                task = _task(args.source)
+            except (KeyError, ValueError):
+                raise FileNotFoundError(f"no teacher at {source}: give a teacher run directory or its .zip "
+                                        "(dynamic), or a task name with --static") from None
+            raise ValueError(f"{args.source} is a task: distil its automaton alone with --static (craftsuite "
+                             f"distill {task} --static --out {args.out}), or give a teacher run directory for its "
+                             "teacher's values")
         env_id, env_kwargs = args.env_id or _registered(args.task, "Grid7"), {}
         if source.is_dir():  # a teacher run directory: its config names the env, its checkpoint the replay
             from .configs import TeacherConfig
@@ -306,8 +332,10 @@ def _write_table(table, automaton, args) -> int:
 
 
 def _student(args) -> int:
-    from .methods import METHODS, resolve_method
     from .configs import StudentConfig
+    from .files import directory_to_write
+    from .methods import METHODS, resolve_method
+    from .suite_runner import check_budgets
     from .training import train_student
 
     args.method = resolve_method(args.method)  # a row of the user's own (module:name): its module registers it
@@ -320,6 +348,8 @@ def _student(args) -> int:
                            n_envs=args.n_envs, automaton_state=args.automaton_state, engine=args.engine)
     if METHODS[args.method].needs_table and not args.table:
         raise ValueError(f"method {args.method!r} needs --table (a teacher's table.npz: craftsuite teacher)")
+    check_budgets([config], {})  # as a transfer's: a budget that takes no update is refused, not trained
+    directory_to_write(args.out, "--out")
     path = train_student(config, args.out)
     print((path / "result.json").read_text().strip())
     print(f"student run: {path}")
@@ -339,7 +369,8 @@ def _transfer(args) -> int:
         raise KeyError(f"unknown suite {args.suite!r}; suites: {sorted(SUITES)}")
     suite = SUITES[args.suite]
     if args.tags is not None or args.tasks is not None:  # the rungs given replace the suite's
-        suite = dataclasses.replace(suite, tags=tuple(args.tags or ()), tasks=tuple(map(_task, args.tasks or ())))
+        suite = dataclasses.replace(suite, tags=tuple(args.tags or ()),
+                                    tasks=tuple(_task(t, "--worlds") for t in args.tasks or ()))
     changes = {k: v for k, v in (("worlds", tuple(args.worlds) if args.worlds else None), ("seeds", args.seeds),
                                  ("student_steps", args.steps),
                                  # a row of the user's own (module:name) is registered by its module's import
@@ -487,6 +518,9 @@ def _positive(text: str) -> int:
     return value
 
 
+_positive.__name__ = "integer"  # argparse names a non-integer "invalid integer value"
+
+
 def _positive_float(text: str) -> float:
     value = float(text)
     if not 0 < value < float("inf"):  # nan and inf are no rate either
@@ -512,6 +546,9 @@ def _fraction(text: str) -> float:
     if not 0 <= value <= 1:
         raise argparse.ArgumentTypeError(f"must be between 0 and 1, got {value}")
     return value
+
+
+_fraction.__name__ = "number"  # argparse names a non-number "invalid number value"
 
 
 def _on_off(text: str) -> bool:
@@ -736,7 +773,7 @@ def _check_task(args) -> None:
 
     if getattr(args, "task", None) is None:
         return
-    args.task = _task(args.task)
+    args.task = _task(args.task, {"student": "--world", "teacher": "--size"}.get(args.command))
     if getattr(args, "world", None) is not None:  # student
         _registered(args.task, args.world)
     elif args.command == "teacher":

@@ -14,7 +14,7 @@ from pathlib import Path
 from .ids import env_id, grid_id, grid_world, world_kind
 from .envs.grid import layout_kwargs
 from .hyperparameters import algorithm_settings
-from .methods import METHODS, check_methods
+from .methods import METHODS, check_methods, methods_for
 from .runs import config_key
 from .task_registry import resolve_task
 
@@ -108,11 +108,20 @@ class StudentConfig:
     def __post_init__(self):
         _check_n_envs(self.n_envs)
         _check_engine(self.engine)
+        kind = world_kind(self.world)  # a ValueError naming the worlds there are
         if self.method in METHODS:  # an unknown method is named where it is used (check_methods)
-            METHODS[self.method].observes(self.automaton_state)  # a MethodError naming both
-            if self.automaton_state == METHODS[self.method].product:  # what the method does anyway: one run key
+            row = METHODS[self.method]
+            if row.world != kind:  # DQN needs discrete moves, TD3 continuous thrust
+                worlds = "e.g. Grid10" if row.world == "Grid" else "Cont or Kinematic"
+                raise ValueError(f"method {self.method!r} runs in the {row.world} worlds, not in {self.world}; "
+                                 f"give a {row.world} world ({worlds}), or one of {self.world}'s methods: "
+                                 f"{methods_for(self.world)}")
+            if self.table is not None and not row.needs_table:  # it would be recorded, and change the run key
+                raise ValueError(f"method {self.method!r} distils no teacher's table: leave out the table; the "
+                                 f"methods that take one: {[m for m, r in METHODS.items() if r.needs_table]}")
+            row.observes(self.automaton_state)  # a MethodError naming both
+            if self.automaton_state == row.product:  # what the method does anyway: one run key
                 object.__setattr__(self, "automaton_state", None)
-        world_kind(self.world)  # a ValueError naming the worlds there are
         if layout_kwargs(self.layout_seed) and world_kind(self.world) != "Grid":  # also checks the seed
             raise ValueError(f"layout_seed fixes a grid instance; the {self.world} world has none "
                              "(its objects are placed anew every episode)")

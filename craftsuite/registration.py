@@ -46,8 +46,9 @@ def world_keywords(world: str) -> tuple[str, ...]:
 
 def check_world_kwargs(world: str, kwargs, source: str | None = None) -> None:
     """Raise a ValueError (``source``: where they came from, e.g. ``--env``) when ``kwargs``
-    hold a keyword ``world`` does not take, naming the keywords it does; before anything
-    is built, so a misspelt keyword is not Python's "unexpected keyword argument"."""
+    hold a keyword ``world`` does not take, naming the keywords it does, or a ``product``
+    that is not True or False; before anything is built, so a misspelt keyword is not
+    Python's "unexpected keyword argument"."""
     kind = _entry_key(world)
     prefix = f"{source}: " if source else ""
     accepted = world_keywords(world)
@@ -59,6 +60,9 @@ def check_world_kwargs(world: str, kwargs, source: str | None = None) -> None:
         accepted = tuple(k for k in accepted if k not in owns)
     unknown = sorted(set(kwargs) - set(accepted) - {"task"})
     if not unknown:
+        if not isinstance(kwargs.get("product", False), bool):  # "no" or 0 would pass as a truth value
+            raise ValueError(f"{prefix}product must be True or False (whether the observation has the automaton "
+                             f"state's one-hot), got {kwargs['product']!r}")
         return
     why = [_WHY_NOT.get(kind, {}).get(k) for k in unknown]
     if all(why):

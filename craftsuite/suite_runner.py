@@ -323,9 +323,9 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     the kernel's out-of-memory killer, say) stops the rest the same way.
 
     Bad input (a budget too small to train, a device this machine lacks, an output
-    directory or archive that cannot be one, a Ray cluster out of reach, an sb3 run
-    finished nowhere) is refused
-    before anything is written."""
+    directory or archive that cannot be one, an output directory of another suite's runs,
+    a Ray cluster out of reach, an sb3 run finished nowhere) is refused before anything is
+    written."""
     from .archive import keep_all, restore
     from .archive import size as archive_size
     from .completion import reread_in_place
@@ -343,6 +343,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     teachers = suite.teachers()
     check_budgets(configs, teachers)
     kept = _check_places(out, archive, suite.name)
+    _check_out_suite(out, suite.name)
     _check_students(configs, device, teachers.values())  # fail before any training
     read(out)  # a damaged provenance record, too
     _counting_acceptance([out / "students" / c.run_name() for c in configs])  # none unfinished
@@ -554,6 +555,17 @@ def _check_places(out: Path, archive, suite: str) -> Path | None:
         return None
     directory_to_write(archive, "--archive")
     return directory_to_write(Path(archive) / suite, "--archive")  # a file there, too
+
+
+def _check_out_suite(out: Path, name: str) -> None:
+    """Refuse an output directory that holds another suite's runs (its ``suite.json``): both
+    would share one leaderboard, and the other's record of its suite would be replaced."""
+    from .reporting.sources import suite_json
+
+    held = suite_json(out).get("name")
+    if held not in (None, name):
+        raise ValueError(f"--out {out} holds runs of the {held} suite (its suite.json), which the {name} suite's "
+                         f"would join on one leaderboard; give another --out, e.g. runs/{name}")
 
 
 def _best_student_video(students: list[Path], out: Path, log=print) -> Path | None:

@@ -63,6 +63,32 @@ def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
      "--hyper: learning_rate must be above 0 (default 0.0005), got -1"),
     (["transfer", "--dqn-hyper", '{"batch_size": -1}'], "--dqn-hyper: batch_size must be at least 1"),
     (["transfer", "--env", '{"layout_seed": 1}'], "--env: unknown keyword 'layout_seed' for the MuJoCo world"),
+    # a method of the other kind of world: DQN's first in the list, the world Cont by default
+    (["student", "FirstTool", "--method", "dqn"],
+     "method 'dqn' runs in the Grid worlds, not in Cont; give a Grid world (e.g. Grid10), or one of Cont's methods: "
+     "['td3', 'product-td3'"),
+    (["student", "FirstTool", "--method", "td3", "--world", "Grid10"],
+     "method 'td3' runs in the Cont worlds, not in Grid10; give a Cont world (Cont or Kinematic)"),
+    # a table the method does not read would be recorded in its config, and change its run key
+    (["student", "FirstTool", "--method", "td3", "--table", "/etc/hostname"],
+     "method 'td3' distils no teacher's table: leave out the table"),
+    # a budget with no gradient update in it, as transfer refuses it
+    (["student", "FirstTool", "--method", "td3", "--steps", "100"],
+     "--steps 100: too small to train FirstTool's td3 students (Cont), which take no gradient update in their "
+     "first 1,000 transitions (learning_starts); use --steps 1001 or more"),
+    # the engine's device is --device; as a setting it was ignored, though recorded in the run key
+    (["student", "FirstTool", "--method", "td3", "--hyper", '{"device": "cuda"}'],
+     "method 'td3': the population engine, which trains CraftSuite's runs, does not support device among the "
+     "settings: the device is the command's --device"),
+    (["student", "FirstTool", "--method", "td3", "--hyper", '{"policy_kwargs": {"net_arch": "big"}}'],
+     "method 'td3': the population engine, which trains CraftSuite's runs, does not support net_arch 'big' (it "
+     "takes the hidden layers' widths"),
+    (["student", "CraftSuite/FirstTool-Cont-v0"],
+     "CraftSuite/FirstTool-Cont-v0 is an id; give its task (FirstTool) and the world with --world"),
+    (["scripted", "--task", "CraftSuite/Reach-Cont-v0"], "CraftSuite/Reach-Cont-v0 is an id; give its task (Reach)\n"),
+    (["distill", "FirstTool"], "FirstTool is a task: distil its automaton alone with --static"),
+    (["distill", "no-such-teacher"], "no teacher at no-such-teacher: give a teacher run directory or its .zip "
+                                     "(dynamic), or a task name with --static"),
 ])
 def test_a_refused_command_names_its_flag_and_leaves_no_output_folder(tmp_path, capsys, command, message):
     out = tmp_path / "new" / "runs"
@@ -70,6 +96,59 @@ def test_a_refused_command_names_its_flag_and_leaves_no_output_folder(tmp_path, 
     err = capsys.readouterr().err
     assert err.startswith(f"craftsuite {command[0]}: error: {message}") and err.count("\n") == 1
     assert list(tmp_path.iterdir()) == []
+
+
+def test_where_a_command_writes_is_checked_before_it_computes(tmp_path, capsys):
+    """A file where a directory goes, a directory where a file goes, a drawing in a format
+    there is none of: refused in one line before the command computes or writes anything
+    (distill wrote its table first; tasks rolled out every id for minutes)."""
+    file, folder = tmp_path / "file", tmp_path / "folder"
+    file.write_text("kept\n")
+    folder.mkdir()
+    table = tmp_path / "table.npz"
+    refused = {
+        ("student", "FirstTool", "--method", "td3", "--out", str(file)): f"--out {file} is a file, not a directory",
+        ("teacher", "FirstTool", "--out", str(file)): f"--out {file} is a file, not a directory",
+        ("scripted", "--task", "Reach", "--out", str(file)): f"--out {file} is a file, not a directory",
+        ("distill", "FirstTool", "--static", "--out", str(folder)):
+            f"--out {folder} is a directory, not a file: give the file to write, e.g. {folder / 'table.npz'}",
+        ("distill", "FirstTool", "--static", "--out", str(table), "--draw", str(tmp_path / "v.jpg")):
+            f"cannot draw to '{tmp_path / 'v.jpg'}': use a .png, .svg, .pdf or .dot file",
+        ("tasks", "--markdown", str(folder)): f"--markdown {folder} is a directory, not a file",
+        ("automaton", "FirstTool", "--out", "."): "cannot draw to '.': use a .png, .svg, .pdf or .dot file",
+    }
+    for command, message in refused.items():
+        assert main(list(command)) == 2, command
+        err = capsys.readouterr().err
+        assert err.startswith(f"craftsuite {command[0]}: error: {message}") and err.count("\n") == 1, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file", "folder"] and not any(folder.iterdir())
+    assert file.read_text() == "kept\n"
+
+
+def test_a_directory_given_for_a_file_names_the_file_in_it(tmp_path, capsys):
+    """A teacher's run directory where its table goes, a run directory where a checkpoint
+    goes: the message names the file to give."""
+    teacher = tmp_path / "teacher-FirstTool-Grid7-s0"
+    teacher.mkdir()
+    (teacher / "table.npz").write_bytes(b"")
+    assert main(["student", "FirstTool", "--method", "td3-dynamic", "--table", str(teacher),
+                 "--out", str(tmp_path / "runs")]) == 2
+    assert (f"{teacher} is a directory, not a distilled table: give the table file, e.g. {teacher / 'table.npz'} "
+            "(the teacher's is there)") in capsys.readouterr().err
+    assert main(["video", "FirstTool", "--policy", str(teacher), "--out", str(tmp_path / "v.mp4")]) == 2
+    assert f"is a directory, not a checkpoint: give the checkpoint file, e.g. {teacher / 'model.zip'}" in (
+        capsys.readouterr().err)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [teacher.name]
+
+
+def test_a_word_where_a_number_goes_is_named_as_a_number(capsys):
+    """argparse names the type by its function: the message says integer or number."""
+    for command, text in ((["transfer", "--seeds", "two"], "argument --seeds: invalid integer value: 'two'"),
+                          (["teacher", "Reach", "--target-success", "high"],
+                           "argument --target-success: invalid number value: 'high'")):
+        with pytest.raises(SystemExit):
+            main(command)
+        assert text in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("command", [["student", "Reach", "--seed", "-1"], ["teacher", "Reach", "--seed", "-1"],
@@ -206,6 +285,18 @@ def test_transfer_refuses_a_file_where_its_directories_must_be(tmp_path, capsys)
     (tmp_path / "results" / "quick").write_text("")  # the suite's place in the archive
     assert "--archive" in _refused(tmp_path, capsys, "--steps", "2000", "--archive", str(tmp_path / "results"))
     assert file.read_text() == "kept\n"
+
+
+def test_transfer_refuses_an_output_directory_of_another_suite(tmp_path, capsys):
+    """Suites never share an output directory (a quick run's would join the standard suite's
+    leaderboard, and its suite.json be replaced); the same suite's resumes as before."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "suite.json").write_text(json.dumps({"name": "standard"}))
+    assert _refused(tmp_path, capsys, "--steps", "2000", out=out) == (
+        f"--out {out} holds runs of the standard suite (its suite.json), which the quick suite's would join on one "
+        "leaderboard; give another --out, e.g. runs/quick")
+    assert json.loads((out / "suite.json").read_text()) == {"name": "standard"}
 
 
 def _closed_port() -> int:

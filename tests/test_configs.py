@@ -18,7 +18,7 @@ def test_importing_the_configs_imports_no_torch():
 
 
 def test_a_configs_env_id_is_built_by_the_id_module():
-    student = configs.StudentConfig(task="Reach", world="Grid10")
+    student = configs.StudentConfig(task="Reach", method="dqn", world="Grid10")
     assert student.env_id == ids.env_id("Reach", "Grid10") and ids.parse_id(student.env_id) == ("Reach", "Grid10")
     teacher = configs.TeacherConfig(task="Reach", size=10)
     assert ids.parse_id(teacher.env_id) == ("Reach", "Grid10")

@@ -38,7 +38,7 @@ def test_a_grid_student_trains_and_is_evaluated_on_one_fixed_instance(tmp_path, 
     with pytest.raises(ValueError, match="the Cont world has none"):
         StudentConfig(world="Cont", layout_seed=3)
     with pytest.raises(ValueError, match="layout_seed must be a non-negative integer"):
-        StudentConfig(world="Grid7", layout_seed=-1)  # refused before a run directory is made
+        StudentConfig(method="dqn", world="Grid7", layout_seed=-1)  # refused before a run directory is made
 
 
 def test_a_student_trains_and_is_evaluated_in_the_world_its_config_names(tmp_path, monkeypatch):

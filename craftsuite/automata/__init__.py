@@ -2,10 +2,10 @@
 
 from .compile import COMPILER_VERSION, cache_dir, compile_ltlf
 from .dfa import Automaton
-from .draw import to_dot, write_image
+from .draw import image_format, to_dot, write_image
 from .ltlf import LTLfSyntaxError, parse
 
 __all__ = [
     "Automaton", "compile_ltlf", "cache_dir", "COMPILER_VERSION", "LTLfSyntaxError", "parse",
-    "to_dot", "write_image",
+    "image_format", "to_dot", "write_image",
 ]

@@ -63,16 +63,27 @@ def to_dot(
     return "\n".join(lines) + "\n"
 
 
+def image_format(path) -> str:
+    """The format ``write_image`` draws ``path`` in, by its suffix (checked before a command
+    computes what it draws).
+
+    Raises:
+        ValueError: a suffix it cannot draw, naming the path and the ones it can.
+    """
+    fmt = Path(path).suffix.lstrip(".").lower()
+    if fmt not in ("png", "svg", "pdf", "dot", "gv"):
+        raise ValueError(f"cannot draw to {str(path)!r}: use a .png, .svg, .pdf or .dot file")
+    return fmt
+
+
 def write_image(automaton: Automaton, path, **dot_options) -> Path:
     """Render to PNG, SVG or PDF (by the file suffix) with Graphviz ``dot``; ``.dot`` writes text."""
     path = Path(path)
+    fmt = image_format(path)
     text = to_dot(automaton, **dot_options)
-    fmt = path.suffix.lstrip(".").lower()
     if fmt in ("dot", "gv"):
         path.write_text(text)
         return path
-    if fmt not in ("png", "svg", "pdf"):
-        raise ValueError(f"cannot draw to {path.name!r}: use a .png, .svg, .pdf or .dot file")
     dot = shutil.which("dot")
     if dot is None:
         raise RuntimeError(

@@ -38,12 +38,12 @@ class EngineError(ValueError):
 _READ = {
     "td3": {"learning_rate", "buffer_size", "batch_size", "learning_starts", "gamma", "tau", "target_policy_noise",
             "target_noise_clip", "action_noise", "policy_kwargs", "train_freq", "gradient_steps", "n_steps",
-            "prioritized", "replay_buffer_kwargs", "policy_delay", "delay_schedule", "device",
+            "prioritized", "replay_buffer_kwargs", "policy_delay", "delay_schedule",
             "stats_window_size", "optimize_memory_usage", "layer_norm"},
     "dqn": {"learning_rate", "buffer_size", "batch_size", "learning_starts", "gamma", "tau", "train_freq",
             "gradient_steps", "target_update_interval", "exploration_fraction", "exploration_initial_eps",
             "exploration_final_eps", "policy_kwargs", "n_steps", "prioritized", "replay_buffer_kwargs",
-            "max_grad_norm", "double", "dueling", "loss", "target_update_unit", "features_extractor", "device",
+            "max_grad_norm", "double", "dueling", "loss", "target_update_unit", "features_extractor",
             "stats_window_size", "optimize_memory_usage", "layer_norm"},
 }
 _POLICY_KWARGS = {"net_arch", "activation_fn", "optimizer_kwargs", "n_critics"}
@@ -54,12 +54,18 @@ def check_supported(method: str, settings: dict) -> None:
     algorithm = METHODS[method].algorithm
     why = None
     unknown = sorted(set(settings) - _READ[algorithm])
-    if unknown:
+    if "device" in settings:  # SB3's keyword; the engine's device is its run's, not a setting (nor in the run key)
+        why = "device among the settings: the device is the command's --device (train_population's device)"
+    elif unknown:
         why = f"the settings {unknown}"
     elif settings.get("optimize_memory_usage"):
         why = "optimize_memory_usage (its replay keeps next observations; a grid's as their nonzero entries)"
     elif sorted(set(settings.get("policy_kwargs") or {}) - _POLICY_KWARGS):
         why = f"policy_kwargs {sorted(set(settings['policy_kwargs']) - _POLICY_KWARGS)}"
+    elif not _widths_ok((settings.get("policy_kwargs") or {}).get("net_arch", [64]), algorithm):
+        pi_qf = ', or {"pi": [...], "qf": [...]}' if algorithm == "td3" else ""
+        why = (f"net_arch {settings['policy_kwargs']['net_arch']!r} (it takes the hidden layers' widths, positive "
+               f"integers, e.g. [256, 256]{pi_qf})")
     elif not _train_every(settings.get("train_freq", 1)):
         why = f"train_freq {settings['train_freq']!r} (it trains every k steps, not episodes)"
     elif not (isinstance(settings.get("gradient_steps", 1), int) and settings.get("gradient_steps", 1) >= 1):
@@ -78,6 +84,15 @@ def _check_n_steps(method: str, n_steps) -> None:
     """Raise ``EngineError`` for a return length no engine runs: not a positive integer."""
     if not isinstance(n_steps, int) or isinstance(n_steps, bool) or n_steps < 1:
         raise EngineError(f"method {method!r}: n_steps must be a positive integer, got {n_steps!r}")
+
+
+def _widths_ok(arch, algorithm: str) -> bool:
+    """Whether ``net_arch`` is what the engine builds from: a list of positive widths (TD3:
+    or one for the actor and one for the critics, ``{"pi": [...], "qf": [...]}``)."""
+    if algorithm == "td3" and isinstance(arch, dict):
+        return set(arch) == {"pi", "qf"} and all(_widths_ok(arch[k], "dqn") for k in ("pi", "qf"))
+    return isinstance(arch, (list, tuple)) and all(
+        isinstance(w, int) and not isinstance(w, bool) and w >= 1 for w in arch)
 
 
 def _train_every(train_freq) -> int | None:

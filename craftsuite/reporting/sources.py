@@ -85,7 +85,7 @@ def read_runs(path, *, transfer: bool = False, suite_cells: bool = False) -> Run
         raise FileNotFoundError(f"{path} is not a transfer output directory (no students/)")
     if not students.is_dir():
         raise FileNotFoundError(f"no run directory at {path}")
-    suite = _suite_json(path)
+    suite = suite_json(path)
     asked = SUITES.get(_name(suite, path)) if suite_cells else None
     board = build(students, apart=None if asked is None else superseded(asked, students))
     unfinished = len(board.unfinished) + (len(board.apart.unfinished) if board.apart else 0)
@@ -97,7 +97,7 @@ def read_runs(path, *, transfer: bool = False, suite_cells: bool = False) -> Run
     return RunsDirectory(path, students, board, suite, read(path))
 
 
-def _suite_json(path: Path) -> dict:
+def suite_json(path: Path) -> dict:
     """The suite as last run into ``path`` (``suite.json``; empty: none)."""
     if not (path / "suite.json").exists():
         return {}

@@ -233,6 +233,14 @@ def test_an_unknown_keyword_names_the_keywords_the_world_accepts(env_id, keyword
     assert str(err.value).startswith(problem) and "unexpected keyword" not in str(err.value)
 
 
+@pytest.mark.parametrize("world,product", [("Grid7", "no"), ("Cont", 1), ("Kinematic", None)])
+def test_product_is_true_or_false(world, product):
+    """Any other value would pass as a truth value ("no" would add the automaton state)."""
+    with pytest.raises(ValueError, match=f"^product must be True or False \\(whether the observation has the "
+                                         f"automaton state's one-hot\\), got {product!r}$"):
+        gym.make(f"CraftSuite/Reach-{world}-v0", product=product)
+
+
 def test_every_keyword_a_world_lists_is_taken():
     from craftsuite.registration import world_keywords
 

@@ -407,6 +407,43 @@ def test_the_pool_names_the_signal_that_killed_a_worker():
     assert pool.lost == [signal.SIGKILL]
 
 
+def _wait_then_pid(barrier) -> int:
+    """A job that returns its worker's pid once both jobs have started (each on a worker of its own)."""
+    barrier.wait(timeout=120)
+    return os.getpid()
+
+
+def _wait_then_die(barrier) -> None:
+    barrier.wait(timeout=120)
+    signal.raise_signal(signal.SIGKILL)
+
+
+def test_two_workers_run_two_jobs_at_once_and_a_killed_one_is_named():
+    """Two real workers: two jobs that each wait for the other run at once (two pids); then
+    one job's worker killed while the other's job still runs: the pool names the signal, and
+    the abort stops the live worker rather than wait for its job."""
+    import multiprocessing as mp
+    from concurrent.futures.process import BrokenProcessPool
+
+    with mp.get_context("spawn").Manager() as manager:
+        pool = worker_pool.WorkerPool(2, workers=2)
+        try:
+            barrier = manager.Barrier(2)
+            pids = {f.result(timeout=300) for f in [pool.submit(_wait_then_pid, barrier) for _ in range(2)]}
+            assert len(pids) == 2
+            barrier = manager.Barrier(2)
+            killed = pool.submit(_wait_then_die, barrier)
+            waiting = pool.submit(time.sleep, 600)  # would hold the pool for ten minutes
+            barrier.wait(timeout=300)  # (the third party: the killed job has started)
+            with pytest.raises(BrokenProcessPool):
+                killed.result(timeout=300)
+            start = time.monotonic()
+        finally:
+            pool.close(abort=True)
+        assert pool.lost == [signal.SIGKILL] and time.monotonic() - start < 60
+        assert waiting.done() and not [p for p in mp.active_children() if p.pid in pids]
+
+
 class _Worker:
     """A worker process as the executor holds it: its sentinel is ready once it has ended,
     and ``join`` reaps it (``code``: the exit code it then shows)."""

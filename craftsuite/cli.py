@@ -475,8 +475,14 @@ def _leaderboard(args) -> int:
     from .reporting.pages import write_leaderboard, write_results_page
     from .reporting.board import build
     from .reporting.plots import draw_curves, save_figures
+    from .methods import resolve_method
     from .reporting.sources import read_runs
 
+    for method in args.methods or ():  # a row of the user's own: its module registers it
+        if ":" not in method:
+            raise ValueError(f"--methods {method}: name a row of your own as module:name (CraftSuite's rows are "
+                             "known already)")
+        resolve_method(method)
     if args.reproduction:
         if args.page or args.out or len(args.runs) > 1:
             raise ValueError("--reproduction writes one page from one transfer directory: give one RUNS, "
@@ -739,6 +745,9 @@ def build_parser() -> argparse.ArgumentParser:
                    "from the RUNS directories to PATH, e.g. docs/results.md")
     p.add_argument("--reproduction", metavar="PATH", help="write the paper's Figure 5 panels, each beside the "
                    "paper's claim, from one transfer directory (craftsuite transfer --suite paper)")
+    p.add_argument("--methods", nargs="+", metavar="MODULE:ROW", help="method rows of your own that runs were "
+                   "trained with (as transfer's --methods my_module:my-row): read as the methods they are "
+                   "(compared with scratch where distilled, described in the legend)")
     p.set_defaults(run=_leaderboard)
 
     p = sub.add_parser("video", help="record rollouts of a policy as an MP4 (any world of a task)")

@@ -54,11 +54,22 @@ def protocol(env: str, suite: str = "standard", step: int | None = None):
     spec = resolve_task(task)
     try:
         config = SUITES[suite].student_config(spec, world, scratch(world))
-    except ValueError:  # no budget for its level: the rung is another suite's
-        theirs = [name for name, s in SUITES.items() if spec.name in {r.name for r in s.rungs()}]
-        raise ValueError(f"{task} is not a rung of the {suite!r} suite, whose protocol (budget, evaluations) an "
-                         f"evaluation follows: give suite= one of {theirs or sorted(SUITES)}") from None
+    except ValueError:  # no budget for its level in this world: the rung is another suite's
+        theirs = [name for name, s in SUITES.items() if _has_budget(s, spec, world)]
+        raise ValueError(f"{task} in {world} is not a rung of the {suite!r} suite, whose protocol (budget, "
+                         f"evaluations) an evaluation follows: give suite= one of {theirs or sorted(SUITES)}") from None
     return config, config.steps if step is None else step
+
+
+def _has_budget(suite, spec, world: str) -> bool:
+    """Whether ``suite`` has a student budget for ``spec``'s rung in ``world``."""
+    from .methods import scratch
+
+    try:
+        suite.student_config(spec, world, scratch(world))
+    except ValueError:
+        return False
+    return True
 
 
 def evaluate(policy, env: str, *, suite: str = "standard", step: int | None = None, episodes: int | None = None,

@@ -78,7 +78,8 @@ def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "stand
 
     Raises:
         ValueError: a method named as one of CraftSuite's (its runs would pool with the
-            archive's), a bad seed, id or suite; each named with its fix.
+            archive's), a bad seed, id or suite, a world the suite does not run; each named
+            with its fix.
     """
     from .evaluation import protocol
     from .methods import METHODS
@@ -93,6 +94,12 @@ def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "stand
     from .suites import SUITES
 
     suite_config, _ = protocol(env_id, suite)
+    if suite_config.world not in SUITES[suite].worlds:  # its runs would sit beside none of the suite's
+        from .ids import env_id as env_id_of  # (this function's argument is named env_id)
+
+        raise ValueError(f"the {suite!r} suite runs no {suite_config.world} world (its worlds: "
+                         f"{', '.join(SUITES[suite].worlds)}): record in one of them, e.g. "
+                         f"{env_id_of(suite_config.task, SUITES[suite].worlds[0])}")
     if steps is not None:
         if not isinstance(steps, int) or isinstance(steps, bool) or steps < 1:
             raise ValueError(f"steps (the budget in transitions) must be a positive integer, got {steps!r}")

@@ -87,5 +87,5 @@ def test_a_module_is_evaluated_in_eval_mode_and_left_as_it_was():
 
 
 def test_a_rung_of_another_suite_names_the_suites_it_is_in():
-    with pytest.raises(ValueError, match=r"DiamondMine is not a rung of the 'standard' suite.*'hard'"):
+    with pytest.raises(ValueError, match=r"DiamondMine in Grid10 is not a rung of the 'standard' suite.*'hard'"):
         craftsuite.evaluate(lambda obs: 0, "CraftSuite/DiamondMine-Grid10-v0", step=1000)

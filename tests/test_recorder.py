@@ -110,10 +110,14 @@ def test_the_leaderboard_sets_self_reported_runs_beside_every_regimes_own(tmp_pa
     for seed in range(3):
         fake_run(archive, "td3", seed, [(1000, 0.0)], [(995, 1.0)], hyperparameters={})
         fake_run(archive, "td3", seed, [(1000, 0.5)], [(995, 1.0)], hyperparameters={"n_steps": 3})
-        fake_run(mine, "my-sac", seed, [(1000, 1.0)], [(995, 1.0)], self_reported=True)
+        fake_run(mine, "my-sac", seed, [(1000, 1.0)], [(995, 1.0)], self_reported=True, library="sb3 2.4 SAC")
         fake_run(mine, "my-long", seed, [(2000, 1.0)], [(1995, 1.0)], budget=2000, self_reported=True)
     assert main(["leaderboard", str(mine), str(archive), "--out", str(out)]) == 0
     md = (out / "leaderboard.md").read_text()
+    # the legend says what a self-reported method is, with the library its records name
+    assert ("- `my-sac`: self-reported: trained outside CraftSuite (sb3 2.4 SAC), its records written by "
+            "craftsuite.Recorder") in md
+    assert "- `my-long`: self-reported: trained outside CraftSuite, its records written by craftsuite.Recorder" in md
     one_step, n_step = md.split("## Learner regime `n-step`")
     for part in (one_step, n_step):
         assert "| my-sac *(self-reported)* | 3 | 1.00" in part
@@ -126,6 +130,20 @@ def test_the_leaderboard_sets_self_reported_runs_beside_every_regimes_own(tmp_pa
         ("my-sac", "self-reported", "1"), ("my-long", "self-reported", "1"), ("td3", "one-step", "0"),
         ("td3", "n-step", "0")}
     assert {r["budget_transitions"] for r in rows if r["method"] == "my-long"} == {"2000"}
+
+
+@pytest.mark.parametrize("env,suite,message", [
+    # the quick suite runs Reach in MuJoCo alone: its protocol has no grid budget to follow
+    ("CraftSuite/Reach-Grid10-v0", "quick", "Reach in Grid10 is not a rung of the 'quick' suite, whose protocol "
+     "(budget, evaluations) an evaluation follows: give suite= one of ['standard', 'paper']"),
+    # the standard suite has a grid budget, but runs no Grid7: a record there would sit beside none of its runs
+    ("CraftSuite/Reach-Grid7-v0", "standard", "the 'standard' suite runs no Grid7 world (its worlds: Grid10, Cont): "
+     "record in one of them, e.g. CraftSuite/Reach-Grid10-v0"),
+])
+def test_a_world_the_suite_does_not_run_is_refused_naming_its_worlds(tmp_path, env, suite, message):
+    with pytest.raises(ValueError) as err:
+        craftsuite.Recorder(env, tmp_path, method="my-random", suite=suite)
+    assert str(err.value) == message and list(tmp_path.iterdir()) == []
 
 
 def test_a_budget_off_the_schedule_is_evaluated_at_the_budget_once(tmp_path):

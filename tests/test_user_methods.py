@@ -55,6 +55,38 @@ def test_transfer_trains_a_users_row_in_a_spawned_worker(tmp_path):
     assert "| dqn-mine |" in (out / "leaderboard.md").read_text()
 
 
+def test_the_leaderboard_reads_a_users_row_given_by_its_module(tmp_path, capsys):
+    """Runs of a row of the user's own, on a board made by a process that has not imported
+    its module: with --methods module:name they are that method (compared with scratch as a
+    distilled one, described in the legend); without, named as rows it does not know."""
+    from .reporting.fakes import fake_run
+
+    (tmp_path / "my_rows.py").write_text(
+        "from craftsuite.methods import Method, register_method\n"
+        "register_method(Method('mine-static', 'Grid', 'dqn', True, distill='static', description='my static'))\n")
+    runs, out = tmp_path / "runs", tmp_path / "board"
+    for seed in range(3):
+        fake_run(runs, "dqn", seed, [(1000, 0.0)], [(995, 0.0)], world="Grid10")
+        fake_run(runs, "mine-static", seed, [(1000, 1.0)], [(995, 1.0)], world="Grid10",
+                 effective={"method": {"algorithm": "dqn"}})  # as a run of a user's row records it
+    assert main(["leaderboard", str(runs), "--out", str(out)]) == 0
+    md = (out / "leaderboard.md").read_text()
+    assert "- `mine-static`: not a method of this version (a row of your own: `craftsuite leaderboard --methods " \
+        "module:name` reads its runs as the method they are)" in md and "P(> `dqn`)" not in md
+    sys.path.insert(0, str(tmp_path))
+    try:
+        assert main(["leaderboard", str(runs), "--out", str(out), "--methods", "my_rows:mine-static"]) == 0
+    finally:
+        sys.path.remove(str(tmp_path))
+        sys.modules.pop("my_rows", None)
+    md = (out / "leaderboard.md").read_text()
+    assert "- `mine-static`: my static" in md and "`mine-static` +1.00 [+1.00, +1.00], P(> `dqn`) 1.00" in md
+    capsys.readouterr()
+    assert main(["leaderboard", str(runs), "--out", str(out), "--methods", "mine-static"]) == 2
+    assert capsys.readouterr().err == ("craftsuite leaderboard: error: --methods mine-static: name a row of your "
+                                       "own as module:name (CraftSuite's rows are known already)\n")
+
+
 class _FreshWorkerRay:
     """The part of Ray the pool uses, each task run in a newly spawned process: as a Ray
     worker, it starts with the package's rows alone."""

@@ -220,10 +220,26 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
     shown = [m for m in METHODS if m in {e.method for e in entries}]
     shown += sorted({e.method for e in entries} - set(shown))  # runs of a method no longer in the table
     lines += ["Methods:", ""]
-    lines += [f"- `{m}`: {METHODS[m].description if m in METHODS else 'not a method of this version'}"
-              for m in shown]
+    lines += [f"- `{m}`: {_method_note(m, [e for e in entries if e.method == m])}" for m in shown]
     lines.append("")
     return "\n".join(lines)
+
+
+def _method_note(method: str, rows: list[Entry]) -> str:
+    """What a method of a board's legend is: its row's description; a learner trained
+    outside CraftSuite, with the libraries its records name; else a row this process has
+    not registered."""
+    from ..methods import METHODS  # (the rows registered by then: a user's too)
+
+    if method in METHODS:
+        return METHODS[method].description
+    if rows and all(e.self_reported for e in rows):
+        libraries = sorted({json.loads((run / "config.json").read_text()).get("library") or "" for e in rows
+                            for run in e.runs} - {""})
+        return ("self-reported: trained outside CraftSuite" + (f" ({'; '.join(libraries)})" if libraries else "")
+                + ", its records written by craftsuite.Recorder")
+    return ("not a method of this version (a row of your own: `craftsuite leaderboard --methods module:name` "
+            "reads its runs as the method they are)")
 
 
 def _share(x: float) -> str:

@@ -94,3 +94,10 @@ def test_bad_input_is_named(tmp_path, capsys):
     assert not (tmp_path / "r.md").exists()
     assert main(["leaderboard", str(tmp_path), str(tmp_path), "--reproduction", str(tmp_path / "r.md")]) == 2
     assert "one transfer directory" in capsys.readouterr().err
+    # another suite's runs (the quick suite's Reach): a page of panels that all say "did not run"
+    _seeds(tmp_path / "students", "td3", 0.5, world="Cont", task="Reach")
+    assert main(["leaderboard", str(tmp_path), "--reproduction", str(tmp_path / "r.md")]) == 2
+    err = capsys.readouterr().err
+    assert f"{tmp_path} holds no run of a task and world of Figure 5's panels (BlindCraftsman in Cont," in err
+    assert err.endswith("--reproduction reads a transfer of the paper suite (craftsuite transfer --suite paper)\n")
+    assert not (tmp_path / "r.md").exists() and not (tmp_path / "images").exists()

@@ -34,8 +34,8 @@ def test_cli_teacher_distill_student_leaderboard_video(tmp_path, capsys, gl_avai
     assert "dynamic automaton Q-table" in capsys.readouterr().out
     dot = (tmp_path / "values.dot").read_text()
     assert re.search(r'label="[^"]*-?\d+\.\d', dot), "no distilled value printed on an edge"
-    for method in ("td3-dynamic", "td3"):
-        assert main(["student", "BlindCraftsman", "--method", method, "--table", str(tmp_path / "again.npz"),
+    for method, table in (("td3-dynamic", ["--table", str(tmp_path / "again.npz")]), ("td3", [])):
+        assert main(["student", "BlindCraftsman", "--method", method, *table,
                      "--out", str(runs / "students"), "--steps", "300", "--eval-every", "150",
                      "--eval-episodes", "1", "--hyper", '{"learning_starts": 100}']) == 0
     capsys.readouterr()

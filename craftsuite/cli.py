@@ -9,10 +9,10 @@ from pathlib import Path
 TIME_LIMIT_STATUS = 3  # the exit status of a transfer its --time-limit stopped: runs are left to resume
 
 
-def _task(argument: str, world_flag: str | None = None) -> str:
+def _task(argument: str, world: str | None = None) -> str:
     """A task argument's task name: a known task's, or a spec file's (``*.toml``, read and
-    registered here, with its ids). Called before anything is written. ``world_flag``: the
-    command's option that picks a world (e.g. ``--world``), named where an id was given.
+    registered here, with its ids). Called before anything is written. ``world``: how the
+    command picks a world (e.g. ``the world with --world``), said where an id was given.
 
     Raises:
         KeyError: an unknown task name, listing the known ones.
@@ -25,8 +25,7 @@ def _task(argument: str, world_flag: str | None = None) -> str:
 
     if str(argument).startswith(f"{NAMESPACE}/"):  # an id where a task goes: not a path to look for
         task, _ = parse_id(argument)  # a malformed one: the id format, named
-        world = f" and the world with {world_flag}" if world_flag else ""
-        raise ValueError(f"{argument} is an id; give its task ({task}){world}")
+        raise ValueError(f"{argument} is an id; give its task ({task})" + (f" and {world}" if world else ""))
     if is_spec_file(argument):
         return parse_id(register_task(Path(argument))[0])[0]
     return resolve_task(argument).name
@@ -335,7 +334,7 @@ def _student(args) -> int:
     from .configs import StudentConfig
     from .files import directory_to_write
     from .methods import METHODS, resolve_method
-    from .suite_runner import check_budgets
+    from .suite_runner import check_trains
     from .training import train_student
 
     args.method = resolve_method(args.method)  # a row of the user's own (module:name): its module registers it
@@ -348,9 +347,12 @@ def _student(args) -> int:
                            n_envs=args.n_envs, automaton_state=args.automaton_state, engine=args.engine)
     if METHODS[args.method].needs_table and not args.table:
         raise ValueError(f"method {args.method!r} needs --table (a teacher's table.npz: craftsuite teacher)")
-    check_budgets([config], {})  # as a transfer's: a budget that takes no update is refused, not trained
+    if args.table and not METHODS[args.method].needs_table:  # it would be recorded, and change the run key
+        raise ValueError(f"method {args.method!r} distils no teacher's table: leave out --table (the methods that "
+                         f"take one: {', '.join(m for m, row in METHODS.items() if row.needs_table)})")
+    check_trains(config, f"{config.task}'s {config.method} student ({config.world})")  # as a transfer does
     directory_to_write(args.out, "--out")
-    path = train_student(config, args.out)
+    path = train_student(config, args.out, device=args.device)
     print((path / "result.json").read_text().strip())
     print(f"student run: {path}")
     return 0
@@ -370,7 +372,7 @@ def _transfer(args) -> int:
     suite = SUITES[args.suite]
     if args.tags is not None or args.tasks is not None:  # the rungs given replace the suite's
         suite = dataclasses.replace(suite, tags=tuple(args.tags or ()),
-                                    tasks=tuple(_task(t, "--worlds") for t in args.tasks or ()))
+                                    tasks=tuple(_task(t, "the worlds with --worlds") for t in args.tasks or ()))
     changes = {k: v for k, v in (("worlds", tuple(args.worlds) if args.worlds else None), ("seeds", args.seeds),
                                  ("student_steps", args.steps),
                                  # a row of the user's own (module:name) is registered by its module's import
@@ -678,6 +680,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--automaton-state", type=_on_off, metavar="on|off",
                    help="whether a distilled student sees the automaton state (default: as its method; the paper's "
                    "authors' students did not)")
+    p.add_argument("--device", default="cpu", help="the population engine's torch device: cpu (default) or cuda")
     p.set_defaults(run=_student)
 
     p = sub.add_parser("transfer", help="a suite end to end: teacher, distillation, students, leaderboard, video")
@@ -782,7 +785,8 @@ def _check_task(args) -> None:
 
     if getattr(args, "task", None) is None:
         return
-    args.task = _task(args.task, {"student": "--world", "teacher": "--size"}.get(args.command))
+    args.task = _task(args.task, {"student": "the world with --world",
+                                  "teacher": "the grid's side with --size (e.g. --size 10)"}.get(args.command))
     if getattr(args, "world", None) is not None:  # student
         _registered(args.task, args.world)
     elif args.command == "teacher":

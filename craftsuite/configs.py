@@ -116,9 +116,6 @@ class StudentConfig:
                 raise ValueError(f"method {self.method!r} runs in the {row.world} worlds, not in {self.world}; "
                                  f"give a {row.world} world ({worlds}), or one of {self.world}'s methods: "
                                  f"{methods_for(self.world)}")
-            if self.table is not None and not row.needs_table:  # it would be recorded, and change the run key
-                raise ValueError(f"method {self.method!r} distils no teacher's table: leave out the table; the "
-                                 f"methods that take one: {[m for m, r in METHODS.items() if r.needs_table]}")
             row.observes(self.automaton_state)  # a MethodError naming both
             if self.automaton_state == row.product:  # what the method does anyway: one run key
                 object.__setattr__(self, "automaton_state", None)

@@ -56,6 +56,7 @@ def protocol(env: str, suite: str = "standard", step: int | None = None):
         config = SUITES[suite].student_config(spec, world, scratch(world))
     except ValueError:  # no budget for its level in this world: the rung is another suite's
         theirs = [name for name, s in SUITES.items() if _has_budget(s, spec, world)]
+        theirs = [name for name in theirs if world in SUITES[name].worlds] or theirs  # those running it first
         raise ValueError(f"{task} in {world} is not a rung of the {suite!r} suite, whose protocol (budget, "
                          f"evaluations) an evaluation follows: give suite= one of {theirs or sorted(SUITES)}") from None
     return config, config.steps if step is None else step

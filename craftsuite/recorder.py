@@ -96,10 +96,12 @@ def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "stand
     suite_config, _ = protocol(env_id, suite)
     if suite_config.world not in SUITES[suite].worlds:  # its runs would sit beside none of the suite's
         from .ids import env_id as env_id_of  # (this function's argument is named env_id)
+        from .ids import world_kind
 
+        alike = [w for w in SUITES[suite].worlds if world_kind(w) == world_kind(suite_config.world)]
         raise ValueError(f"the {suite!r} suite runs no {suite_config.world} world (its worlds: "
-                         f"{', '.join(SUITES[suite].worlds)}): record in one of them, e.g. "
-                         f"{env_id_of(suite_config.task, SUITES[suite].worlds[0])}")
+                         f"{', '.join(SUITES[suite].worlds)}): record in one of them"
+                         + (f", e.g. {env_id_of(suite_config.task, alike[0])}" if alike else ""))
     if steps is not None:
         if not isinstance(steps, int) or isinstance(steps, bool) or steps < 1:
             raise ValueError(f"steps (the budget in transitions) must be a positive integer, got {steps!r}")

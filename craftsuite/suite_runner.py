@@ -516,13 +516,8 @@ def check_budgets(configs: list[StudentConfig], teachers: dict[str, TeacherConfi
                              f"gradient update in its first {settings['learning_starts']:,} transitions "
                              f"(learning_starts); use --teacher-steps {need} or more")
     for c in configs:
-        settings = c.effective()["hyperparameters"]
         who = f"{c.task}'s {c.method} students ({c.world})"
-        need = smallest_budget(settings, c.n_envs)
-        if c.steps < need:
-            raise ValueError(f"--steps {c.steps}: too small to train {who}, which take no gradient update in their "
-                             f"first {settings['learning_starts']:,} transitions (learning_starts); use --steps "
-                             f"{need} or more")
+        check_trains(c, who)
         if c.eval_every > c.steps:
             raise ValueError(f"an evaluation every {c.eval_every:,} transitions (--eval-every, or the suite's) is "
                              f"longer than the {c.steps:,}-transition budget of {who}, which would be evaluated only "
@@ -530,6 +525,16 @@ def check_budgets(configs: list[StudentConfig], teachers: dict[str, TeacherConfi
         if c.eval_every < c.n_envs:
             raise ValueError(f"--eval-every {c.eval_every}: shorter than one step of the {c.n_envs} envs of {who}, "
                              f"the least between two evaluations; use --eval-every {c.n_envs} or more")
+
+
+def check_trains(config: StudentConfig, who: str) -> None:
+    """Refuse a student's budget in which it takes no gradient update, naming ``--steps``
+    and the least that trains (``who``: the runs, as the message names them)."""
+    settings = config.effective()["hyperparameters"]
+    need = smallest_budget(settings, config.n_envs)
+    if config.steps < need:
+        raise ValueError(f"--steps {config.steps}: too small to train {who}: no gradient update comes in the first "
+                         f"{settings['learning_starts']:,} transitions (learning_starts); use --steps {need} or more")
 
 
 def smallest_budget(settings: dict, n_envs: int) -> int:

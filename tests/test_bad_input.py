@@ -71,11 +71,11 @@ def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
      "method 'td3' runs in the Cont worlds, not in Grid10; give a Cont world (Cont or Kinematic)"),
     # a table the method does not read would be recorded in its config, and change its run key
     (["student", "FirstTool", "--method", "td3", "--table", "/etc/hostname"],
-     "method 'td3' distils no teacher's table: leave out the table"),
+     "method 'td3' distils no teacher's table: leave out --table (the methods that take one: dynamic, "),
     # a budget with no gradient update in it, as transfer refuses it
     (["student", "FirstTool", "--method", "td3", "--steps", "100"],
-     "--steps 100: too small to train FirstTool's td3 students (Cont), which take no gradient update in their "
-     "first 1,000 transitions (learning_starts); use --steps 1001 or more"),
+     "--steps 100: too small to train FirstTool's td3 student (Cont): no gradient update comes in the first 1,000 "
+     "transitions (learning_starts); use --steps 1001 or more"),
     # the engine's device is --device; as a setting it was ignored, though recorded in the run key
     (["student", "FirstTool", "--method", "td3", "--hyper", '{"device": "cuda"}'],
      "method 'td3': the population engine, which trains CraftSuite's runs, does not support device among the "
@@ -87,6 +87,10 @@ def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
      "CraftSuite/FirstTool-Cont-v0 is an id; give its task (FirstTool) and the world with --world"),
     (["scripted", "--task", "CraftSuite/Reach-Cont-v0"], "CraftSuite/Reach-Cont-v0 is an id; give its task (Reach)\n"),
     (["distill", "FirstTool"], "FirstTool is a task: distil its automaton alone with --static"),
+    (["student", "FirstTool", "--method", "td3", "--device", "cuda"] if not __import__("torch").cuda.is_available()
+     else ["student", "FirstTool", "--method", "td3", "--device", "tpu"], "--device "),
+    (["teacher", "CraftSuite/FirstTool-Grid7-v0"], "CraftSuite/FirstTool-Grid7-v0 is an id; give its task "
+     "(FirstTool) and the grid's side with --size (e.g. --size 10)"),
     (["distill", "no-such-teacher"], "no teacher at no-such-teacher: give a teacher run directory or its .zip "
                                      "(dynamic), or a task name with --static"),
 ])
@@ -178,8 +182,8 @@ def _refused(tmp_path, capsys, *flags, out=None) -> str:
 
 
 @pytest.mark.parametrize("flags,message", [
-    (["--steps", "100"], "--steps 100: too small to train Reach's td3 students (Cont), which take no gradient update "
-     "in their first 1,000 transitions (learning_starts); use --steps 1001 or more"),
+    (["--steps", "100"], "--steps 100: too small to train Reach's td3 students (Cont): no gradient update comes in "
+     "the first 1,000 transitions (learning_starts); use --steps 1001 or more"),
     (["--steps", "2000", "--teacher-steps", "1000"], "--teacher-steps 1000: too small to train the Reach teacher, "
      "which takes no gradient update in its first 1,000 transitions (learning_starts); use --teacher-steps 1001 or "
      "more"),

@@ -139,6 +139,9 @@ def test_the_leaderboard_sets_self_reported_runs_beside_every_regimes_own(tmp_pa
     # the standard suite has a grid budget, but runs no Grid7: a record there would sit beside none of its runs
     ("CraftSuite/Reach-Grid7-v0", "standard", "the 'standard' suite runs no Grid7 world (its worlds: Grid10, Cont): "
      "record in one of them, e.g. CraftSuite/Reach-Grid10-v0"),
+    # a continuous agent is pointed to the continuous world, not the first the suite lists
+    ("CraftSuite/KeySwordDragon-Kinematic-v0", "standard", "the 'standard' suite runs no Kinematic world (its "
+     "worlds: Grid10, Cont): record in one of them, e.g. CraftSuite/KeySwordDragon-Cont-v0"),
 ])
 def test_a_world_the_suite_does_not_run_is_refused_naming_its_worlds(tmp_path, env, suite, message):
     with pytest.raises(ValueError) as err:

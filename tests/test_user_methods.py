@@ -69,10 +69,11 @@ def test_the_leaderboard_reads_a_users_row_given_by_its_module(tmp_path, capsys)
         fake_run(runs, "dqn", seed, [(1000, 0.0)], [(995, 0.0)], world="Grid10")
         fake_run(runs, "mine-static", seed, [(1000, 1.0)], [(995, 1.0)], world="Grid10",
                  effective={"method": {"algorithm": "dqn"}})  # as a run of a user's row records it
+        fake_run(runs, "hand-made", seed, [(1000, 0.5)], [(995, 1.0)], world="Grid10")  # the format, by other code
     assert main(["leaderboard", str(runs), "--out", str(out)]) == 0
     md = (out / "leaderboard.md").read_text()
     assert "- `mine-static`: not a method of this version (a row of your own: `craftsuite leaderboard --methods " \
-        "module:name` reads its runs as the method they are)" in md and "P(> `dqn`)" not in md
+        "module:name` reads its runs as the method they are)" in md and "`mine-static` +1.00" not in md
     sys.path.insert(0, str(tmp_path))
     try:
         assert main(["leaderboard", str(runs), "--out", str(out), "--methods", "my_rows:mine-static"]) == 0
@@ -80,6 +81,8 @@ def test_the_leaderboard_reads_a_users_row_given_by_its_module(tmp_path, capsys)
         sys.path.remove(str(tmp_path))
         sys.modules.pop("my_rows", None)
     md = (out / "leaderboard.md").read_text()
+    assert "- `hand-made`: trained outside CraftSuite's trainers (its records hold no CraftSuite learner's " \
+        "settings)" in md
     assert "- `mine-static`: my static" in md and "`mine-static` +1.00 [+1.00, +1.00], P(> `dqn`) 1.00" in md
     capsys.readouterr()
     assert main(["leaderboard", str(runs), "--out", str(out), "--methods", "mine-static"]) == 2

@@ -234,8 +234,12 @@ def _method_note(method: str, rows: list[Entry]) -> str:
     if method in METHODS:
         return METHODS[method].description
     if rows and all(e.self_reported for e in rows):
-        libraries = sorted({json.loads((run / "config.json").read_text()).get("library") or "" for e in rows
-                            for run in e.runs} - {""})
+        from ..runs import read_config
+
+        configs = [read_config(run) for e in rows for run in e.runs]
+        if not all(c.get("self_reported") for c in configs):  # records of the format written by other code
+            return "trained outside CraftSuite's trainers (its records hold no CraftSuite learner's settings)"
+        libraries = sorted({c.get("library") or "" for c in configs} - {""})
         return ("self-reported: trained outside CraftSuite" + (f" ({'; '.join(libraries)})" if libraries else "")
                 + ", its records written by craftsuite.Recorder")
     return ("not a method of this version (a row of your own: `craftsuite leaderboard --methods module:name` "

@@ -102,9 +102,13 @@ def suite_json(path: Path) -> dict:
     if not (path / "suite.json").exists():
         return {}
     try:
-        return json.loads((path / "suite.json").read_text())
+        suite = json.loads((path / "suite.json").read_text())
     except ValueError as err:
         raise ValueError(f"{path / 'suite.json'} is not valid JSON ({err})") from None
+    if not isinstance(suite, dict):
+        raise ValueError(f"{path / 'suite.json'} is not a suite's record (a JSON object): move it aside, or give "
+                         "another directory")
+    return suite
 
 
 def session_line(session: dict, *, to_the_minute: bool) -> str:

@@ -42,7 +42,6 @@ def protocol(env: str, suite: str = "standard", step: int | None = None):
         ValueError: not a CraftSuite id, an unknown suite, or a task the suite has no
             budget for while no ``step`` is given; each named with its fix.
     """
-    from .methods import scratch
     from .suites import SUITES
     from .task_registry import resolve_task
 
@@ -52,25 +51,24 @@ def protocol(env: str, suite: str = "standard", step: int | None = None):
         raise ValueError(f"unknown suite {suite!r}; suites: {sorted(SUITES)}")
     task, world = parse_id(env)
     spec = resolve_task(task)
-    try:
-        config = SUITES[suite].student_config(spec, world, scratch(world))
-    except ValueError:  # no budget for its level in this world: the rung is another suite's
-        theirs = [name for name, s in SUITES.items() if _has_budget(s, spec, world)]
+    config = _scratch_config(SUITES[suite], spec, world)
+    if config is None:  # no budget for its level in this world: the rung is another suite's
+        theirs = [name for name, s in SUITES.items() if _scratch_config(s, spec, world) is not None]
         theirs = [name for name in theirs if world in SUITES[name].worlds] or theirs  # those running it first
         raise ValueError(f"{task} in {world} is not a rung of the {suite!r} suite, whose protocol (budget, "
-                         f"evaluations) an evaluation follows: give suite= one of {theirs or sorted(SUITES)}") from None
+                         f"evaluations) an evaluation follows: give suite= one of {theirs or sorted(SUITES)}")
     return config, config.steps if step is None else step
 
 
-def _has_budget(suite, spec, world: str) -> bool:
-    """Whether ``suite`` has a student budget for ``spec``'s rung in ``world``."""
+def _scratch_config(suite, spec, world: str):
+    """``suite``'s config of a scratch student of ``spec``'s rung in ``world``; None where
+    the suite has no budget for it."""
     from .methods import scratch
 
     try:
-        suite.student_config(spec, world, scratch(world))
+        return suite.student_config(spec, world, scratch(world))
     except ValueError:
-        return False
-    return True
+        return None
 
 
 def evaluate(policy, env: str, *, suite: str = "standard", step: int | None = None, episodes: int | None = None,

@@ -87,8 +87,8 @@ def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
      "CraftSuite/FirstTool-Cont-v0 is an id; give its task (FirstTool) and the world with --world"),
     (["scripted", "--task", "CraftSuite/Reach-Cont-v0"], "CraftSuite/Reach-Cont-v0 is an id; give its task (Reach)\n"),
     (["distill", "FirstTool"], "FirstTool is a task: distil its automaton alone with --static"),
-    (["student", "FirstTool", "--method", "td3", "--device", "cuda"] if not __import__("torch").cuda.is_available()
-     else ["student", "FirstTool", "--method", "td3", "--device", "tpu"], "--device "),
+    (["student", "FirstTool", "--method", "td3", "--device", "tpu"],
+     "--device 'tpu' is not a torch device: use cpu or cuda"),
     (["teacher", "CraftSuite/FirstTool-Grid7-v0"], "CraftSuite/FirstTool-Grid7-v0 is an id; give its task "
      "(FirstTool) and the grid's side with --size (e.g. --size 10)"),
     (["distill", "no-such-teacher"], "no teacher at no-such-teacher: give a teacher run directory or its .zip "

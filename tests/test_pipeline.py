@@ -407,65 +407,6 @@ def test_the_pool_names_the_signal_that_killed_a_worker():
     assert pool.lost == [signal.SIGKILL]
 
 
-def _wait_then_pid(barrier) -> int:
-    """A job that returns its worker's pid once both jobs have started (each on a worker of its own)."""
-    barrier.wait(timeout=120)
-    return os.getpid()
-
-
-def _wait_then_sleep(barrier) -> None:
-    barrier.wait(timeout=120)
-    time.sleep(600)  # would hold its worker for ten minutes
-
-
-def _wait_then_die(barrier) -> None:
-    barrier.wait(timeout=120)
-    signal.raise_signal(signal.SIGKILL)
-
-
-def test_two_workers_run_two_jobs_at_once_and_an_abort_stops_both():
-    """Two real workers: two jobs that each wait for the other run at once (two pids); two
-    jobs of ten minutes, both started, are stopped by an abort at once, their workers gone."""
-    import multiprocessing as mp
-
-    with mp.get_context("spawn").Manager() as manager:
-        pool = worker_pool.WorkerPool(2, workers=2)
-        start = None
-        try:
-            barrier = manager.Barrier(2)
-            pids = {f.result(timeout=300) for f in [pool.submit(_wait_then_pid, barrier) for _ in range(2)]}
-            assert len(pids) == 2
-            barrier = manager.Barrier(3)
-            for _ in range(2):
-                pool.submit(_wait_then_sleep, barrier)
-            barrier.wait(timeout=300)  # (the third party: both jobs have started)
-            start = time.monotonic()
-        finally:
-            pool.close(abort=True)
-        assert start is not None and time.monotonic() - start < 60
-        assert not [p for p in mp.active_children() if p.pid in pids]
-
-
-def test_a_worker_killed_beside_a_live_one_is_named_by_its_signal():
-    """A real worker killed while the other still runs its job: the pool names the signal
-    (the live worker, stopped later by the executor with SIGTERM, is not counted)."""
-    import multiprocessing as mp
-    from concurrent.futures.process import BrokenProcessPool
-
-    with mp.get_context("spawn").Manager() as manager:
-        pool = worker_pool.WorkerPool(2, workers=2)
-        try:
-            barrier = manager.Barrier(3)
-            killed = pool.submit(_wait_then_die, barrier)
-            pool.submit(_wait_then_sleep, barrier)
-            barrier.wait(timeout=300)  # both jobs started, one on each worker
-            with pytest.raises(BrokenProcessPool):
-                killed.result(timeout=300)
-        finally:
-            pool.close(abort=True)
-        assert pool.lost == [signal.SIGKILL]
-
-
 class _Worker:
     """A worker process as the executor holds it: its sentinel is ready once it has ended,
     and ``join`` reaps it (``code``: the exit code it then shows)."""

@@ -133,7 +133,20 @@ class WorkerPool:
             return ref.future()
         future = self.pool.submit(job, *args)
         future.add_done_callback(self._note_lost)
+        self._wake_manager()
         return future
+
+    def _wake_manager(self) -> None:
+        """Make the executor's manager thread look again at which workers it watches.
+
+        ``submit`` wakes that thread before it starts the worker the new job may need, so the
+        thread can go back to waiting on the workers it knew: a worker started then and later
+        killed (the out-of-memory killer) would go unseen until another worker's job returned,
+        hours in a suite. Woken now, with the new worker listed, it watches every worker."""
+        wakeup, lock = (getattr(self.pool, name, None) for name in ("_executor_manager_thread_wakeup", "_shutdown_lock"))
+        if wakeup is not None and lock is not None:  # (the executor's own: where a Python has them not, nothing)
+            with lock:  # as ``submit`` wakes it
+                wakeup.wakeup()
 
     def _note_lost(self, future: Future) -> None:
         """Once a job has failed because the pool broke (a worker died), the signals that had

@@ -407,6 +407,67 @@ def test_the_pool_names_the_signal_that_killed_a_worker():
     assert pool.lost == [signal.SIGKILL]
 
 
+def _say_started_then_sleep(path) -> None:
+    """A job that writes its worker's pid to ``path`` once it runs, then holds the worker ten minutes."""
+    Path(path).write_text(str(os.getpid()))
+    time.sleep(600)
+
+
+def _started(path, timeout=120) -> int:
+    """The pid a job wrote to ``path`` once it ran (waiting for it ``timeout`` seconds at most)."""
+    end = time.monotonic() + timeout
+    while not (Path(path).is_file() and Path(path).read_text()):
+        assert time.monotonic() < end, f"the job writing {path} did not start in {timeout} s"
+        time.sleep(0.05)
+    return int(Path(path).read_text())
+
+
+def test_a_worker_started_for_a_later_job_is_watched_too(monkeypatch, tmp_path):
+    """The executor wakes its manager thread before it starts the worker a new job needs; a
+    worker started then and killed went unseen until the other worker's job returned (ten
+    minutes here, hours in a suite). The pool wakes the thread again: the break is seen. The
+    start is slowed here so that the thread surely waits on the old list of workers first."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    pool = worker_pool.WorkerPool(2, workers=2)
+    start_worker = pool.pool._adjust_process_count
+    monkeypatch.setattr(pool.pool, "_adjust_process_count", lambda: (time.sleep(0.5), start_worker()))
+    try:
+        pool.submit(_say_started_then_sleep, tmp_path / "busy")
+        _started(tmp_path / "busy")  # the first worker holds its job: the next needs a second worker
+        killed = pool.submit(signal.raise_signal, signal.SIGKILL)
+        with pytest.raises(BrokenProcessPool):
+            killed.result(timeout=60)
+    finally:
+        pool.close(abort=True)
+    assert pool.lost == [signal.SIGKILL]  # the live worker, stopped by the executor, not counted
+
+
+def test_an_abort_stops_the_jobs_running_on_two_workers(tmp_path):
+    """Two jobs of ten minutes, each running on a worker of its own, are stopped at once by an
+    abort, their workers gone (reaped: no pid left) when ``close`` returns."""
+    pool = worker_pool.WorkerPool(2, workers=2)
+    start = None
+    try:
+        for name in ("first", "second"):
+            pool.submit(_say_started_then_sleep, tmp_path / name)
+        pids = {_started(tmp_path / name) for name in ("first", "second")}
+        start = time.monotonic()
+    finally:
+        pool.close(abort=True)
+    assert start is not None and time.monotonic() - start < 60 and len(pids) == 2
+
+    def alive(pid):
+        try:
+            os.kill(pid, 0)  # a zombie, not yet reaped, would count as alive
+        except ProcessLookupError:
+            return False
+        return True
+    # (the executor's thread may reap a worker before this process's join does, so which of
+    # them did is not asked: multiprocessing's own list can call such a worker alive a moment)
+    assert not [pid for pid in pids if alive(pid)]
+
+
 class _Worker:
     """A worker process as the executor holds it: its sentinel is ready once it has ended,
     and ``join`` reaps it (``code``: the exit code it then shows)."""

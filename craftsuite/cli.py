@@ -267,6 +267,7 @@ def _distill(args) -> int:
         image_format(args.draw)
         file_to_write(args.draw, "--draw", "values.png")
     if args.static:
+        _unread(args, f"with --static the task is SOURCE ({args.source}) and no teacher is read")
         spec = resolve_task(_task(args.source))
         table = static_distillation(spec.automaton, completion_reward=spec.completion_reward)
         automaton = spec.automaton
@@ -283,8 +284,9 @@ def _distill(args) -> int:
             raise ValueError(f"{args.source} is a task: distil its automaton alone with --static (craftsuite "
                              f"distill {task} --static --out {args.out}), or give a teacher run directory for its "
                              "teacher's values")
-        env_id, env_kwargs = args.env_id or _registered(args.task, "Grid7"), {}
         if source.is_dir():  # a teacher run directory: its config names the env, its checkpoint the replay
+            _unread(args, f"{source} is a teacher run directory: its config names the task and env, its checkpoint "
+                          "the replay")
             from .configs import TeacherConfig
             from .runs import RunDir, load_config
 
@@ -302,6 +304,7 @@ def _distill(args) -> int:
                 raise FileNotFoundError(f"{source} has no checkpoint (model and replay buffer) yet")
             model, replay = saved / "model.zip", saved / "replay.pkl"
         else:
+            env_id, env_kwargs = args.env_id or _registered(args.task or "BlindCraftsman", "Grid7"), {}
             model, replay = source, Path(args.replay) if args.replay else None
         if replay is None or not replay.is_file():
             raise FileNotFoundError(f"dynamic distillation needs the teacher's replay buffer: "
@@ -313,6 +316,14 @@ def _distill(args) -> int:
         table = distill_from_replay(teacher)
         automaton = teacher.get_env().envs[0].unwrapped.automaton
     return _write_table(table, automaton, args)
+
+
+def _unread(args, why: str) -> None:
+    """Refuse the flags of a teacher .zip where SOURCE answers them (given, they were ignored)."""
+    given = [flag for flag, value in (("--task", args.task), ("--env-id", args.env_id), ("--replay", args.replay))
+             if value is not None]
+    if given:
+        raise ValueError(f"{', '.join(given)}: {why}; leave {'it' if len(given) == 1 else 'them'} out")
 
 
 def _write_table(table, automaton, args) -> int:
@@ -650,7 +661,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="the table to write (.npz)")
     p.add_argument("--static", action="store_true", help="value iteration over the automaton alone")
     p.add_argument("--replay", help="the teacher's replay buffer (.pkl), when SOURCE is a .zip")
-    p.add_argument("--task", default="BlindCraftsman", help=f"the teacher's task, when SOURCE is a .zip: {task_help}")
+    p.add_argument("--task", help=f"the teacher's task, when SOURCE is a .zip (default: BlindCraftsman): {task_help}")
     p.add_argument("--env-id", help="the teacher's env id (default: CraftSuite/<task>-Grid7-v0)")
     p.add_argument("--draw", help="also draw the values on the automaton (.png/.svg/.dot; unseen edges dotted)")
     p.set_defaults(run=_distill)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+from pathlib import Path
 
 import pytest
 
@@ -14,6 +15,7 @@ from craftsuite.configs import StudentConfig, TeacherConfig
 from craftsuite.hyperparameters import HyperparameterError
 from craftsuite.training import train_student, train_teacher
 
+HERE = Path(__file__).parent  # a directory that is no teacher run
 
 
 @pytest.mark.parametrize("hyper,message", [({"batch_size": "big"}, "batch_size must be an integer"),
@@ -93,6 +95,12 @@ def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
      "(FirstTool) and the grid's side with --size (e.g. --size 10)"),
     (["distill", "no-such-teacher"], "no teacher at no-such-teacher: give a teacher run directory or its .zip "
                                      "(dynamic), or a task name with --static"),
+    # a teacher .zip's flags where SOURCE answers them were ignored
+    (["distill", "FirstTool", "--static", "--task", "DungeonQuest"],
+     "--task: with --static the task is SOURCE (FirstTool) and no teacher is read; leave it out"),
+    (["distill", str(HERE), "--task", "DungeonQuest", "--replay", "replay.pkl"],
+     f"--task, --replay: {HERE} is a teacher run directory: its config names the task and env, its checkpoint the "
+     "replay; leave them out"),
 ])
 def test_a_refused_command_names_its_flag_and_leaves_no_output_folder(tmp_path, capsys, command, message):
     out = tmp_path / "new" / "runs"

@@ -414,7 +414,6 @@ def _transfer(args) -> int:
     if args.regime is not None:  # another regime's runs never pool with the suite's: they may share its archive
         changes["regime"] = args.regime
     suite = dataclasses.replace(suite, **changes)
-    print(f"suite {suite.name}: {suite.description}")
     out = args.out or f"runs/{args.suite}"
     if args.archive and args.no_archive:
         raise ValueError("--archive DIR keeps the runs in that archive, --no-archive keeps none: give one or neither")
@@ -428,11 +427,17 @@ def _transfer(args) -> int:
               or set(suite.worlds) - set(registered.worlds) or set(suite.methods) - set(registered.methods))
     own = suite.archived and not settings & set(changes) and not beyond
     archive = None if args.no_archive or not (args.archive or own) else (args.archive or "results")
+    notes = []  # said under the suite's line, which transfer says once it has checked its input
     if suite.archived and not own and archive is None and not args.no_archive:
-        print(f"({'rungs, worlds or methods' if beyond else 'settings'} beyond the suite's: no results archive "
-              "unless --archive DIR is given)")
+        notes.append(f"({'rungs, worlds or methods' if beyond else 'settings'} beyond the suite's: no results archive "
+                     "unless --archive DIR is given)")
+
+    def log(line: str) -> None:
+        print(line)
+        while notes:
+            print(notes.pop(0))
     try:
-        result = transfer(suite, out, workers=args.workers, ray=args.ray, video=not args.no_video,
+        result = transfer(suite, out, workers=args.workers, ray=args.ray, video=not args.no_video, log=log,
                           command=command_line(), device=args.device, archive=archive, members=args.members,
                           time_limit=None if args.time_limit is None else args.time_limit * 60)
     except TimeLimitReached as stopped:

@@ -350,6 +350,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     _refuse_sb3_not_kept(out, kept, configs, teachers.values())  # nothing written for a run it would not train
     # the pool, and a Ray cluster with it, before anything is written: one out of reach leaves no output behind
     pool = WorkerPool(len(cells(configs, members)) + len(teachers), workers, ray)
+    log(f"suite {suite.name}: {suite.description}")  # (its input checked: a refused transfer says only why)
     if suite.eval_every is None and suite.student_steps is not None:  # the interval follows a budget given: say so
         every = sorted({c.eval_every for c in configs})
         log(f"(students evaluated every {' or '.join(f'{e:,}' for e in every)} transitions, a 20th of their "

@@ -180,11 +180,12 @@ QUICK_REACH = ["transfer", "--suite", "quick", "--tasks", "Reach", "--seeds", "1
 
 
 def _refused(tmp_path, capsys, *flags, out=None) -> str:
-    """Run ``transfer`` with ``flags``; assert it exits 2 with one line and wrote nothing; return the line."""
+    """Run ``transfer`` with ``flags``; assert it exits 2 with one line (on stderr, nothing on
+    stdout: not the suite it would have run) and wrote nothing; return the line."""
     before = sorted(tmp_path.rglob("*"))
     assert main([*QUICK_REACH, *flags, "--out", str(out or tmp_path / "out")]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith("craftsuite transfer: error: ") and err.count("\n") == 1
+    said, err = capsys.readouterr()
+    assert err.startswith("craftsuite transfer: error: ") and err.count("\n") == 1 and said == ""
     assert sorted(tmp_path.rglob("*")) == before
     return err.removeprefix("craftsuite transfer: error: ").strip()
 
@@ -246,7 +247,8 @@ def test_a_budget_given_announces_the_evaluation_interval_it_sets(tmp_path, monk
     suite = dataclasses.replace(SUITES["quick"], tasks=("Reach",), seeds=1, student_steps=4_000)
     with pytest.raises(KeyboardInterrupt):
         suite_runner.transfer(suite, tmp_path / "out", log=said.append)
-    assert said == ["(students evaluated every 200 transitions, a 20th of their budget of 4,000; --eval-every N sets "
+    assert said == [f"suite quick: {suite.description}",
+                    "(students evaluated every 200 transitions, a 20th of their budget of 4,000; --eval-every N sets "
                     "another)"]
     assert [p.closed for p in pools] == [[True]]  # an interrupted transfer stops its pool
 

@@ -473,13 +473,27 @@ class _Worker:
     and ``join`` reaps it (``code``: the exit code it then shows)."""
 
     def __init__(self, ended: bool, code=None):
-        read, self._write = os.pipe()
+        read, write = os.pipe()
         if ended:
-            os.close(self._write)
+            os.close(write)
+        self._open = [read] if ended else [read, write]
         self.sentinel, self.code, self.exitcode, self.joins = read, code, None, 0
 
     def join(self, timeout=None):
         self.joins, self.exitcode = self.joins + 1, self.code
+
+    def close(self):
+        while self._open:
+            os.close(self._open.pop())
+
+
+@pytest.fixture
+def worker():
+    """Makes ``_Worker(ended, code)``s, their pipes closed after the test."""
+    made = []
+    yield lambda *args, **kwargs: made.append(_Worker(*args, **kwargs)) or made[-1]
+    for each in made:
+        each.close()
 
 
 def _broken_pool(*workers, broken="a child process terminated abruptly"):
@@ -495,34 +509,34 @@ def _broken_pool(*workers, broken="a child process terminated abruptly"):
     return pool, failed
 
 
-def test_a_broken_pool_waits_for_its_dead_worker_to_be_reapable():
+def test_a_broken_pool_waits_for_its_dead_worker_to_be_reapable(worker):
     """Under load the executor can see a killed worker's pipe close before the kernel has made
     the worker reapable (its exit code still None): the pool waits for it rather than report
     no signal (which would make a transfer killed for memory exit 1, a status a campaign does
     not resume), and leaves the live worker alone."""
-    killed, alive = _Worker(ended=True, code=-signal.SIGKILL), _Worker(ended=False)
+    killed, alive = worker(ended=True, code=-signal.SIGKILL), worker(ended=False)
     pool, failed = _broken_pool(killed, alive)
     pool._note_lost(failed)
     assert pool.lost == [signal.SIGKILL] and killed.joins == 1 and alive.joins == 0
 
 
-def test_a_pool_broken_without_a_signal_is_looked_at_once_and_at_once():
+def test_a_pool_broken_without_a_signal_is_looked_at_once_and_at_once(worker):
     """A worker that exited by itself (status 1) names no signal, and the jobs failed with it
     do not each wait for the live workers."""
-    exited = _Worker(ended=True, code=1)
-    pool, failed = _broken_pool(exited, _Worker(ended=False))
+    exited = worker(ended=True, code=1)
+    pool, failed = _broken_pool(exited, worker(ended=False))
     start = time.monotonic()
     for _ in range(5):
         pool._note_lost(failed)
     assert pool.lost == [] and exited.joins == 1 and time.monotonic() - start < worker_pool.LOST_WAIT
 
 
-def test_a_jobs_own_broken_pool_error_is_not_a_break():
+def test_a_jobs_own_broken_pool_error_is_not_a_break(worker):
     """A job that raised BrokenProcessPool itself, its pool whole, leaves the workers unread."""
-    worker = _Worker(ended=True, code=-signal.SIGKILL)
-    pool, failed = _broken_pool(worker, broken=False)
+    killed = worker(ended=True, code=-signal.SIGKILL)
+    pool, failed = _broken_pool(killed, broken=False)
     pool._note_lost(failed)
-    assert pool.lost == [] and worker.joins == 0 and not pool._looked
+    assert pool.lost == [] and killed.joins == 0 and not pool._looked
 
 
 def test_an_abort_cancels_the_tasks_sent_to_a_joined_ray_cluster(monkeypatch):

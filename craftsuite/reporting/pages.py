@@ -197,8 +197,7 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
                       f"Against scratch, {COMPARED['auc']} (how soon a run learned; the same rules): "
                       + "; ".join(_comparison_text(*pair) for pair in in_metric(pairs, "auc")) + "."]
         lines += obstacles_markdown(rows)
-        notes = [f"*{e.label}: " + "; ".join(f"{k} = {json.dumps(v)}" for k, v in e.differs.items()) + "*"
-                 for e in rows if e.variant]
+        notes = _variant_notes(rows)
         if notes:
             lines += ["", "Runs of one method that differ in more than the seed are not pooled; "
                       "each setting is a row of its own (put runs of another setting in another directory):", ""]
@@ -223,6 +222,13 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
     lines += [f"- `{m}`: {_method_note(m, [e for e in entries if e.method == m])}" for m in shown]
     lines.append("")
     return "\n".join(lines)
+
+
+def _variant_notes(rows) -> list[str]:
+    """What tells a method's variants apart, one note each, in the order of their letters (the
+    table ranks them by success, so (b) may stand above (a))."""
+    return [f"*{e.label}: " + "; ".join(f"{k} = {json.dumps(v)}" for k, v in e.differs.items()) + "*"
+            for e in sorted((e for e in rows if e.variant), key=lambda e: (e.method, len(e.variant), e.variant))]
 
 
 def _method_note(method: str, rows: list[Entry]) -> str:
@@ -809,8 +815,7 @@ def superseded_markdown(board: Board | None, level: int = 3) -> list[str]:
         rows = ranked([e for e in board if (e.task, e.world_label) == (task, world)])
         waiting = sorted((u.method, u.seed) for u in board.unfinished if (u.task, u.world_label) == (task, world))
         lines += [f"{h}# {task} ({world})", "", *(task_table(rows) if rows else [])]
-        lines += [f"- *{e.label}: " + "; ".join(f"{k} = {json.dumps(v)}" for k, v in e.differs.items()) + "*"
-                  for e in rows if e.variant]
+        lines += [f"- {note}" for note in _variant_notes(rows)]
         if waiting:
             lines += ["", "Unfinished, not counted: " + ", ".join(f"{m} seed {seed}" for m, seed in waiting)]
         lines.append("")

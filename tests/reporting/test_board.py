@@ -163,6 +163,13 @@ def test_runs_of_one_method_that_differ_beyond_the_seed_are_flagged_and_not_pool
             ("td3", "a"): "steps", ("td3", "b"): "steps", ("td3-dynamic", ""): ""}
 
 
+def test_the_notes_on_variants_follow_their_letters_where_the_table_ranks_b_first(runs):
+    fake_run(runs, "td3", 2, [(2000, 1.0)], [(1995, 9.0)], budget=2_000)  # (b): one seed, and at 1.0
+    md = leaderboard_markdown(Board(list(build(runs))))
+    assert md.index("| td3 (b) |") < md.index("| td3 (a) |")  # the table ranks by success
+    assert md.index("- *td3 (a): steps = 1000*") < md.index("- *td3 (b): steps = 2000*")
+
+
 def test_a_task_only_the_baseline_ran_with_one_seed_does_not_drop_the_baseline(runs):
     fake_run(runs, "td3", 0, [(1000, 1.0)], [(995, 1.0)], task="Reach")  # one seed, and only td3 ran Reach
     [agg] = aggregates(list(build(runs)))

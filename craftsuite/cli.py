@@ -285,13 +285,13 @@ def _distill(args) -> int:
                              f"distill {task} --static --out {args.out}), or give a teacher run directory for its "
                              "teacher's values")
         if source.is_dir():  # a teacher run directory: its config names the env, its checkpoint the replay
-            _unread(args, f"{source} is a teacher run directory: its config names the task and env, its checkpoint "
-                          "the replay")
             from .configs import TeacherConfig
             from .runs import RunDir, load_config
 
             if not (source / "config.json").is_file():
                 raise FileNotFoundError(f"{source} is not a teacher run directory (no config.json)")
+            _unread(args, f"{source} is a teacher run directory: its config names the task and env, its checkpoint "
+                          "the replay")
             config = load_config(TeacherConfig, source)
             if config.engine == "population":
                 from .population.teacher import distill_run
@@ -304,6 +304,9 @@ def _distill(args) -> int:
                 raise FileNotFoundError(f"{source} has no checkpoint (model and replay buffer) yet")
             model, replay = saved / "model.zip", saved / "replay.pkl"
         else:
+            if args.env_id is not None and args.task is not None:
+                raise ValueError(f"--task {args.task} --env-id {args.env_id}: the env id names the teacher's task "
+                                 "too; give one of them")
             env_id, env_kwargs = args.env_id or _registered(args.task or "BlindCraftsman", "Grid7"), {}
             model, replay = source, Path(args.replay) if args.replay else None
         if replay is None or not replay.is_file():

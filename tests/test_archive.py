@@ -118,13 +118,14 @@ def test_the_archive_command_keeps_a_suites_runs_and_names_the_rest(tmp_path, ca
     assert main(["archive", str(source), "--suite", "biggest"]) == 2
 
 
-def test_transfer_flags_choose_the_archive(tmp_path, monkeypatch):
+def test_transfer_flags_choose_the_archive(tmp_path, monkeypatch, capsys):
     import craftsuite.suite_runner
 
     seen = {}
 
     def fake_transfer(suite, out, **kwargs):
         seen[suite.name] = kwargs["archive"]
+        kwargs["log"](f"suite {suite.name}")  # as transfer says it, once it has checked its input
         return craftsuite.suite_runner.TransferResult(out, {}, [], out, [], None)
 
     monkeypatch.setattr(craftsuite.suite_runner, "transfer", fake_transfer)
@@ -135,8 +136,11 @@ def test_transfer_flags_choose_the_archive(tmp_path, monkeypatch):
     assert main(args + ["--suite", "standard", "--archive", "elsewhere"]) == 0 and seen["standard"] == "elsewhere"
     assert main(args + ["--suite", "standard", "--no-archive"]) == 0 and seen["standard"] is None
     assert main(args + ["--suite", "standard", "--no-archive", "--archive", "x"]) == 2
-    # settings beyond the suite's (a smoke test's budget) stay out of the archive unless asked for
+    # settings beyond the suite's (a smoke test's budget) stay out of the archive unless asked for, as said
+    capsys.readouterr()
     assert main(args + ["--suite", "standard", "--steps", "1000"]) == 0 and seen["standard"] is None
+    assert capsys.readouterr().out.startswith(
+        "suite standard\n(settings beyond the suite's: no results archive unless --archive DIR is given)\n")
     assert main(args + ["--suite", "standard", "--steps", "1000", "--archive", "x"]) == 0 and seen["standard"] == "x"
     # and so do rungs, worlds and methods the suite does not run: they are not its runs
     for beyond in (["--tasks", "Reach"], ["--worlds", "Kinematic", "--methods", "td3"], ["--methods", "crm-edges"]):

@@ -98,9 +98,9 @@ def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
     # a teacher .zip's flags where SOURCE answers them were ignored
     (["distill", "FirstTool", "--static", "--task", "DungeonQuest"],
      "--task: with --static the task is SOURCE (FirstTool) and no teacher is read; leave it out"),
-    (["distill", str(HERE), "--task", "DungeonQuest", "--replay", "replay.pkl"],
-     f"--task, --replay: {HERE} is a teacher run directory: its config names the task and env, its checkpoint the "
-     "replay; leave them out"),
+    (["distill", str(HERE / "test_bad_input.py"), "--task", "DungeonQuest", "--env-id",
+      "CraftSuite/FirstTool-Grid7-v0"], "--task DungeonQuest --env-id CraftSuite/FirstTool-Grid7-v0: the env id "
+     "names the teacher's task too; give one of them"),
 ])
 def test_a_refused_command_names_its_flag_and_leaves_no_output_folder(tmp_path, capsys, command, message):
     out = tmp_path / "new" / "runs"
@@ -108,6 +108,18 @@ def test_a_refused_command_names_its_flag_and_leaves_no_output_folder(tmp_path, 
     err = capsys.readouterr().err
     assert err.startswith(f"craftsuite {command[0]}: error: {message}") and err.count("\n") == 1
     assert list(tmp_path.iterdir()) == []
+
+
+def test_distill_refuses_the_flags_a_teacher_run_directory_answers(tmp_path, capsys):
+    teacher = tmp_path / "teacher-FirstTool-Grid7-s0"
+    teacher.mkdir()
+    (teacher / "config.json").write_text("{}")
+    assert main(["distill", str(teacher), "--task", "DungeonQuest", "--replay", "replay.pkl",
+                 "--out", str(tmp_path / "table.npz")]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"craftsuite distill: error: --task, --replay: {teacher} is a teacher run directory: its config "
+                   "names the task and env, its checkpoint the replay; leave them out\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [teacher.name]
 
 
 def test_where_a_command_writes_is_checked_before_it_computes(tmp_path, capsys):

@@ -437,7 +437,7 @@ def test_a_worker_started_for_a_later_job_is_watched_too(monkeypatch, tmp_path):
         _started(tmp_path / "busy")  # the first worker holds its job: the next needs a second worker
         killed = pool.submit(signal.raise_signal, signal.SIGKILL)
         with pytest.raises(BrokenProcessPool):
-            killed.result(timeout=60)
+            killed.result(timeout=300)
     finally:
         pool.close(abort=True)
     assert pool.lost == [signal.SIGKILL]  # the live worker, stopped by the executor, not counted

@@ -143,7 +143,8 @@ class WorkerPool:
         thread can go back to waiting on the workers it knew: a worker started then and later
         killed (the out-of-memory killer) would go unseen until another worker's job returned,
         hours in a suite. Woken now, with the new worker listed, it watches every worker."""
-        wakeup, lock = (getattr(self.pool, name, None) for name in ("_executor_manager_thread_wakeup", "_shutdown_lock"))
+        wakeup = getattr(self.pool, "_executor_manager_thread_wakeup", None)
+        lock = getattr(self.pool, "_shutdown_lock", None)
         if wakeup is not None and lock is not None:  # (the executor's own: where a Python has them not, nothing)
             with lock:  # as ``submit`` wakes it
                 wakeup.wakeup()

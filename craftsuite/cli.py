@@ -321,6 +321,13 @@ def _distill(args) -> int:
     return _write_table(table, automaton, args)
 
 
+def _table_methods() -> str:
+    """The methods that distil a teacher's table, as the student command names them."""
+    from .methods import METHODS
+
+    return ", ".join(m for m, row in METHODS.items() if row.needs_table)
+
+
 def _unread(args, why: str) -> None:
     """Refuse the flags of a teacher .zip where SOURCE answers them (given, they were ignored)."""
     given = [flag for flag, value in (("--task", args.task), ("--env-id", args.env_id), ("--replay", args.replay))
@@ -363,7 +370,7 @@ def _student(args) -> int:
         raise ValueError(f"method {args.method!r} needs --table (a teacher's table.npz: craftsuite teacher)")
     if args.table and not METHODS[args.method].needs_table:  # it would be recorded, and change the run key
         raise ValueError(f"method {args.method!r} distils no teacher's table: leave out --table (the methods that "
-                         f"take one: {', '.join(m for m, row in METHODS.items() if row.needs_table)})")
+                         f"take one: {_table_methods()})")
     check_trains(config, f"{config.task}'s {config.method} student ({config.world})")  # as a transfer does
     directory_to_write(args.out, "--out")
     path = train_student(config, args.out, device=args.device)
@@ -682,7 +689,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--world", default="Cont", type=_world,
                    help=f"Cont (MuJoCo), Kinematic or Grid<size>, a world of the task; the known tasks': {worlds}")
     p.add_argument("--table", help="a teacher's table.npz (craftsuite teacher), for the methods that distil one: "
-                   + ", ".join(m for m, row in METHODS.items() if row.needs_table))
+                   + _table_methods())
     p.add_argument("--out", default="runs/students", help="runs directory (default: runs/students)")
     p.add_argument("--seed", type=_seed, default=0)
     p.add_argument("--steps", type=_positive, default=20_000, help="the budget in transitions (default: 20000)")

@@ -15,7 +15,7 @@ from craftsuite.configs import StudentConfig, TeacherConfig
 from craftsuite.hyperparameters import HyperparameterError
 from craftsuite.training import train_student, train_teacher
 
-HERE = Path(__file__).parent  # a directory that is no teacher run
+THIS_FILE = Path(__file__)  # a file given where a teacher .zip goes: its flags are checked before it is read
 
 
 @pytest.mark.parametrize("hyper,message", [({"batch_size": "big"}, "batch_size must be an integer"),
@@ -98,7 +98,7 @@ def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
     # a teacher .zip's flags where SOURCE answers them were ignored
     (["distill", "FirstTool", "--static", "--task", "DungeonQuest"],
      "--task: with --static the task is SOURCE (FirstTool) and no teacher is read; leave it out"),
-    (["distill", str(HERE / "test_bad_input.py"), "--task", "DungeonQuest", "--env-id",
+    (["distill", str(THIS_FILE), "--task", "DungeonQuest", "--env-id",
       "CraftSuite/FirstTool-Grid7-v0"], "--task DungeonQuest --env-id CraftSuite/FirstTool-Grid7-v0: the env id "
      "names the teacher's task too; give one of them"),
 ])

@@ -158,6 +158,9 @@ class Recorder(gym.Wrapper):
             raise RuntimeError(f"{self.path}: the recording is finished (or closed): a Recorder records one run")
         if self._episode is None:
             raise RuntimeError("step() before reset(): reset the env first, as gymnasium envs need")
+        if self.done:  # a transition past the budget would train the policy the budget's evaluation plays
+            raise RuntimeError(f"{self.path}: the budget's {self.budget:,} transitions are collected: stop stepping "
+                               "when done says so, and call finish(policy, updates=...)")
         obs, reward, terminated, truncated, info = self.env.step(action)
         self.transitions += 1
         self._episode[0] += float(reward)

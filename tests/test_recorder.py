@@ -86,6 +86,16 @@ def test_finishing_before_the_budget_is_refused_and_a_second_recording_too(tmp_p
         craftsuite.Recorder(ENV, tmp_path, method="my-short")
 
 
+def test_a_step_past_the_budget_is_refused_and_the_run_still_finishes_at_it(tmp_path):
+    env = craftsuite.Recorder(ENV, tmp_path, method="my-greedy", steps=50)
+    _random_loop(env, np.random.default_rng(0), evaluate=False)
+    with pytest.raises(RuntimeError, match="the budget's 50 transitions are collected: stop stepping when done"):
+        env.step(0)
+    path = env.finish(lambda obs: 0, updates=0)
+    assert json.loads((path / "result.json").read_text())["steps"] == 50
+    assert sum(int(r["length"]) for r in read_csv(path / "episodes.csv")) <= 50
+
+
 def test_another_budget_keeps_the_suites_schedule_for_it():
     config = recorded_config("CraftSuite/ToolHome-Cont-v0", "my-sac", steps=4_000)
     assert (config.steps, config.eval_every) == (4_000, SUITES["standard"].eval_interval(4_000, "Cont"))

@@ -12,7 +12,9 @@ run resumed after a kill, sees the old file or the new one, never a torn one.
 
 A command checks where it will write before it computes anything: ``file_to_write(path,
 flag)`` and ``directory_to_write(path, flag)`` name the flag, the path, the problem and the
-fix in one line (a directory given for a file, a file on the way, no permission).
+fix in one line (a directory given for a file, a file on the way, no permission). A file it
+reads, given as a directory (a run's, most likely), is refused by ``file_to_read``, naming
+the file in it to give.
 """
 
 from __future__ import annotations
@@ -122,4 +124,20 @@ def file_to_write(path, flag: str, example: str) -> Path:
         raise IsADirectoryError(f"{flag} {given} {'is' if path.is_dir() else 'names'} a directory, not a file: "
                                 f"give the file to write, e.g. {path / example}")
     _check_writable_dir(path.parent, flag, given)
+    return path
+
+
+def file_to_read(path, what: str, names: tuple[str, ...]) -> Path:
+    """``path`` as a file a command reads (a checkpoint, a table), refused where it is a
+    directory: a run's directory, most likely, holding the file under one of ``names``.
+
+    Raises:
+        IsADirectoryError: ``path`` is a directory; the message gives the file in it to
+            give (the first of ``names`` there, else the first of them), and says when it is there.
+    """
+    path = Path(path)
+    if path.is_dir():
+        inside = next((path / name for name in names if (path / name).is_file()), None)
+        raise IsADirectoryError(f"{path} is a directory, not a {what}: give the {what} file, e.g. "
+                                f"{inside or path / names[0]}" + (" (it is there)" if inside else ""))
     return path

@@ -27,11 +27,9 @@ def load_policy(name: str, env, seed: int = 0):
 
 def _load_checkpoint(path: Path, env):
     from .agents.factory import load_agent
+    from .files import file_to_read
 
-    if path.is_dir():  # a run directory, most likely: its model is a file in it (a teacher's: teacher.zip)
-        model = next((path / n for n in ("model.zip", "teacher.zip") if (path / n).is_file()), path / "model.zip")
-        raise IsADirectoryError(f"{str(path)!r} is a directory, not a checkpoint: give the checkpoint file, e.g. "
-                                f"{model}")
+    file_to_read(path, "checkpoint", ("model.zip", "teacher.zip"))  # a student's run directory, or a teacher's
     if not path.is_file():
         raise FileNotFoundError(
             f"no such checkpoint {str(path)!r}; a policy is 'random', 'scripted' or a checkpoint file")

@@ -157,11 +157,14 @@ def test_a_directory_given_for_a_file_names_the_file_in_it(tmp_path, capsys):
     (teacher / "table.npz").write_bytes(b"")
     assert main(["student", "FirstTool", "--method", "td3-dynamic", "--table", str(teacher),
                  "--out", str(tmp_path / "runs")]) == 2
-    assert (f"{teacher} is a directory, not a distilled table: give the table file, e.g. {teacher / 'table.npz'} "
-            "(the teacher's is there)") in capsys.readouterr().err
+    assert (f"{teacher} is a directory, not a distilled table: give the distilled table file, e.g. "
+            f"{teacher / 'table.npz'} (it is there)") in capsys.readouterr().err
     assert main(["video", "FirstTool", "--policy", str(teacher), "--out", str(tmp_path / "v.mp4")]) == 2
-    assert f"is a directory, not a checkpoint: give the checkpoint file, e.g. {teacher / 'model.zip'}" in (
+    assert f"{teacher} is a directory, not a checkpoint: give the checkpoint file, e.g. {teacher / 'model.zip'}\n" in (
         capsys.readouterr().err)
+    (teacher / "teacher.zip").write_bytes(b"")  # a teacher's run directory: its checkpoint is named
+    assert main(["video", "FirstTool", "--policy", str(teacher), "--out", str(tmp_path / "v.mp4")]) == 2
+    assert f"give the checkpoint file, e.g. {teacher / 'teacher.zip'} (it is there)\n" in capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir()) == [teacher.name]
 
 

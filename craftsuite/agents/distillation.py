@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from ..automata import Automaton
-from ..files import atomic_path
+from ..files import atomic_path, file_to_read
 from ..methods import TARGET_DEFAULTS
 
 FORMAT_VERSION = 1
@@ -89,16 +89,13 @@ class AutomatonQTable:
         """The table saved at ``path``; with ``automaton``, checked to be made for it.
 
         Raises:
-            FileNotFoundError: no file at ``path`` (a directory there named, with the fix).
+            IsADirectoryError: a directory at ``path`` (the table file in it named).
+            FileNotFoundError: no file at ``path``.
             DistillationError: the file is no distilled table (not an .npz archive, arrays
                 missing or unreadable, another format) or was made for another automaton;
                 the message names the file and what is wrong.
         """
-        path = Path(path)
-        if path.is_dir():  # a teacher's run directory, most likely: its table is a file in it
-            inside = " (the teacher's is there)" if (path / "table.npz").is_file() else ""
-            raise FileNotFoundError(f"{path} is a directory, not a distilled table: give the table file, e.g. "
-                                    f"{path / 'table.npz'}{inside}")
+        path = file_to_read(path, "distilled table", ("table.npz",))  # a teacher's run directory, most likely
         if not path.is_file():
             raise FileNotFoundError(f"no distilled table at {path}")
         where = f"{path} is not a CraftSuite distilled table"

@@ -17,7 +17,7 @@ import torch.nn.functional as F
 from stable_baselines3.common.utils import polyak_update  # elementwise: stacked members too
 
 from .cnn import StackedQNetwork, StackedResidualCNN
-from .nets import StackedMLP, activation_of, clip_grad_norm_per_member
+from .nets import StackedMLP, activation_of, clip_grad_norm_per_member, hidden_widths
 from .replay import Batch, SparseRows
 from .targets import MemberTargets, discount
 
@@ -35,7 +35,7 @@ class PopulationDQN:
 
         self.members, self.device, self.n_actions, self.obs_dim = members, th.device(device), n_actions, obs_dim
         policy_kwargs = settings.get("policy_kwargs") or {}
-        hidden = list(policy_kwargs.get("net_arch", [64, 64]))
+        hidden, _ = hidden_widths(policy_kwargs, "dqn", [64, 64])
         act = activation_of(policy_kwargs.get("activation_fn", nn.ReLU))
         self.dueling = bool(settings.get("dueling", True))
         outputs = n_actions + 1 if self.dueling else n_actions  # column 0 is V, as agents.dqn's head

@@ -23,6 +23,7 @@ from ..agents.noise import make_action_noise
 from ..methods import METHODS
 from ..shaping import Shaping, potential
 from .dqn import PopulationDQN
+from .nets import hidden_widths
 from .envs import step_records
 from .replay import CounterfactualView, PopulationReplay
 from .targets import MemberTargets
@@ -62,10 +63,8 @@ def check_supported(method: str, settings: dict) -> None:
         why = "optimize_memory_usage (its replay keeps next observations; a grid's as their nonzero entries)"
     elif sorted(set(settings.get("policy_kwargs") or {}) - _POLICY_KWARGS):
         why = f"policy_kwargs {sorted(set(settings['policy_kwargs']) - _POLICY_KWARGS)}"
-    elif not _widths_ok((settings.get("policy_kwargs") or {}).get("net_arch", [64]), algorithm):
-        pi_qf = ', or {"pi": [...], "qf": [...]}' if algorithm == "td3" else ""
-        why = (f"net_arch {settings['policy_kwargs']['net_arch']!r} (it takes the hidden layers' widths, positive "
-               f"integers, e.g. [256, 256]{pi_qf})")
+    elif (bad_widths := _refused(hidden_widths, settings.get("policy_kwargs") or {}, algorithm, [64])):
+        why = bad_widths
     elif not _train_every(settings.get("train_freq", 1)):
         why = f"train_freq {settings['train_freq']!r} (it trains every k steps, not episodes)"
     elif not (isinstance(settings.get("gradient_steps", 1), int) and settings.get("gradient_steps", 1) >= 1):
@@ -86,13 +85,13 @@ def _check_n_steps(method: str, n_steps) -> None:
         raise EngineError(f"method {method!r}: n_steps must be a positive integer, got {n_steps!r}")
 
 
-def _widths_ok(arch, algorithm: str) -> bool:
-    """Whether ``net_arch`` is what the engine builds from: a list of positive widths (TD3:
-    or one for the actor and one for the critics, ``{"pi": [...], "qf": [...]}``)."""
-    if algorithm == "td3" and isinstance(arch, dict):
-        return set(arch) == {"pi", "qf"} and all(_widths_ok(arch[k], "dqn") for k in ("pi", "qf"))
-    return isinstance(arch, (list, tuple)) and all(
-        isinstance(w, int) and not isinstance(w, bool) and w >= 1 for w in arch)
+def _refused(check, *args) -> str | None:
+    """The message of the ValueError ``check(*args)`` raises, None where it passes."""
+    try:
+        check(*args)
+    except ValueError as err:
+        return str(err)
+    return None
 
 
 def _train_every(train_freq) -> int | None:

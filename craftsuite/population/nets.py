@@ -134,6 +134,27 @@ def _norms(sequential: nn.Module, stacked: StackedMLP) -> list[nn.LayerNorm]:
     return norms
 
 
+def hidden_widths(policy_kwargs: dict, algorithm: str, default) -> tuple[list[int], list[int]]:
+    """The hidden layers' widths of SB3's ``net_arch`` (``default`` where not given): a list
+    of positive integers for every network, or, for TD3, one for the actor and one for the
+    critics (``{"pi": [...], "qf": [...]}``). Returns (actor's or Q-network's, critics').
+
+    Raises:
+        ValueError: anything else; the message says what ``net_arch`` takes.
+    """
+    arch = policy_kwargs.get("net_arch", default)
+    if algorithm == "td3" and isinstance(arch, dict) and set(arch) == {"pi", "qf"}:
+        pi, qf = arch["pi"], arch["qf"]
+    else:
+        pi = qf = arch
+    if not all(isinstance(widths, (list, tuple)) and all(
+            isinstance(w, int) and not isinstance(w, bool) and w >= 1 for w in widths) for widths in (pi, qf)):
+        pi_qf = ', or {"pi": [...], "qf": [...]}' if algorithm == "td3" else ""
+        raise ValueError(f"net_arch {arch!r} (it takes the hidden layers' widths, positive integers, e.g. "
+                         f"[256, 256]{pi_qf})")
+    return list(pi), list(qf)
+
+
 def activation_of(activation_fn) -> callable:
     """The function of SB3's ``activation_fn`` class (``nn.ReLU`` by default)."""
     try:

@@ -13,18 +13,9 @@ import torch as th
 from stable_baselines3.common.utils import polyak_update  # elementwise: stacked members too
 
 from ..hyperparameters import TD3_DELAY_SCHEDULE
-from .nets import StackedMLP, activation_of
+from .nets import StackedMLP, activation_of, hidden_widths
 from .replay import Batch
 from .targets import MemberTargets, discount
-
-
-def net_arch(policy_kwargs: dict, default) -> tuple[list[int], list[int]]:
-    """The actor's and the critics' hidden sizes from SB3's ``net_arch`` (a list for both,
-    or ``{"pi": [...], "qf": [...]}``)."""
-    arch = policy_kwargs.get("net_arch", default)
-    if isinstance(arch, dict):
-        return list(arch["pi"]), list(arch["qf"])
-    return list(arch), list(arch)
 
 
 class PopulationTD3:
@@ -40,7 +31,7 @@ class PopulationTD3:
 
         self.members, self.device = members, th.device(device)
         policy_kwargs = settings.get("policy_kwargs") or {}
-        pi, qf = net_arch(policy_kwargs, [400, 300])
+        pi, qf = hidden_widths(policy_kwargs, "td3", [400, 300])
         act = activation_of(policy_kwargs.get("activation_fn", nn.ReLU))
         n_critics = policy_kwargs.get("n_critics", 2)
         layer_norm = bool(settings.get("layer_norm", False))  # the critics' only, as agents.td3's policy

@@ -41,3 +41,21 @@ def test_the_actor_step_leaves_the_critics_gradients_as_the_critic_step_left_the
     assert all(p.grad is None for p in critic_only.actor.parameters())
     for mine, theirs in zip(with_actor.critics.parameters(), critic_only.critics.parameters(), strict=True):
         assert th.equal(mine.grad, theirs.grad)
+
+
+def test_the_actor_and_the_critics_take_their_own_widths_and_a_malformed_one_is_refused_by_the_engine_first():
+    """``{"pi": [...], "qf": [...]}`` builds each network from its own list; what the networks
+    cannot build, the engine's check refuses with their own message, before anything runs."""
+    from craftsuite.population.engine import EngineError, check_supported
+
+    arch = {"pi": [8], "qf": [5, 3]}
+    population = PopulationTD3(K, OBS, ACT, algorithm_settings("td3", {"policy_kwargs": {"net_arch": arch}}))
+    assert [net.sizes for net in (population.actor, *population.critics)] == [
+        [OBS, 8, ACT], [OBS + ACT, 5, 3, 1], [OBS + ACT, 5, 3, 1]]
+    for bad in ({"pi": [8]}, {"pi": [8], "qf": [0]}, [8, "wide"]):
+        settings = algorithm_settings("td3", {"policy_kwargs": {"net_arch": bad}})
+        with pytest.raises(ValueError) as built:
+            PopulationTD3(K, OBS, ACT, settings)
+        with pytest.raises(EngineError, match="does not support net_arch") as checked:
+            check_supported("td3", settings)
+        assert str(built.value) in str(checked.value)

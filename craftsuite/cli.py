@@ -69,7 +69,9 @@ class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
 
     def _get_help_string(self, action):
         text = action.help or ""
-        if "default" in text or action.default in (None, False, (), argparse.SUPPRESS):
+        # `is`, not `in`: 0 == False, and a default of 0 is one to show
+        if "default" in text or action.default is None or action.default is False or action.default in (
+                (), argparse.SUPPRESS):
             return text
         return super()._get_help_string(action)
 

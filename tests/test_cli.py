@@ -106,7 +106,9 @@ def test_help_shows_every_default():
     for name, command in commands.items():
         formatter = command._get_formatter()
         for action in command._actions:
-            if action.option_strings and action.default not in (None, False, (), "==SUPPRESS=="):
+            # a default of 0 is one to show (0 == False: compared by identity)
+            if action.option_strings and not (action.default is None or action.default is False
+                                              or action.default in ((), "==SUPPRESS==")):
                 assert "default" in formatter._expand_help(action), (name, action.option_strings)
     text = " ".join(commands["student"].format_help().split())
     assert "--seed SEED (default: 0)" in text and "--eval-every EVAL_EVERY (default: 2000)" in text

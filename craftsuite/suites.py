@@ -287,11 +287,10 @@ SUITES = {s.name: s for s in (
     # the transfer target (a distilled student at 80% greedy success in at most half the
     # transitions its algorithm needs from scratch) on the paper's three tasks: scratch, the
     # paper's method and the transfer method, in the standard suite's collection regimes, with
-    # a 200k-transition replay (see PAPER_METHODS) for every TD3 method alike. A DQN's replay
-    # holds its whole budget: crm-edges on Diamond Mine's grid fills about 7.5 GB (13 copies
-    # of 721 numbers), so on 24 GiB run the grids with --workers 1
+    # a 200k-transition replay (see PAPER_METHODS) for every TD3 method alike (a DQN's replay
+    # holds its whole budget, 100k here)
     Suite("transfer", "the paper's three tasks: scratch, the paper's method and the transfer method (crm-edges), "
-          "Grid10 and MuJoCo, 5 seeds (about 4 hours on 2 cores)",
+          "Grid10 and MuJoCo, 5 seeds",
           tasks=("BlindCraftsman", "DungeonQuest", "DiamondMine"), worlds=("Grid10", "Cont"),
           methods=TRANSFER_METHODS, seeds=5, budgets={"Cont": {"hard": 600_000}, "Grid": {"hard": 100_000}},
           td3_n_envs=TD3_REGIME["td3_n_envs"], td3_hyperparameters={**TD3_REGIME["td3_hyperparameters"],

@@ -23,8 +23,8 @@ from ..agents.noise import make_action_noise
 from ..methods import METHODS
 from ..shaping import Shaping, potential
 from .dqn import PopulationDQN
-from .nets import hidden_widths
 from .envs import step_records
+from .nets import hidden_widths
 from .replay import CounterfactualView, PopulationReplay
 from .targets import MemberTargets
 from .td3 import PopulationTD3, delay_at, delay_schedule

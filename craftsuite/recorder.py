@@ -21,6 +21,9 @@ marked ``self_reported``: CraftSuite did not train them, and says so wherever it
         if env.evaluation_due:
             env.evaluate(agent.act)
     env.finish(agent.act, updates=agent.updates)
+
+A step past the budget is refused: a library that collects in rollouts (SB3's PPO, say) stops
+at it through a callback that returns ``not env.done``.
 """
 
 from __future__ import annotations
@@ -160,7 +163,8 @@ class Recorder(gym.Wrapper):
             raise RuntimeError("step() before reset(): reset the env first, as gymnasium envs need")
         if self.done:  # a transition past the budget would train the policy the budget's evaluation plays
             raise RuntimeError(f"{self.path}: the budget's {self.budget:,} transitions are collected: stop stepping "
-                               "when done says so, and call finish(policy, updates=...)")
+                               "when done says so (in SB3, a callback whose _on_step returns not env.done), and "
+                               "call finish(policy, updates=...)")
         obs, reward, terminated, truncated, info = self.env.step(action)
         self.transitions += 1
         self._episode[0] += float(reward)

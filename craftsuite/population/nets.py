@@ -136,7 +136,7 @@ def _norms(sequential: nn.Module, stacked: StackedMLP) -> list[nn.LayerNorm]:
 
 def hidden_widths(policy_kwargs: dict, algorithm: str, default) -> tuple[list[int], list[int]]:
     """The hidden layers' widths of SB3's ``net_arch`` (``default`` where not given): a list
-    of positive integers for every network, or, for TD3, one for the actor and one for the
+    of positive integers (not a tuple) for every network, or, for TD3, one for the actor and one for the
     critics (``{"pi": [...], "qf": [...]}``). Returns (actor's or Q-network's, critics').
 
     Raises:
@@ -147,10 +147,11 @@ def hidden_widths(policy_kwargs: dict, algorithm: str, default) -> tuple[list[in
         pi, qf = arch["pi"], arch["qf"]
     else:
         pi = qf = arch
-    if not all(isinstance(widths, (list, tuple)) and all(
+    # a list, as SB3 takes it: a member is saved as an SB3 policy, whose TD3 asserts on a tuple
+    if not all(isinstance(widths, list) and all(
             isinstance(w, int) and not isinstance(w, bool) and w >= 1 for w in widths) for widths in (pi, qf)):
         pi_qf = ', or {"pi": [...], "qf": [...]}' if algorithm == "td3" else ""
-        raise ValueError(f"net_arch {arch!r} (it takes the hidden layers' widths, positive integers, e.g. "
+        raise ValueError(f"net_arch {arch!r} (it takes the hidden layers' widths, a list of positive integers, e.g. "
                          f"[256, 256]{pi_qf})")
     return list(pi), list(qf)
 

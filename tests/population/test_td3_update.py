@@ -52,7 +52,7 @@ def test_the_actor_and_the_critics_take_their_own_widths_and_a_malformed_one_is_
     population = PopulationTD3(K, OBS, ACT, algorithm_settings("td3", {"policy_kwargs": {"net_arch": arch}}))
     assert [net.sizes for net in (population.actor, *population.critics)] == [
         [OBS, 8, ACT], [OBS + ACT, 5, 3, 1], [OBS + ACT, 5, 3, 1]]
-    for bad in ({"pi": [8]}, {"pi": [8], "qf": [0]}, [8, "wide"]):
+    for bad in ({"pi": [8]}, {"pi": [8], "qf": [0]}, [8, "wide"], (8, 8)):  # a tuple: SB3's TD3 saves no such
         settings = algorithm_settings("td3", {"policy_kwargs": {"net_arch": bad}})
         with pytest.raises(ValueError) as built:
             PopulationTD3(K, OBS, ACT, settings)

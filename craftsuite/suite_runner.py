@@ -265,18 +265,11 @@ def _announce(log, kind: str, runs: list[tuple[Path, int]], root) -> dict[Path, 
 
 
 def checkpoint_step(run: Path) -> int | None:
-    """The step a killed population member resumes from: its newest complete checkpoint's
-    (None: it has none)."""
-    from .population.train import CHECKPOINT, STEP
-    from .runs import RunDir
+    """The newest step a killed population member has a complete checkpoint of (None: it has
+    none); its population resumes from the newest step every member holds."""
+    from .population.train import saved_steps
 
-    for folder in (run / name for name in RunDir.CHECKPOINTS):  # newest first
-        try:
-            if (folder / STEP).is_file() and (folder / CHECKPOINT).is_file():
-                return int(json.loads((folder / STEP).read_text())["num_timesteps"])
-        except (OSError, ValueError, KeyError, TypeError):
-            continue  # unreadable: the worker falls back to the one before, as this does
-    return None
+    return max(saved_steps(run), default=None)
 
 
 def _stamp(path: Path) -> int | None:

@@ -346,15 +346,19 @@ def read_member_state(path: Path) -> dict:
     return th.load(path, weights_only=False, map_location="cpu", mmap=archive)
 
 
-def _saved_steps(run: RunDir) -> dict[int, Path]:
-    """A member's complete checkpoints by step, newest directory first for each step."""
+def saved_steps(run: Path) -> dict[int, Path]:
+    """A member's complete checkpoints (its run directory's), their files by step, the newest
+    directory's for a step held twice: what a population resumes from (``_resume``: the newest
+    step every member holds) and what a suite announces before it does."""
     found = {}
-    for folder in run.checkpoint_dirs((CHECKPOINT, STEP)):
+    for folder in (run / name for name in RunDir.CHECKPOINTS):  # newest first
+        if not ((folder / CHECKPOINT).is_file() and (folder / STEP).is_file()):
+            continue
         try:
-            step = json.loads((folder / STEP).read_text())["num_timesteps"]
+            step = int(json.loads((folder / STEP).read_text())["num_timesteps"])
         except (OSError, ValueError, KeyError, TypeError):
             continue  # written only in part: not a checkpoint
-        found.setdefault(int(step), folder / CHECKPOINT)
+        found.setdefault(step, folder / CHECKPOINT)
     return found
 
 
@@ -381,7 +385,7 @@ def _resume(pop: Population, runs) -> list[float | None]:
     member's share of the wall time its checkpoint records (``_saved_share``; 0 from step 0)."""
     from ..runs import CheckpointError
 
-    found = [_saved_steps(run) for run in runs]
+    found = [saved_steps(run.path) for run in runs]
     if not any(found):
         for run in runs:
             run.trim_logs(0)

@@ -35,7 +35,7 @@ from .progress import progress_bar
 from .runs import RunDir, read_result
 from .suites import Suite
 from .task_registry import carried, resolve_task
-from .worker_pool import WorkerPool
+from .worker_pool import WorkerPool, ray_worker_lost
 
 
 class TimeLimitReached(Exception):
@@ -44,29 +44,33 @@ class TimeLimitReached(Exception):
 
 
 class WorkerLost(Exception):
-    """A transfer's local worker process died while it trained (killed by a signal: most
-    often the kernel's out-of-memory killer, whose SIGKILL no process can catch): the rest
-    were stopped, each run resumes from its newest checkpoint when asked for again, and the
-    finished ones are kept. ``status`` is a shell's for a process that signal killed (128 +
-    its number: 137 for SIGKILL), so that a campaign's part takes the transfer up again as
-    it would one killed itself; 1 where no signal is known."""
+    """A transfer's worker died while it trained (a local process killed by a signal: most
+    often the kernel's out-of-memory killer, whose SIGKILL no process can catch; or a Ray
+    worker, ``how`` saying what Ray said): the rest were stopped, each run resumes from its
+    newest checkpoint when asked for again, and the finished ones are kept. ``status`` is a
+    shell's for a process that signal killed (128 + its number: 137 for SIGKILL), so that a
+    campaign's part takes the transfer up again as it would one killed itself; 1 where no
+    signal is known."""
 
-    def __init__(self, signals: list[int]):
+    def __init__(self, signals: list[int], how: str | None = None):
         self.signals = signals
         self.signal = signal.SIGKILL if signal.SIGKILL in signals else (signals[0] if signals else None)
         self.status = 1 if self.signal is None else 128 + self.signal
+        super().__init__(f"{how or self._killed()}; the same command resumes the unfinished runs from their "
+                         "checkpoints")
+
+    def _killed(self) -> str:
+        """What became of a local worker, by its signal."""
         if self.signal is None:
-            how = "a worker process ended abruptly"
-        elif self.signal == signal.SIGKILL:
-            how = ("a worker process was killed by SIGKILL, most likely out of memory: fewer seeds to a population "
-                   "(--members) or populations at once (--workers) use less")
-        else:
-            try:
-                name = signal.Signals(self.signal).name
-            except ValueError:  # a real-time signal, say: no name
-                name = f"signal {self.signal}"
-            how = f"a worker process was killed by {name}"
-        super().__init__(f"{how}; the same command resumes the unfinished runs from their checkpoints")
+            return "a worker process ended abruptly"
+        if self.signal == signal.SIGKILL:
+            return ("a worker process was killed by SIGKILL, most likely out of memory: fewer seeds to a population "
+                    "(--members) or populations at once (--workers) use less")
+        try:
+            name = signal.Signals(self.signal).name
+        except ValueError:  # a real-time signal, say: no name
+            name = f"signal {self.signal}"
+        return f"a worker process was killed by {name}"
 
 
 def _population_job(configs: list[dict], root: str, task: str | dict | None = None, device: str = "cpu") -> list[str]:
@@ -384,8 +388,11 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     except BrokenProcessPool as err:  # a local worker died (run_students has stopped the rest already)
         pool.close(abort=True)
         raise WorkerLost(pool.lost) from err
-    except BaseException:
+    except BaseException as err:
         pool.close(abort=True)  # (run_students closes it too, but not if it failed before its jobs; twice is harmless)
+        how = ray_worker_lost(err)
+        if how is not None:  # as a local worker's death: one line, and the same command resumes
+            raise WorkerLost([], how) from err
         raise
     finally:  # what finished is kept, whatever stopped the rest (each population was, as it finished)
         if kept is not None:

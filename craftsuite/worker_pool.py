@@ -12,6 +12,7 @@ from __future__ import annotations
 import multiprocessing as mp
 import multiprocessing.connection  # mp.connection.wait: which workers have ended
 import os
+import sys
 import threading
 import time
 from concurrent.futures import Future, ProcessPoolExecutor
@@ -101,6 +102,21 @@ def _check_reachable(address: str, timeout: float = 5.0) -> None:
 
 
 LOST_WAIT = 2.0  # seconds a broken pool waits for a worker to have ended
+
+
+def ray_worker_lost(err: BaseException) -> str | None:
+    """How a Ray worker was lost, where ``err`` is Ray's word that one was (its worker or node
+    died, or Ray's memory monitor killed it), else None. Ray, when used, is imported already:
+    an error of a Ray never imported is none of these."""
+    exceptions = sys.modules.get("ray.exceptions")
+    if exceptions is None:
+        return None
+    if isinstance(err, exceptions.OutOfMemoryError):
+        return ("a Ray worker was killed by Ray's memory monitor (out of memory): fewer seeds to a population "
+                "(--members) use less")
+    if isinstance(err, (exceptions.WorkerCrashedError, exceptions.NodeDiedError, exceptions.LocalRayletDiedError)):
+        return f"a Ray worker died ({type(err).__name__})"
+    return None
 
 
 class WorkerPool:

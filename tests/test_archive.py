@@ -315,6 +315,32 @@ def test_a_transfer_whose_worker_was_killed_keeps_what_finished_and_exits_as_a_k
     assert len(list((tmp_path / "results" / "standard" / "students").iterdir())) == 1
 
 
+@pytest.mark.parametrize("died, how", [
+    (("WorkerCrashedError",), "a Ray worker died (WorkerCrashedError)"),
+    (("OutOfMemoryError", "Task was killed due to the node running low on memory."),
+     "a Ray worker was killed by Ray's memory monitor (out of memory): fewer seeds to a population (--members) use "
+     "less"),
+])
+def test_a_transfer_whose_ray_worker_died_says_so_in_one_line(tmp_path, monkeypatch, capsys, died, how):
+    """On Ray a worker's death is Ray's own error, not a broken pool: the transfer says so as
+    it does a local worker's, in one line with the way on (no traceback), and exits 1."""
+    exceptions = pytest.importorskip("ray.exceptions")
+    import craftsuite.suite_runner as suite_runner
+
+    monkeypatch.setattr(suite_runner, "WorkerPool", _InProcessPool)
+
+    def a_worker_dies(configs, root, **kwargs):
+        raise getattr(exceptions, died[0])(*died[1:])
+
+    monkeypatch.setattr(suite_runner, "run_students", a_worker_dies)
+    monkeypatch.chdir(tmp_path)
+    status = main(["transfer", "--suite", "standard", "--worlds", "Grid10", "--tasks", "Reach", "--methods", "dqn",
+                   "--seeds", "1", "--no-video", "--out", "runs"])
+    assert status == 1
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"craftsuite transfer: error: {how}; the same command resumes the unfinished runs from their checkpoints"]
+
+
 def test_a_transfer_stopped_by_its_time_limit_keeps_what_finished_and_records_its_time(tmp_path, monkeypatch,
                                                                                         capsys):
     import time

@@ -369,7 +369,13 @@ class RunDir:
         """The run's complete checkpoints (each holding all ``files``), newest first:
         ``checkpoint-new`` (complete only when a kill came between its writing and the
         commit: each file is written whole), ``checkpoint`` and ``checkpoint-old``."""
-        return [d for d in (self.path / name for name in self.CHECKPOINTS) if all((d / f).exists() for f in files)]
+        return self.checkpoints_in(self.path, files)
+
+    @classmethod
+    def checkpoints_in(cls, path: Path, files) -> list[Path]:
+        """``checkpoint_dirs`` of the run directory at ``path``, read without its config
+        (a suite's driver looking at a member it does not own)."""
+        return [d for d in (Path(path) / name for name in cls.CHECKPOINTS) if all((d / f).exists() for f in files)]
 
     def last_checkpoint(self, files=("model.zip", "replay.pkl")) -> Path | None:
         """The directory of the run's last complete checkpoint, if any."""

@@ -136,8 +136,9 @@ def _norms(sequential: nn.Module, stacked: StackedMLP) -> list[nn.LayerNorm]:
 
 def hidden_widths(policy_kwargs: dict, algorithm: str, default) -> tuple[list[int], list[int]]:
     """The hidden layers' widths of SB3's ``net_arch`` (``default`` where not given): a list
-    of positive integers (not a tuple) for every network, or, for TD3, one for the actor and one for the
-    critics (``{"pi": [...], "qf": [...]}``). Returns (actor's or Q-network's, critics').
+    of positive integers (not a tuple) for every network, or, for TD3, one for the actor and
+    one for the critics (``{"pi": [...], "qf": [...]}``). Returns (actor's or Q-network's,
+    critics').
 
     Raises:
         ValueError: anything else; the message says what ``net_arch`` takes.

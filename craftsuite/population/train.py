@@ -351,9 +351,7 @@ def saved_steps(run: Path) -> dict[int, Path]:
     directory's for a step held twice: what a population resumes from (``_resume``: the newest
     step every member holds) and what a suite announces before it does."""
     found = {}
-    for folder in (run / name for name in RunDir.CHECKPOINTS):  # newest first
-        if not ((folder / CHECKPOINT).is_file() and (folder / STEP).is_file()):
-            continue
+    for folder in RunDir.checkpoints_in(run, (CHECKPOINT, STEP)):
         try:
             step = int(json.loads((folder / STEP).read_text())["num_timesteps"])
         except (OSError, ValueError, KeyError, TypeError):

@@ -73,14 +73,16 @@ class WorkerLost(Exception):
         return f"a worker process was killed by {name}"
 
 
-def _population_job(configs: list[dict], root: str, task: str | dict | None = None, device: str = "cpu") -> list[str]:
-    """The seeds of one cell in a worker process, as one population (``craftsuite.population``)."""
+def _population_job(configs: list[dict], root: str, task: str | dict | None = None, device: str = "cpu",
+                    check_memory: bool = True) -> list[str]:
+    """The seeds of one cell in a worker process, as one population (``craftsuite.population``;
+    ``check_memory`` False: the driver checked its replay's memory with the others')."""
     _start_worker(task)
     from .population import train_population
 
     with _quiet():
         return [str(p) for p in train_population([StudentConfig(**c) for c in configs], root, progress=False,
-                                                 device=device)]
+                                                 device=device, check_memory=check_memory)]
 
 
 def cells(configs: list[StudentConfig], members: int | None = None, finished=None) -> list[list[StudentConfig]]:
@@ -157,8 +159,11 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     teachers = teachers or {}
-    # what a population will train: the engine skips the members whose RunDir is finished
-    jobs = cells(configs, members, finished=lambda c: RunDir(root / c.run_name(), c).finished())
+
+    def done(c: StudentConfig) -> bool:  # what a population skips: the engine trains the unfinished only
+        return RunDir(root / c.run_name(), c).finished()
+
+    jobs = cells(configs, members, finished=done)
     waiting = {task: [job for job in jobs if job[0].task == task and METHODS[job[0].method].needs_table]
                for task in teachers}
     ready = [job for job in jobs if not (job[0].task in teachers and METHODS[job[0].method].needs_table)]
@@ -169,13 +174,18 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
         _announce(log, "teacher", [(Path(teacher_root) / t.run_name(), t.max_steps) for t in teachers.values()],
                   teacher_root)
     start = _announce(log, "student", [(run, c.steps) for c, run in runs], root)
+    if workers_.processes is not None:  # local: the populations training at once share this machine's memory
+        from .population.train import warn_if_replays_exceed_memory
+
+        unfinished = [[c for c in job if not done(c)] for job in jobs if job[0].engine == "population"]
+        warn_if_replays_exceed_memory([job for job in unfinished if job], workers_.processes)
     with progress_bar(total, f"{len(configs)} student runs", initial=sum(start.values()), enabled=progress) as bar:
         seen = {run: _stamp(run / "progress.json") for _, run in runs}  # a killed run's, until it writes anew
 
         def submit(job: list[StudentConfig]) -> Future:
             if job[0].engine == "population":
                 return workers_.submit(_population_job, [dataclasses.asdict(c) for c in job], str(root),
-                                       _carried(job[0].task), device)
+                                       _carried(job[0].task), device, workers_.processes is None)
             from .training import finished_sb3_run
 
             reused = Future()  # an sb3 run is reused, never trained: no worker

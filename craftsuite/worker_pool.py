@@ -127,6 +127,7 @@ class WorkerPool:
         self.ray, self.started, self._task = None, False, None
         self.lost: list[int] = []  # the signals that had killed local workers when the pool broke
         self._looked = False  # whether a break's workers have been looked at
+        self.processes = None  # local processes, all on this machine (None on Ray: a cluster's are not counted)
         if ray is not None:
             self.ray, self.started = connect_ray(ray)
             self._rows = external_rows()
@@ -135,7 +136,8 @@ class WorkerPool:
             context = mp.get_context("spawn")
             # the workers' pids, as each reports them: what an abort stops
             self._pids, self._reported, self._stopping = set(), context.SimpleQueue(), context.Event()
-            self.pool = ProcessPoolExecutor(workers or max(1, min(jobs, os.cpu_count() or 1)), mp_context=context,
+            self.processes = workers or max(1, min(jobs, os.cpu_count() or 1))
+            self.pool = ProcessPoolExecutor(self.processes, mp_context=context,
                                             initializer=_report_and_watch,
                                             initargs=(os.getpid(), self._reported, self._stopping,
                                                       external_rows()))

@@ -175,6 +175,8 @@ class _InProcessPool:
     """A worker pool that runs each job here, at once: a reused sb3 run needs no worker, and
     training, were any asked for, would hit the spies this process holds."""
 
+    processes = None  # no worker processes: each population checks its own memory
+
     def __init__(self, *args):
         self.jobs = []
 

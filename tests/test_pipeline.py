@@ -294,6 +294,8 @@ class _StaggeredPool:
     """Populations that "finish" one after another: the first at once, each next one a
     second later (its result.json written then), as workers of unequal cells do."""
 
+    processes = 1  # a local pool's: the populations at once
+
     def __init__(self):
         self.timers, self.aborted = [], False
 
@@ -343,6 +345,24 @@ def test_run_students_puts_the_seeds_still_to_train_in_one_population(tmp_path):
     pool.submit = lambda job, configs, *rest: jobs.append([c["seed"] for c in configs]) or submit(job, configs, *rest)
     run_students(configs, tmp_path, pool=pool, progress=False, members=2)
     assert jobs[0] == [3, 4]  # not seeds 2 and 3, then 4 alone
+
+
+def test_run_students_checks_the_memory_of_the_populations_at_once_and_not_again_in_each(tmp_path, monkeypatch):
+    from craftsuite.population import train as population_train
+
+    configs = [StudentConfig(method="dqn", world="Grid7", seed=s, steps=300) for s in range(5)]
+    for c in configs[:3]:  # finished already: their populations train nothing and hold no replay
+        (tmp_path / c.run_name()).mkdir()
+        (tmp_path / c.run_name() / "result.json").write_text("{}")
+    checked, pool, sent = [], _StaggeredPool(), []
+    pool.processes = 2
+    monkeypatch.setattr(population_train, "warn_if_replays_exceed_memory",
+                        lambda jobs, at_once: checked.append(([[c.seed for c in job] for job in jobs], at_once)))
+    submit = pool.submit
+    pool.submit = lambda job, configs, *rest: sent.append(rest[-1]) or submit(job, configs, *rest)
+    run_students(configs, tmp_path, pool=pool, progress=False, members=2)
+    assert checked == [([[3, 4]], 2)]  # the seeds still to train, as the pool's 2 processes run them
+    assert sent and set(sent) == {False}  # no worker's population warns a second time
 
 
 def test_a_deadline_stops_the_populations_still_training_and_says_how_many(tmp_path):

@@ -115,6 +115,8 @@ def test_a_resumed_population_counts_its_earlier_steps_as_done_before(killed, mo
 class _Pool:
     """Runs nothing: each population job "finishes" at once, as a worker that found its runs done."""
 
+    processes = None  # as a Ray cluster's: no memory of its own to check
+
     def __init__(self, root):
         self.root, self.closed, self.submitted = root, False, []
 

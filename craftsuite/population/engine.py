@@ -120,6 +120,22 @@ def sparse_width(spec, world_kind: str, product: bool) -> int | None:
     return 1 + len(spec.grid.obstacles) + sum(o.count for o in spec.objects) + len(spec.inventory) + int(product)
 
 
+def make_replay(method: str, settings: dict, members: int, n_envs: int, obs_dim: int, action_space, automaton,
+                completion_reward: float, sparse_width: int | None = None, seed: int = 0,
+                shaping: Shaping | None = None) -> PopulationReplay:
+    """The replay a population of ``members`` of ``method`` holds (its arrays take memory
+    only as transitions are written: made alone, it tells what a population will hold)."""
+    row = METHODS[method]
+    discrete = row.algorithm == "dqn"
+    action_shape, action_dtype = ((), np.int64) if discrete else ((int(action_space.shape[-1]),), np.float32)
+    crm = CounterfactualView(automaton, completion_reward, obs_dim) if row.crm else None
+    return PopulationReplay(members, int(settings["buffer_size"]), n_envs, obs_dim, action_shape, action_dtype,
+                            prioritized=bool(settings.get("prioritized", True)), crm=crm, seed=seed,
+                            sparse_width=sparse_width if discrete else None, n_steps=settings.get("n_steps", 1),
+                            gamma=float(settings["gamma"]), shaping=shaping,
+                            **(settings.get("replay_buffer_kwargs") or {}))
+
+
 class Population:
     """K members' learner, replay and exploration over one vector env of K x ``n_envs``.
 
@@ -150,17 +166,13 @@ class Population:
         if self.discrete:
             self.n_actions = int(action_space.n)
             self.learner = PopulationDQN(self.K, obs_dim, self.n_actions, settings, targets, device, planes)
-            action_shape, action_dtype = (), np.int64
             self.noises = []  # epsilon-greedy explores instead
         else:
             self.act_dim = int(action_space.shape[-1])
             self.learner = PopulationTD3(self.K, obs_dim, self.act_dim, settings, targets, device)
-            action_shape, action_dtype = (self.act_dim,), np.float32
             self.delay_schedule = delay_schedule(settings.get("delay_schedule"), settings.get("policy_delay"))
             spec = settings.get("action_noise")
             self.noises = [make_action_noise(spec, self.act_dim, seed, n_envs) if spec else None for seed in seeds]
-        buffer = settings.get("replay_buffer_kwargs") or {}
-        crm = CounterfactualView(automaton, completion_reward, obs_dim) if row.crm else None
         shaping = None
         if row.shaping is not None:
             if row.shaping == "dynamic" and table is None:
@@ -168,11 +180,8 @@ class Population:
             values = table if row.shaping == "dynamic" else static_distillation(automaton,
                                                                                completion_reward=completion_reward)
             shaping = Shaping(automaton, row.potential_sign * potential(values, automaton), float(settings["gamma"]))
-        self.replay = PopulationReplay(self.K, int(settings["buffer_size"]), n_envs, obs_dim, action_shape,
-                                       action_dtype, prioritized=bool(settings.get("prioritized", True)),
-                                       crm=crm, seed=seeds[0] + 1, sparse_width=sparse_width if self.discrete else None,
-                                       n_steps=settings.get("n_steps", 1), gamma=float(settings["gamma"]),
-                                       shaping=shaping, **buffer)
+        self.replay = make_replay(method, settings, self.K, n_envs, obs_dim, action_space, automaton,
+                                  completion_reward, sparse_width, seed=seeds[0] + 1, shaping=shaping)
         self.batch_size = int(settings["batch_size"])
         self.learning_starts = int(settings["learning_starts"])
         self.gradient_steps = int(settings.get("gradient_steps", 1))

@@ -30,7 +30,7 @@ from ..ids import world_kind
 from ..methods import METHODS
 from ..reached import Reached, check_automaton
 from ..runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, eval_seed, reached_target
-from .engine import EngineError, Population, check_supported, sparse_width
+from .engine import EngineError, Population, check_supported, make_replay, sparse_width
 from .envs import make_envs, observation_planes, step_records
 from .scalars import Scalars
 
@@ -70,13 +70,15 @@ def check_device(device: str) -> th.device:
 
 
 def train_population(configs: list[StudentConfig], root, progress: bool = True, device: str = "cpu",
-                     desc: str | None = None, on_evaluation=None) -> list[Path]:
+                     desc: str | None = None, on_evaluation=None, check_memory: bool = True) -> list[Path]:
     """Train every seed of one cell together; returns each config's run directory.
 
     ``on_evaluation(population, step, results)``, if given, is called after each
     evaluation (``results``: each member's (success, mean return, mean length), in seed
     order): the hook an experiment measures more with, as an SB3 callback would (the
-    population's members, their networks and replay, are ``population``'s)."""
+    population's members, their networks and replay, are ``population``'s).
+    ``check_memory``: warn where its replay at the budget exceeds the memory available
+    (False where the caller has checked it with the populations beside it)."""
     from ..agents import AutomatonQTable
     from ..task_registry import resolve_task
 
@@ -100,12 +102,13 @@ def train_population(configs: list[StudentConfig], root, progress: bool = True, 
         todo = [(c, r) for c, r in zip(configs, runs) if not r.finished()]
         if todo:
             _train(todo, settings, table, spec, dev, progress,
-                   desc or f"{config.method} {config.task} {config.world} x{len(todo)}", on_evaluation)
+                   desc or f"{config.method} {config.task} {config.world} x{len(todo)}", on_evaluation,
+                   check_memory=check_memory)
     return [root / n for n in names]
 
 
 def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=None, stop_at=None,
-           finish=None) -> None:
+           finish=None, check_memory: bool = True) -> None:
     """Train the ``todo`` (config, run) pairs together to their budget, or until every
     member's greedy success reaches ``stop_at`` (a teacher's target); then
     ``finish(pop, k, config, run, seconds)`` each member (a student's model and result by
@@ -124,7 +127,8 @@ def _train(todo, settings, table, spec, device, progress, desc, on_evaluation=No
         if device.type == "cpu":
             stack.enter_context(cpu_settings())
         pop = build_population(config, [c.seed for c in configs], settings, spec, table, device, envs)
-        warn_if_replay_exceeds_memory(pop)
+        if check_memory:
+            warn_if_replay_exceeds_memory(pop)
         earlier = _resume(pop, runs)
 
         def shares() -> list[float | None]:
@@ -160,12 +164,74 @@ def warn_if_replay_exceeds_memory(pop: Population, available: int | None = None)
     if available is None:
         available = _available_memory()
     rows = min(pop.replay.capacity, pop.total_steps)
-    needed = pop.replay.nbytes * rows // pop.replay.capacity
+    needed = held_at_budget(pop.replay, pop.total_steps)
     if available is not None and needed > available:
         warnings.warn(f"this population's replay will hold {needed / 2**30:.1f} GiB at its budget ({pop.K} members x "
                       f"{rows:,} transitions), more than the {available / 2**30:.1f} GiB this machine has "
                       "available: train fewer seeds a population (--members) or fewer populations at once "
                       "(--workers)", RuntimeWarning, stacklevel=2)
+
+
+def warn_if_replays_exceed_memory(jobs: list[list[StudentConfig]], at_once: int, available: int | None = None) -> None:
+    """Warn, before any of ``jobs`` (populations, each the configs it trains) starts, where
+    the ``at_once`` largest, training side by side, would hold more replay at their budgets
+    than the machine has available now (``available`` bytes; by default as
+    ``warn_if_replay_exceeds_memory`` reads it): each population alone may fit where they
+    together would be killed for memory hours in. The fixes it names fit at those sizes."""
+    if not jobs:
+        return
+    if available is None:
+        available = _available_memory()
+    if available is None:
+        return
+    cells = [json.dumps(job[0].cell(), sort_keys=True) for job in jobs]
+    member: dict[str, int] = {}  # one member's bytes, by cell (a population of K holds K times as much)
+    for cell, job in zip(cells, jobs):
+        if cell not in member:
+            member[cell] = member_replay_bytes(job[0])
+    sizes = sorted(((member[cell] * len(job), len(job)) for cell, job in zip(cells, jobs)), reverse=True)
+    running = sizes[:at_once]
+    needed = sum(size for size, _ in running)
+    if needed <= available:
+        return
+    largest = max(member.values())
+    fixes = []
+    members = available // (at_once * largest)  # with populations of that many, at_once of the largest fit
+    if 1 <= members < max(k for _, k in sizes):
+        fixes.append(f"fewer seeds a population (--members {members})")
+    fit = next((w for w in range(len(running) - 1, 0, -1) if sum(size for size, _ in running[:w]) <= available), 0)
+    if fit:
+        fixes.append(f"fewer populations at once (--workers {fit})")
+    if not fixes:
+        fixes.append("a smaller replay (buffer_size, in --dqn-hyper or --td3-hyper)")
+    together = (f"the {len(running)} largest populations, training at once, will hold {needed / 2**30:.1f} GiB of "
+                "replay at their budgets" if len(running) > 1 else
+                f"the largest population will hold {needed / 2**30:.1f} GiB of replay at its budget")
+    warnings.warn(f"{together} "
+                  f"({largest / 2**30:.2f} GiB a member at most), more than the {available / 2**30:.1f} GiB this "
+                  f"machine has available, and may be killed for memory hours in: train with "
+                  + " or ".join(fixes), RuntimeWarning, stacklevel=2)
+
+
+def member_replay_bytes(config: StudentConfig) -> int:
+    """The bytes one member of ``config``'s cell holds in its replay at its budget."""
+    from ..task_registry import resolve_task
+
+    spec = resolve_task(config.task)
+    envs = make_envs(config.env_id, 1, config.env_kwargs, config.product)
+    try:
+        replay = make_replay(config.method, config.effective()["hyperparameters"], 1, config.n_envs,
+                             envs.single_observation_space.shape[0], envs.single_action_space, spec.automaton,
+                             spec.completion_reward, sparse_width(spec, world_kind(config.world), config.product))
+    finally:
+        envs.close()
+    return held_at_budget(replay, config.steps)
+
+
+def held_at_budget(replay, steps: int) -> int:
+    """The bytes ``replay`` holds once each member has collected ``steps`` transitions (a
+    replay fills to its capacity, then overwrites)."""
+    return replay.nbytes * min(replay.capacity, steps) // replay.capacity
 
 
 def _available_memory(root: Path = Path("/")) -> int | None:

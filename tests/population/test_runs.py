@@ -385,6 +385,52 @@ def test_a_population_whose_full_replay_exceeds_the_available_memory_is_warned_o
         population_train.warn_if_replay_exceeds_memory(pop)  # not known: nothing said
 
 
+def test_populations_training_at_once_are_warned_of_where_together_they_exceed_the_memory(monkeypatch):
+    """Each population alone fits; side by side (a suite's --workers) they would not."""
+    member = {"Grid10": int(1.2 * 2**30), "Cont": int(0.6 * 2**30)}  # one member's replay at its budget, by world
+    monkeypatch.setattr(population_train, "member_replay_bytes", lambda c: member[c.world])
+    grid = [[StudentConfig(method="dqn", world="Grid10", seed=s) for s in range(10 * i, 10 * i + 10)] for i in (0, 1)]
+    cont = [[StudentConfig(method="td3", world="Cont", seed=s) for s in range(10)]]
+    with pytest.warns(RuntimeWarning) as said:
+        population_train.warn_if_replays_exceed_memory(cont + grid, 2, available=20 * 2**30)
+    [warning] = said
+    assert str(warning.message) == (
+        "the 2 largest populations, training at once, will hold 24.0 GiB of replay at their budgets (1.20 GiB a "
+        "member at most), more than the 20.0 GiB this machine has available, and may be killed for memory hours "
+        "in: train with fewer seeds a population (--members 8) or fewer populations at once (--workers 1)")
+    with pytest.warns(RuntimeWarning, match=r"^the largest population will hold 12\.0 GiB of replay at its budget "
+                                            r".* train with fewer seeds a population \(--members 8\)$"):
+        population_train.warn_if_replays_exceed_memory(grid, 1, available=10 * 2**30)
+    with pytest.warns(RuntimeWarning, match=r"train with a smaller replay \(buffer_size"):  # one member too many
+        population_train.warn_if_replays_exceed_memory(grid, 1, available=2**30)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        population_train.warn_if_replays_exceed_memory(cont + grid, 2, available=25 * 2**30)  # fits: nothing said
+        population_train.warn_if_replays_exceed_memory(cont + grid, 1, available=20 * 2**30)
+        population_train.warn_if_replays_exceed_memory([], 2, available=0)
+        monkeypatch.setattr(population_train, "_available_memory", lambda: None)
+        population_train.warn_if_replays_exceed_memory(cont + grid, 2)  # not known: nothing said
+
+
+@pytest.mark.parametrize("method, world, steps", [("td3-static", "Kinematic", 1_200), ("crm", "Grid7", 900)])
+def test_a_members_replay_is_told_before_its_population_is_built(method, world, steps):
+    """What the transfer's memory check reads per member is what each member of the built
+    population holds at the budget (a CRM replay's counterfactual rows and its sum trees too)."""
+    from craftsuite.population.envs import make_envs
+    from craftsuite.task_registry import resolve_task
+
+    configs = _cell(method=method, world=world, steps=steps, seeds=(0, 1, 2))
+    config, spec = configs[0], resolve_task(configs[0].task)
+    envs = make_envs(config.env_id, 3 * config.n_envs, config.env_kwargs, config.product)
+    try:
+        pop = population_train.build_population(config, [0, 1, 2], config.effective()["hyperparameters"], spec,
+                                                None, th.device("cpu"), envs)
+    finally:
+        envs.close()
+    held = population_train.held_at_budget(pop.replay, steps)
+    assert held > 0 and held == 3 * population_train.member_replay_bytes(config)
+
+
 def test_a_checkpoint_is_read_mapped_so_that_a_resume_holds_no_member_rows_twice(tmp_path):
     """A resume reads every member's state before copying its rows into the replay: read
     into memory, every member's rows would be held twice until then."""

@@ -741,7 +741,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "(default: all of them; the seeds still to train are grouped first, finished ones train "
                    "nothing); smaller populations finish sooner and more run at once, for many cores; "
                    "the processes sharing one GPU take turns on it, so there fewer, larger populations (e.g. 80) "
-                   "should use it better (experiments/fresh-seeds); a member's replay grows to 1.2-1.4 GiB by 1M "
+                   "should use it better (experiments/fresh-seeds); a member's replay grows to 1.1-1.4 GiB by 1M "
                    "transitions on Diamond Mine (less on smaller tasks), and a transfer warns before it trains "
                    "where the populations at once (--workers) would hold more than the memory available")
     p.add_argument("--ray", metavar="ADDRESS", help="run the students on Ray ('local' starts one here)")

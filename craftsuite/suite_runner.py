@@ -160,24 +160,26 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
     root.mkdir(parents=True, exist_ok=True)
     teachers = teachers or {}
 
-    def done(c: StudentConfig) -> bool:  # what a population skips: the engine trains the unfinished only
+    def trained_already(c: StudentConfig) -> bool:  # what a population skips: the engine trains the unfinished only
         return RunDir(root / c.run_name(), c).finished()
 
-    jobs = cells(configs, members, finished=done)
+    jobs = cells(configs, members, finished=trained_already)
     waiting = {task: [job for job in jobs if job[0].task == task and METHODS[job[0].method].needs_table]
                for task in teachers}
     ready = [job for job in jobs if not (job[0].task in teachers and METHODS[job[0].method].needs_table)]
     total = sum(c.steps for c in configs)
     workers_ = pool or WorkerPool(len(jobs) + len(teachers), workers, ray)
+    # local processes share this machine's memory: checked here for all at once, not again in each
+    checked_here = workers_.processes is not None
     runs = [(c, root / c.run_name()) for c in configs]  # named once: a name hashes the run's settings
     if teachers:
         _announce(log, "teacher", [(Path(teacher_root) / t.run_name(), t.max_steps) for t in teachers.values()],
                   teacher_root)
     start = _announce(log, "student", [(run, c.steps) for c, run in runs], root)
-    if workers_.processes is not None:  # local: the populations training at once share this machine's memory
+    if checked_here:
         from .population.train import warn_if_replays_exceed_memory
 
-        unfinished = [[c for c in job if not done(c)] for job in jobs if job[0].engine == "population"]
+        unfinished = [[c for c in job if not trained_already(c)] for job in jobs if job[0].engine == "population"]
         warn_if_replays_exceed_memory([job for job in unfinished if job], workers_.processes)
     with progress_bar(total, f"{len(configs)} student runs", initial=sum(start.values()), enabled=progress) as bar:
         seen = {run: _stamp(run / "progress.json") for _, run in runs}  # a killed run's, until it writes anew
@@ -185,7 +187,7 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
         def submit(job: list[StudentConfig]) -> Future:
             if job[0].engine == "population":
                 return workers_.submit(_population_job, [dataclasses.asdict(c) for c in job], str(root),
-                                       _carried(job[0].task), device, workers_.processes is None)
+                                       _carried(job[0].task), device, not checked_here)
             from .training import finished_sb3_run
 
             reused = Future()  # an sb3 run is reused, never trained: no worker

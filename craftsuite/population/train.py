@@ -177,7 +177,11 @@ def warn_if_replays_exceed_memory(jobs: list[list[StudentConfig]], at_once: int,
     the ``at_once`` largest, training side by side, would hold more replay at their budgets
     than the machine has available now (``available`` bytes; by default as
     ``warn_if_replay_exceeds_memory`` reads it): each population alone may fit where they
-    together would be killed for memory hours in. The fixes it names fit at those sizes."""
+    together would be killed for memory hours in. Replays only, the bulk of a long run's
+    memory: a process's networks and envs (a few hundred MB) and the teachers' replays (a
+    Grid7 budget's) are not counted. The fixes it names fit at those sizes; smaller
+    populations are more jobs, which a pool of one process a core would run more of at
+    once, so ``--members`` is named with the ``--workers`` it fits at."""
     if not jobs:
         return
     if available is None:
@@ -198,7 +202,7 @@ def warn_if_replays_exceed_memory(jobs: list[list[StudentConfig]], at_once: int,
     fixes = []
     members = available // (at_once * largest)  # with populations of that many, at_once of the largest fit
     if 1 <= members < max(k for _, k in sizes):
-        fixes.append(f"fewer seeds a population (--members {members})")
+        fixes.append(f"fewer seeds a population (--members {members} --workers {at_once})")
     fit = next((w for w in range(len(running) - 1, 0, -1) if sum(size for size, _ in running[:w]) <= available), 0)
     if fit:
         fixes.append(f"fewer populations at once (--workers {fit})")

@@ -397,9 +397,9 @@ def test_populations_training_at_once_are_warned_of_where_together_they_exceed_t
     assert str(warning.message) == (
         "the 2 largest populations, training at once, will hold 24.0 GiB of replay at their budgets (1.20 GiB a "
         "member at most), more than the 20.0 GiB this machine has available, and may be killed for memory hours "
-        "in: train with fewer seeds a population (--members 8) or fewer populations at once (--workers 1)")
+        "in: train with fewer seeds a population (--members 8 --workers 2) or fewer populations at once (--workers 1)")
     with pytest.warns(RuntimeWarning, match=r"^the largest population will hold 12\.0 GiB of replay at its budget "
-                                            r".* train with fewer seeds a population \(--members 8\)$"):
+                                            r".* train with fewer seeds a population \(--members 8 --workers 1\)$"):
         population_train.warn_if_replays_exceed_memory(grid, 1, available=10 * 2**30)
     with pytest.warns(RuntimeWarning, match=r"train with a smaller replay \(buffer_size"):  # one member too many
         population_train.warn_if_replays_exceed_memory(grid, 1, available=2**30)

@@ -173,9 +173,9 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
     checked_here = workers_.processes is not None
     runs = [(c, root / c.run_name()) for c in configs]  # named once: a name hashes the run's settings
     if teachers:
-        _announce(log, "teacher", [(Path(teacher_root) / t.run_name(), t.max_steps) for t in teachers.values()],
+        _announce(log, "teacher", [[(Path(teacher_root) / t.run_name(), t.max_steps)] for t in teachers.values()],
                   teacher_root)
-    start = _announce(log, "student", [(run, c.steps) for c, run in runs], root)
+    start = _announce(log, "student", [[(root / c.run_name(), c.steps) for c in job] for job in jobs], root)
     if checked_here:
         from .population.train import warn_if_replays_exceed_memory
 
@@ -267,25 +267,25 @@ def _job_runs(result) -> list:
     return result if isinstance(result, list) else [result]
 
 
-def _announce(log, kind: str, runs: list[tuple[Path, int]], root) -> dict[Path, int]:
-    """Say, each on a line of its own, how many of ``runs`` (directories, each with its
-    budget) are finished already (reused) and which resume from a checkpoint (and from
-    which step); return the steps each of those had done before this session."""
-    done = {run: budget for run, budget in runs if (run / "result.json").exists()}
-    resumed = {run: step for run, _ in runs if run not in done and (step := checkpoint_step(run)) is not None}
+def _announce(log, kind: str, populations: list[list[tuple[Path, int]]], root) -> dict[Path, int]:
+    """Say, each on a line of its own, how many of the runs of ``populations`` (each its
+    members' directories, each with its budget) are finished already (reused) and which
+    resume from a checkpoint (and from which step: the newest their population's unfinished
+    members all hold); return the steps each of those had done before this session."""
+    from .population.train import saved_steps, shared_steps
+
+    done, resumed = {}, {}
+    for members in populations:
+        done.update({run: budget for run, budget in members if (run / "result.json").exists()})
+        todo = [run for run, _ in members if run not in done]
+        step = max(shared_steps([saved_steps(run) for run in todo]), default=None)
+        if step is not None:
+            resumed.update(dict.fromkeys(todo, step))
     if done:
         log(f"reused {len(done)} finished {kind} run{'s' * (len(done) > 1)} from {root}")
     for run, step in resumed.items():
         log(f"resuming {run.name} from step {step:,} (its checkpoint)")
     return {**done, **resumed}
-
-
-def checkpoint_step(run: Path) -> int | None:
-    """The newest step a killed population member has a complete checkpoint of (None: it has
-    none); its population resumes from the newest step every member holds."""
-    from .population.train import saved_steps
-
-    return max(saved_steps(run), default=None)
 
 
 def _stamp(path: Path) -> int | None:

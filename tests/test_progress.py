@@ -3,6 +3,7 @@ announced on lines of their own."""
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import json
 from concurrent.futures import Future
@@ -81,16 +82,16 @@ def test_a_message_gets_a_line_of_its_own(capsys):
 def killed(tmp_path, monkeypatch):
     """``CONFIG``'s population run killed after its checkpoint at 300, the one before at 200,
     the newer set aside: it resumes from 200."""
-    from craftsuite.suite_runner import checkpoint_step
+    from craftsuite.population.train import saved_steps
 
     monkeypatch.setattr(RunDir, "write_result", lambda self, result: (_ for _ in ()).throw(KeyboardInterrupt))
     with pytest.raises(KeyboardInterrupt):
         train_student(CONFIG, tmp_path, progress=False)
     monkeypatch.undo()
     run = tmp_path / CONFIG.run_name()
-    assert checkpoint_step(run) == 300
+    assert max(saved_steps(run)) == 300
     (run / "checkpoint").rename(run / "checkpoint-aside")
-    assert checkpoint_step(run) == 200
+    assert max(saved_steps(run)) == 200
     return run
 
 
@@ -153,6 +154,29 @@ def test_the_suites_bar_announces_reuse_and_resume_and_starts_past_them(killed, 
                     f"resuming {CONFIG.run_name()} from step 200 (its checkpoint)"]
     assert made == [(600, 500)] and pool.closed  # 300 reused and 200 resumed: done before this session
     assert pool.submitted == [CONFIG.run_name()]  # the finished sb3 run is reused without a worker
+
+
+def test_a_suite_announces_the_step_a_population_resumes_from_not_a_members_newest(killed, monkeypatch):
+    """A kill between two members' commits: one member holds a newer checkpoint than the
+    other, and the population resumes from the newest step both hold."""
+    import shutil
+
+    import craftsuite.suite_runner as suite_runner
+
+    root = killed.parent
+    ahead = dataclasses.replace(CONFIG, seed=1)  # the same cell: one population with CONFIG's run
+    shutil.copytree(killed, root / ahead.run_name())
+    (root / ahead.run_name() / "checkpoint-aside").rename(root / ahead.run_name() / "checkpoint")  # 300 and 200
+    made = []
+    real = suite_runner.progress_bar
+    monkeypatch.setattr(suite_runner, "progress_bar",
+                        lambda total, desc, initial=0, enabled=True: made.append((total, initial))
+                        or real(total, desc, initial=initial, enabled=enabled, stream=io.StringIO()))
+    said, pool = [], _Pool(root)
+    suite_runner.run_students([CONFIG, ahead], root, pool=pool, log=said.append)
+    assert said == [f"resuming {CONFIG.run_name()} from step 200 (its checkpoint)",
+                    f"resuming {ahead.run_name()} from step 200 (its checkpoint)"]  # not 300
+    assert made == [(600, 400)] and pool.submitted == [CONFIG.run_name(), ahead.run_name()]
 
 
 def test_a_workers_prints_never_reach_the_drivers_bar(capsys):

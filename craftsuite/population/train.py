@@ -430,6 +430,13 @@ def saved_steps(run: Path) -> dict[int, Path]:
     return found
 
 
+def shared_steps(found: list[dict[int, Path]]) -> set[int]:
+    """The steps a population can resume from: those every member (``found``: each one's
+    ``saved_steps``) holds a complete checkpoint of. Members differ after a kill between two
+    of their commits, the newest step of one then not the population's."""
+    return set(found[0]).intersection(*found[1:]) if found else set()
+
+
 def _saved_share(checkpoint: Path) -> float | None:
     """A member's share of the wall time since step 0 that its checkpoint's ``step.json``
     records (time after a session's last checkpoint is not in it); None where it records
@@ -458,7 +465,7 @@ def _resume(pop: Population, runs) -> list[float | None]:
         for run in runs:
             run.trim_logs(0)
         return [0.0] * len(runs)
-    common = set(found[0]).intersection(*found[1:])
+    common = shared_steps(found)
     if not common:
         raise CheckpointError(
             f"the population of {', '.join(str(r.path) for r in runs)} cannot resume: its members' checkpoints "

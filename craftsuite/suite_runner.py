@@ -40,14 +40,15 @@ from .worker_pool import WorkerPool, ray_worker_lost
 
 class TimeLimitReached(Exception):
     """A transfer's time limit passed with runs still training: they were stopped, each to
-    resume from its newest checkpoint when asked for again, and the finished ones are kept."""
+    resume from its population's newest checkpoint when asked for again, and the finished
+    ones are kept."""
 
 
 class WorkerLost(Exception):
     """A transfer's worker died while it trained (a local process killed by a signal: most
     often the kernel's out-of-memory killer, whose SIGKILL no process can catch; or a Ray
     worker, ``how`` saying what Ray said): the rest were stopped, each run resumes from its
-    newest checkpoint when asked for again, and the finished ones are kept. ``status`` is a
+    population's newest checkpoint when asked for again, and the finished ones are kept. ``status`` is a
     shell's for a process that signal killed (128 + its number: 137 for SIGKILL), so that a
     campaign's part takes the transfer up again as it would one killed itself; 1 where no
     signal is known."""
@@ -171,7 +172,7 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
     workers_ = pool or WorkerPool(len(jobs) + len(teachers), workers, ray)
     # local processes share this machine's memory: checked here for all at once, not again in each
     checked_here = workers_.processes is not None
-    runs = [(c, root / c.run_name()) for c in configs]  # named once: a name hashes the run's settings
+    runs = [(c, root / c.run_name()) for c in configs]  # each run's directory: its name hashes its settings
     if teachers:
         _announce(log, "teacher", [[(Path(teacher_root) / t.run_name(), t.max_steps)] for t in teachers.values()],
                   teacher_root)
@@ -247,8 +248,8 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                         teaching = f" and {len(pending)} teacher{'s' * (len(pending) > 1)}" if pending else ""
                         raise TimeLimitReached(
                             f"time limit reached with {len(left)} of {len(configs)} student runs unfinished"
-                            f"{teaching}: those training were stopped, and each resumes from its newest checkpoint "
-                            "when the same command runs again")
+                            f"{teaching}: those training were stopped, and each resumes from its population's "
+                            "newest checkpoint when the same command runs again")
             check_populations()  # those that finished after the loop's last look
             paths = {}
             for job, future in futures.values():
@@ -271,7 +272,8 @@ def _announce(log, kind: str, populations: list[list[tuple[Path, int]]], root) -
     """Say, each on a line of its own, how many of the runs of ``populations`` (each its
     members' directories, each with its budget) are finished already (reused) and which
     resume from a checkpoint (and from which step: the newest their population's unfinished
-    members all hold); return the steps each of those had done before this session."""
+    members all hold); return the step each of those starts this session from (a finished
+    run's: its budget)."""
     from .population.train import saved_steps, shared_steps
 
     done, resumed = {}, {}

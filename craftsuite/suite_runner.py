@@ -48,10 +48,10 @@ class WorkerLost(Exception):
     """A transfer's worker died while it trained (a local process killed by a signal: most
     often the kernel's out-of-memory killer, whose SIGKILL no process can catch; or a Ray
     worker, ``how`` saying what Ray said): the rest were stopped, each run resumes from its
-    population's newest checkpoint when asked for again, and the finished ones are kept. ``status`` is a
-    shell's for a process that signal killed (128 + its number: 137 for SIGKILL), so that a
-    campaign's part takes the transfer up again as it would one killed itself; 1 where no
-    signal is known."""
+    population's newest checkpoint when asked for again, and the finished ones are kept.
+    ``status`` is a shell's for a process that signal killed (128 + its number: 137 for
+    SIGKILL), so that a campaign's part takes the transfer up again as it would one killed
+    itself; 1 where no signal is known."""
 
     def __init__(self, signals: list[int], how: str | None = None):
         self.signals = signals

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
@@ -212,8 +213,6 @@ def _video(args) -> int:
 
 
 def _json_object(text: str | None, flag: str = "--hyper") -> dict:
-    import json
-
     if not text:
         return {}
     try:
@@ -244,6 +243,7 @@ def _hyper(text: str | None, algorithm: str, flag: str = "--hyper") -> dict:
 def _teacher(args) -> int:
     from .configs import TeacherConfig
     from .files import directory_to_write
+    from .runs import teacher_outcome
     from .training import train_teacher
 
     directory_to_write(args.out, "--out")
@@ -253,8 +253,14 @@ def _teacher(args) -> int:
                            eval_every=args.eval_every, eval_episodes=args.eval_episodes,
                            hyperparameters=_hyper(args.hyper, "dqn"), n_envs=args.n_envs, engine=args.engine)
     path = train_teacher(config, args.out, device=args.device)
-    print((path / "result.json").read_text().strip())
-    print(f"teacher run: {path}\n  teacher: {path / 'teacher.zip'}\n  dynamic table: {path / 'table.npz'}")
+    text = (path / "result.json").read_text()
+    print(text.strip())
+    result = json.loads(text)
+    print(f"teacher run: {path}: {teacher_outcome(result, config.target_success)}")
+    if not result["reached_target"]:
+        print(f"  its table distils what it learned so far; for a teacher at its target give it more than "
+              f"--max-steps {config.max_steps:,}")
+    print(f"  teacher: {path / 'teacher.zip'}\n  dynamic table: {path / 'table.npz'}")
     return 0
 
 
@@ -339,17 +345,18 @@ def _unread(args, why: str) -> None:
 
 
 def _write_table(table, automaton, args) -> int:
-    table.save(args.out)
-    print(table.describe(automaton))
-    print(f"wrote {args.out}")
-    if args.draw:
+    if args.draw:  # drawn first: a failed drawing leaves no table behind either
         from .automata import write_image
 
         values = table.edge_values(automaton)
         unseen = {e for e in automaton.edges() if e not in values}
-        path = write_image(automaton, args.draw, title=f"{table.kind} distillation: {automaton.formula}",
-                           edge_notes={e: f"{v:.1f}" for e, v in values.items()}, dotted=unseen)
-        print(f"drew {path}")
+        drawn = write_image(automaton, args.draw, title=f"{table.kind} distillation: {automaton.formula}",
+                            edge_notes={e: f"{v:.1f}" for e, v in values.items()}, dotted=unseen)
+    table.save(args.out)
+    print(table.describe(automaton))
+    print(f"wrote {args.out}")
+    if args.draw:
+        print(f"drew {drawn}")
     return 0
 
 

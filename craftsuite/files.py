@@ -41,9 +41,11 @@ def _fsync(path: Path) -> None:
 @contextlib.contextmanager
 def atomic_path(path) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; once the block ends without an error, the
-    file written there replaces ``path``. On an error ``path`` is left as it was and the
-    temporary file is removed."""
+    file written there replaces ``path``. Its folders are made where missing. On an error
+    ``path`` is left as it was, the temporary file is removed, and so are the folders made
+    for it while they are empty."""
     path = Path(path)
+    made = [p for p in reversed(path.parents) if not p.exists()]  # outermost first
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = _temporary(path)
     try:
@@ -52,6 +54,12 @@ def atomic_path(path) -> Iterator[Path]:
             raise FileNotFoundError(f"nothing was written to {tmp} (the temporary file for {path})")
         _fsync(tmp)
         os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        for folder in reversed(made):  # innermost first; one another writer has filled stays
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+        raise
     finally:
         tmp.unlink(missing_ok=True)
 

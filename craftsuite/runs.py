@@ -434,6 +434,13 @@ def reached_target(run, target: float) -> bool:
     return bool(evals) and float(evals[-1]["success"]) >= target
 
 
+def teacher_outcome(result: dict, target: float) -> str:
+    """A finished teacher's ``result.json`` in words, its target said whichever way it went:
+    ``"2,000 steps, greedy success 0.68 (did NOT reach 90%)"``."""
+    reached = "reached" if result["reached_target"] else "did NOT reach"
+    return f"{result['steps']:,} steps, greedy success {result['success']:.2f} ({reached} {target:.0%})"
+
+
 def read_csv(path, fields: tuple[str, ...] = (), required: bool = False) -> list[dict]:
     """A run's CSV log as rows (none if it is missing); ``<name>.gz`` beside a missing
     ``<name>`` is read instead (the results archive keeps ``episodes.csv`` compressed).

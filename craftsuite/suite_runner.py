@@ -32,7 +32,7 @@ from .files import atomic_write
 from .ids import file_stem
 from .methods import METHODS, methods_for
 from .progress import progress_bar
-from .runs import RunDir, read_result
+from .runs import RunDir, read_result, teacher_outcome
 from .suites import Suite
 from .task_registry import carried, resolve_task
 from .worker_pool import WorkerPool, ray_worker_lost
@@ -234,11 +234,8 @@ def run_students(configs: list[StudentConfig], root, workers: int | None = None,
                     path = Path(future.result())  # re-raises a teacher's error
                     if finished is not None:
                         finished("teachers", [path])
-                    result = read_result(path)
-                    reached = "reached" if result["reached_target"] else "did NOT reach"
-                    (bar.write if progress else log)(
-                        f"teacher {task}: {result['steps']:,} steps, greedy success {result['success']:.2f} "
-                        f"({reached} {teachers[task].target_success:.0%}) -> {path}")
+                    outcome = teacher_outcome(read_result(path), teachers[task].target_success)
+                    (bar.write if progress else log)(f"teacher {task}: {outcome} -> {path}")
                     for job in waiting.pop(task):
                         futures[id(job)] = (job, submit(job))
                 check_populations()

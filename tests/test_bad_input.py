@@ -374,3 +374,34 @@ def test_transfer_refuses_ray_out_of_reach_before_writing_anything(tmp_path, cap
         assert _refused(tmp_path, capsys, *base, "--ray", address) == (
             f"--ray {address}: no Ray cluster could be joined there (ConnectionError: Failed to connect to Ray "
             f"cluster at {address}); give the address of a running head node, or --ray local")
+
+
+def test_a_drawing_makes_its_folders_and_a_failed_one_leaves_nothing(tmp_path, capsys, monkeypatch):
+    """A drawing goes where it is asked, folders made as the other commands make them (the
+    render wrote to a folder that was not there and failed on it); a render that fails, or a
+    Graphviz that is missing, leaves no drawing and no table behind."""
+    import craftsuite.automata.draw as draw
+
+    assert main(["automaton", "FirstTool", "--out", str(tmp_path / "new" / "deeper" / "a.dot")]) == 0
+    assert "digraph" in (tmp_path / "new" / "deeper" / "a.dot").read_text()
+    assert main(["distill", "FirstTool", "--static", "--out", str(tmp_path / "t.npz"),
+                 "--draw", str(tmp_path / "drawn" / "v.dot")]) == 0
+    assert (tmp_path / "t.npz").is_file() and "digraph" in (tmp_path / "drawn" / "v.dot").read_text()
+    capsys.readouterr()
+    failing = tmp_path / "bin" / "dot"  # a Graphviz that writes half a file and fails
+    failing.parent.mkdir()
+    failing.write_text("#!/bin/sh\nfor a; do out=$a; done\necho half > \"$out\"\necho 'Error: no layout' >&2\n"
+                       "exit 1\n")
+    failing.chmod(0o755)
+    monkeypatch.setattr(draw, "_dot", lambda: str(failing))
+    before = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*"))
+    assert main(["distill", "FirstTool", "--static", "--out", str(tmp_path / "t2.npz"),
+                 "--draw", str(tmp_path / "out" / "v.png")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"craftsuite distill: error: dot failed on {tmp_path / 'out' / 'v.png'}: Error: no layout")
+    monkeypatch.setattr(draw, "_dot", lambda: None)
+    assert main(["automaton", "FirstTool", "--out", str(tmp_path / "a.png")]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"craftsuite automaton: error: cannot draw {tmp_path / 'a.png'}: Graphviz 'dot' is not installed "
+                   "(Debian: apt-get install graphviz); write a .dot file instead\n")
+    assert sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*")) == before

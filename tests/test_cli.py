@@ -277,3 +277,28 @@ def test_transfer_hands_members_to_the_populations(tmp_path, monkeypatch):
         main(["transfer", "--suite", "quick", "--tasks", "Reach", "--methods", "td3", "--seeds", "3",
               "--members", "2", "--workers", "1", "--no-archive", "--no-video", "--out", str(tmp_path / "out")])
     assert seen["members"] == 2 and seen["jobs"] == [2, 1]
+
+
+@pytest.mark.parametrize("success", [0.68, 0.95])
+def test_teacher_says_whether_it_reached_its_target(tmp_path, capsys, monkeypatch, success):
+    """The teacher command says on its own line whether the teacher reached its target (it
+    said so only inside the JSON), and what to do where it did not: as a suite says it."""
+    import json
+
+    import craftsuite.training as training
+
+    def trained(config, out, device="cpu"):
+        run = tmp_path / "teacher-Reach-Grid7-s0"
+        run.mkdir()
+        (run / "result.json").write_text(json.dumps({"steps": 2000, "success": success,
+                                                     "reached_target": success >= config.target_success}))
+        return run
+
+    monkeypatch.setattr(training, "train_teacher", trained)
+    assert main(["teacher", "Reach", "--max-steps", "2000", "--out", str(tmp_path)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    reached = "reached" if success >= 0.9 else "did NOT reach"
+    assert lines[1] == f"teacher run: {tmp_path / 'teacher-Reach-Grid7-s0'}: 2,000 steps, greedy success " \
+                       f"{success:.2f} ({reached} 90%)"
+    hint = "  its table distils what it learned so far; for a teacher at its target give it more than --max-steps 2,000"
+    assert (hint in lines) == (success < 0.9)

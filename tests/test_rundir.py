@@ -107,6 +107,23 @@ def test_atomic_write_takes_bytes_and_keeps_the_old_file_when_a_writer_fails(tmp
     assert path.read_bytes() == b"\x00old"
 
 
+def test_a_failed_atomic_write_removes_the_folders_made_for_it_while_empty(tmp_path):
+    """A writer that fails leaves none of the folders made for its file; a folder that held
+    something before, or was filled meanwhile, stays."""
+    from craftsuite.files import atomic_path
+
+    (tmp_path / "kept").mkdir()
+    with pytest.raises(RuntimeError), atomic_path(tmp_path / "kept" / "new" / "deeper" / "a.png") as tmp:
+        tmp.write_bytes(b"half")
+        raise RuntimeError("dot failed")
+    assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*")) == ["kept"]
+    with pytest.raises(RuntimeError), atomic_path(tmp_path / "kept" / "new" / "deeper" / "a.png"):
+        (tmp_path / "kept" / "new" / "other.txt").write_text("another writer's")
+        raise RuntimeError("dot failed")
+    assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*")) == ["kept", "kept/new",
+                                                                                         "kept/new/other.txt"]
+
+
 def test_atomic_path_keeps_the_suffix_writers_add_when_it_is_missing(tmp_path):
     import numpy as np
 

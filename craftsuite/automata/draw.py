@@ -13,6 +13,7 @@ import shutil
 import subprocess
 from pathlib import Path
 
+from ..files import atomic_path
 from .dfa import Automaton
 
 
@@ -73,26 +74,27 @@ def image_format(path) -> str:
     fmt = Path(path).suffix.lstrip(".").lower()
     if fmt not in ("png", "svg", "pdf", "dot", "gv"):
         raise ValueError(f"cannot draw to {str(path)!r}: use a .png, .svg, .pdf or .dot file")
+    if fmt not in ("dot", "gv") and _dot() is None:
+        raise RuntimeError(f"cannot draw {path}: Graphviz 'dot' is not installed (Debian: apt-get install "
+                           "graphviz); write a .dot file instead")
     return fmt
 
 
+def _dot() -> str | None:
+    return shutil.which("dot")
+
+
 def write_image(automaton: Automaton, path, **dot_options) -> Path:
-    """Render to PNG, SVG or PDF (by the file suffix) with Graphviz ``dot``; ``.dot`` writes text."""
+    """Render to PNG, SVG or PDF (by the file suffix) with Graphviz ``dot``; ``.dot`` writes
+    text. Its folders are made where missing; a failed render leaves no file."""
     path = Path(path)
     fmt = image_format(path)
     text = to_dot(automaton, **dot_options)
-    if fmt in ("dot", "gv"):
-        path.write_text(text)
-        return path
-    dot = shutil.which("dot")
-    if dot is None:
-        raise RuntimeError(
-            "Graphviz 'dot' is not installed (Debian: apt-get install graphviz); "
-            "write a .dot file instead"
-        )
-    result = subprocess.run(
-        [dot, f"-T{fmt}", "-o", str(path)], input=text.encode(), capture_output=True
-    )
-    if result.returncode != 0:
-        raise RuntimeError(f"dot failed on {path}: {result.stderr.decode().strip()}")
+    with atomic_path(path) as tmp:
+        if fmt in ("dot", "gv"):
+            tmp.write_text(text)
+        else:
+            result = subprocess.run([_dot(), f"-T{fmt}", "-o", str(tmp)], input=text.encode(), capture_output=True)
+            if result.returncode != 0:
+                raise RuntimeError(f"dot failed on {path}: {result.stderr.decode().strip()}")
     return path

@@ -29,6 +29,7 @@ at it through a callback that returns ``not env.done``.
 from __future__ import annotations
 
 import operator
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -128,6 +129,24 @@ class Recorder(gym.Wrapper):
     def __init__(self, env_id: str, out, *, method: str, seed: int = 0, suite: str = "standard",
                  library: str = "", settings: dict | None = None, commit: str | None = None,
                  product: bool = False, steps: int | None = None):
+        """Open the recording of one run (``out/<run name>``, which must not exist yet).
+
+        Args:
+            env_id: the rung, as a CraftSuite id (``CraftSuite/ToolHome-Cont-v0``).
+            out: the directory of the user's runs (the leaderboard reads it).
+            method: the user's own name for what trained it (not one of CraftSuite's rows).
+            seed: the run's seed (each seed is one run).
+            suite: the suite whose protocol (budget, schedule, world settings) it follows.
+            library: what trained it, e.g. ``"stable-baselines3 2.4 SAC"``: part of the record.
+            settings: the learner's settings, recorded as given (part of the run's key).
+            commit: the user's code's commit.
+            product: whether the env's observation carries the automaton state.
+            steps: another budget than the suite's for the rung, on the suite's schedule for it.
+
+        Raises:
+            ValueError: bad settings (see ``recorded_config``), each named with its fix.
+            RunError: the run being recorded in this process already, or recorded before.
+        """
         from .reached import Reached
         from .task_registry import resolve_task
 
@@ -196,6 +215,12 @@ class Recorder(gym.Wrapper):
         return min(self.budget, (done // self.config.eval_every + 1) * self.config.eval_every)
 
     @property
+    def scheduled(self) -> list[int]:
+        """The steps of the suite's evaluations of this run: every ``eval_every`` transitions
+        and at the budget."""
+        return [*range(self.config.eval_every, self.budget, self.config.eval_every), self.budget]
+
+    @property
     def evaluation_due(self) -> bool:
         return self.transitions >= self.next_evaluation and self.next_evaluation not in self.evaluated
 
@@ -247,6 +272,11 @@ class Recorder(gym.Wrapper):
             raise ValueError(f"updates must be the count of gradient updates made (an integer >= 0), got {updates!r}")
         if self.budget not in self.evaluated:  # the last evaluation, at the budget
             self.evaluate(policy)
+        skipped = sorted(set(self.scheduled) - set(self.evaluated))
+        if skipped:  # said now, while the loop can still be mended, not first on a board
+            warnings.warn(f"{self.path}: {len(skipped)} of the suite's {len(self.scheduled)} evaluations were not made "
+                          f"(the first at step {skipped[0]:,}): the leaderboard reads this run's AUC as not measured; "
+                          "call evaluate(policy) whenever evaluation_due says so", stacklevel=2)
         self._flush()
         self.run.write_result({"kind": "student", "env_id": self.config.env_id, "method": self.config.method,
                                "task": self.config.task, "seed": self.config.seed, "steps": self.transitions,

@@ -91,7 +91,8 @@ def test_a_step_past_the_budget_is_refused_and_the_run_still_finishes_at_it(tmp_
     _random_loop(env, np.random.default_rng(0), evaluate=False)
     with pytest.raises(RuntimeError, match="the budget's 50 transitions are collected: stop stepping when done"):
         env.step(0)
-    path = env.finish(lambda obs: 0, updates=0)
+    with pytest.warns(UserWarning, match="12 of the suite's 13 evaluations were not made"):  # evaluate=False
+        path = env.finish(lambda obs: 0, updates=0)
     assert json.loads((path / "result.json").read_text())["steps"] == 50
     assert sum(int(r["length"]) for r in read_csv(path / "episodes.csv")) <= 50
 
@@ -176,7 +177,10 @@ def test_a_budget_off_the_schedule_is_evaluated_at_the_budget_once(tmp_path):
 def test_a_run_that_skipped_scheduled_evaluations_has_no_auc(tmp_path):
     env = craftsuite.Recorder(ENV, tmp_path, method="my-lazy", steps=1_000)
     _random_loop(env, np.random.default_rng(0), evaluate=False)
-    env.finish(lambda obs: 0, updates=0)  # only the last evaluation
+    assert env.scheduled == [*range(50, 1_000, 50), 1_000]
+    with pytest.warns(UserWarning, match=r"19 of the suite's 20 evaluations were not made \(the first at step 50\): "
+                                         "the leaderboard reads this run's AUC as not measured"):
+        env.finish(lambda obs: 0, updates=0)  # only the last evaluation
     (entry,) = build(tmp_path)
     assert np.isnan(entry.values["auc"][0]) and np.isfinite(entry.values["success"][0])
 

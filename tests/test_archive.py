@@ -376,3 +376,33 @@ def test_a_transfer_stopped_by_its_time_limit_keeps_what_finished_and_records_it
     with pytest.raises(SystemExit):
         main(["transfer", "--suite", "quick", "--time-limit", "0"])
     assert "--time-limit: must be a number above 0, got 0" in capsys.readouterr().err
+
+
+def test_a_leaderboard_drawn_over_an_archive_directory_leaves_git_clean(tmp_path, capsys):
+    """`craftsuite leaderboard results/standard` writes its board beside the archive's records,
+    as over any directory of runs; git ignores every file it writes there (it showed them as
+    new files in the repository), and none of the records."""
+    import shutil
+    import subprocess
+    from pathlib import Path
+
+    from .reporting.fakes import fake_run
+
+    root = Path(__file__).resolve().parents[1]
+    if shutil.which("git") is None or not (root / ".git").exists():
+        pytest.skip("not a git checkout")
+    for method in ("td3", "td3-dynamic"):
+        fake_run(tmp_path / "runs" / "students", method, 0, [(500, 0.5), (1000, 1.0)], [(995, 1.0, 1)])
+    assert main(["leaderboard", str(tmp_path / "runs")]) == 0
+    capsys.readouterr()
+    written = sorted(p.name for p in (tmp_path / "runs").iterdir() if p.is_file())
+    assert "leaderboard.md" in written and any(name.endswith(".png") for name in written)
+
+    def ignored(path: str) -> bool:
+        return subprocess.run(["git", "-C", str(root), "check-ignore", "-q", "--no-index", path]).returncode == 0
+
+    for archive_dir in ("results/standard", "results/n-step-returns/standard"):
+        assert [n for n in written if not ignored(f"{archive_dir}/{n}")] == []
+        records = ["suite.json", "provenance.json", "looks.json", "students/run/evals.csv",
+                   "students/run/episodes.csv.gz", "teachers/run/table.npz"]
+        assert [r for r in records if ignored(f"{archive_dir}/{r}")] == []

@@ -520,6 +520,11 @@ def _leaderboard(args) -> int:
             raise ValueError(f"--methods {method}: name a row of your own as module:name (CraftSuite's rows are "
                              "known already)")
         resolve_method(method)
+    narrowed = args.tasks is not None or args.worlds is not None
+    if narrowed and (args.page or args.reproduction):
+        raise ValueError("--tasks and --worlds narrow a leaderboard; a page (--page, --reproduction) shows every run "
+                         "of its directories: leave them out")
+    tasks = None if args.tasks is None else {_task(t, "the worlds with --worlds") for t in args.tasks}
     if args.reproduction:
         if args.page or args.out or len(args.runs) > 1:
             raise ValueError("--reproduction writes one page from one transfer directory: give one RUNS, "
@@ -543,8 +548,15 @@ def _leaderboard(args) -> int:
         directory_to_write(args.out, "--out")
     # several directories are one board: a user's runs beside the archive's, on the same rungs;
     # one directory of a suite sets its runs at budgets the suite no longer asks for apart
-    runs = [read_runs(d, suite_cells=len(args.runs) == 1) for d in args.runs]
-    board = runs[0].board if len(runs) == 1 else build(*(r.students for r in runs))
+    def keep(config: dict) -> bool:  # a run's config read alone: the logs of the others are never read
+        return (tasks is None or config.get("task") in tasks) and (args.worlds is None
+                                                                   or config.get("world") in args.worlds)
+
+    only = " of " + " ".join(f"{flag} {' '.join(values)}" for flag, values in (("--tasks", args.tasks),
+                                                                             ("--worlds", args.worlds)) if values)
+    runs = [read_runs(d, suite_cells=len(args.runs) == 1, keep=keep if narrowed else None,
+                      only=only if narrowed else "") for d in args.runs]
+    board = runs[0].board if len(runs) == 1 else build(*(r.students for r in runs), keep=keep if narrowed else None)
     out = Path(args.out or runs[0].path)
     curves = draw_curves(board)  # drawn before the leaderboard is written: a failure leaves no part of it
     path = write_leaderboard(board, out)
@@ -788,6 +800,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--methods", nargs="+", metavar="MODULE:ROW", help="method rows of your own that runs were "
                    "trained with (as transfer's --methods my_module:my-row): read as the methods they are "
                    "(compared with scratch where distilled, described in the legend)")
+    p.add_argument("--tasks", nargs="+", metavar="TASK", help=f"the runs of these tasks alone (the others' logs are "
+                   f"not read: a board of one rung over an archive in seconds), each {task_help}")
+    p.add_argument("--worlds", nargs="+", choices=_known_worlds(), help="the runs in these worlds alone")
     p.set_defaults(run=_leaderboard)
 
     p = sub.add_parser("video", help="record rollouts of a policy as an MP4 (any world of a task)")

@@ -65,11 +65,13 @@ def superseded(suite, students: Path):
     return test
 
 
-def read_runs(path, *, transfer: bool = False, suite_cells: bool = False) -> RunsDirectory:
+def read_runs(path, *, transfer: bool = False, suite_cells: bool = False, keep=None, only: str = "") -> RunsDirectory:
     """The runs under ``path``; ``transfer``: ``path`` must be a transfer output (with ``students/``);
     ``suite_cells``: in the directory of a suite of this version (``RunsDirectory.name``), its
     runs at budgets the suite no longer asks for, beside runs at the budget it does, are set
-    apart (``superseded``, ``Board.apart``).
+    apart (``superseded``, ``Board.apart``). ``keep``: a test of a run's ``config.json``, as
+    ``board.build``'s (the runs it holds false for are not read further); ``only``: those runs
+    in words, for the message where none is left (e.g. `` of --tasks Reach``).
 
     Raises:
         FileNotFoundError: no such directory.
@@ -87,13 +89,14 @@ def read_runs(path, *, transfer: bool = False, suite_cells: bool = False) -> Run
         raise FileNotFoundError(f"no run directory at {path}")
     suite = suite_json(path)
     asked = SUITES.get(_name(suite, path)) if suite_cells else None
-    board = build(students, apart=None if asked is None else superseded(asked, students))
+    board = build(students, apart=None if asked is None else superseded(asked, students), keep=keep)
     unfinished = len(board.unfinished) + (len(board.apart.unfinished) if board.apart else 0)
     if not board.entries and not (board.apart and board.apart.entries):
-        raise ValueError(f"no finished student runs under {students}"
+        raise ValueError(f"no finished student runs{only} under {students}"
                          + (f" ({unfinished} unfinished)" if unfinished else "")
                          + "".join(f"; not read: {reason}" for reason in board.unreadable))
-    looks.check([*board.entries, *(board.apart.entries if board.apart else [])])
+    if keep is None:  # a narrowed board holds some of the cells looks.json names: the whole directory checks it
+        looks.check([*board.entries, *(board.apart.entries if board.apart else [])])
     return RunsDirectory(path, students, board, suite, read(path))
 
 

@@ -43,3 +43,33 @@ def test_sessions_read_to_the_day_or_to_the_minute():
         "- `craftsuite transfer quick`: 2026-01-02 03:04 UTC, commit unknown, 1.5 min on Linux")
     assert session_line({**session, "seconds": None}, to_the_minute=False) == (
         "- `craftsuite transfer quick`: 2026-01-02, commit unknown, did not finish on Linux")
+
+
+def test_a_leaderboard_narrowed_to_tasks_and_worlds_reads_their_runs_alone(tmp_path, capsys):
+    """--tasks and --worlds make the board of those rungs alone, the others' logs never read
+    (a user's rung beside an archive took minutes: every run's logs were read); a filter
+    that leaves no run, or one beside --page, is refused in one line and writes nothing."""
+    runs = tmp_path / "runs"
+    for task, world in (("Reach", "Grid10"), ("Reach", "Cont"), ("FirstWood", "Cont")):
+        method = "dqn" if world == "Grid10" else "td3"
+        fake_run(runs, method, 0, [(500, 0.5), (1000, 1.0)], [(995, 1.0, 1)], task=task, world=world)
+    (runs / "student-FirstWood-Cont-td3-s0" / "evals.csv").write_text("damaged\n")  # never read when left out
+    assert main(["leaderboard", str(runs), "--tasks", "Reach", "--worlds", "Cont", "--out", str(tmp_path / "b")]) == 0
+    board = (tmp_path / "b" / "leaderboard.md").read_text()
+    assert "## Reach (Cont)" in board and "Grid10" not in board and "FirstWood" not in board
+    assert "Not read" not in capsys.readouterr().out  # the damaged run was left out unread
+    refused = {
+        ("--tasks", "FirstTool"): f"craftsuite leaderboard: error: no finished student runs of --tasks FirstTool under "
+                                  f"{runs}\n",
+        ("--tasks", "Reach", "--worlds", "Kinematic"):
+            f"craftsuite leaderboard: error: no finished student runs of --tasks Reach --worlds Kinematic under "
+            f"{runs}\n",
+        ("--worlds", "Cont", "--page", str(tmp_path / "p.md")):
+            "craftsuite leaderboard: error: --tasks and --worlds narrow a leaderboard; a page (--page, --reproduction) "
+            "shows every run of its directories: leave them out\n",
+    }
+    for flags, message in refused.items():
+        assert main(["leaderboard", str(runs), *flags, "--out", str(tmp_path / "c")]) == 2 if "--page" not in flags \
+            else main(["leaderboard", str(runs), *flags]) == 2
+        assert capsys.readouterr().err == message
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["b", "runs"]

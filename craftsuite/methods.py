@@ -130,7 +130,9 @@ class Method:
 _ROWS = {m.name: m for m in (
     Method("dqn", "Grid", "dqn", False, description="DQN without the automaton state"),
     Method("product-dqn", "Grid", "dqn", True, description="DQN over the product MDP (also the teacher)"),
-    Method("crm", "Grid", "dqn", True, crm=True, description="product DQN with counterfactual experiences"),
+    Method("crm", "Grid", "dqn", True, crm=True,
+           description="product DQN with counterfactual experiences (where the automaton has one live state "
+                       "there is none to add, and its runs are product-dqn's, seed for seed)"),
     Method("static", "Grid", "dqn", True, "static", description="DQN student, statically distilled automaton"),
     Method("dynamic", "Grid", "dqn", True, "dynamic",
            description="DQN student, teacher distilled into the automaton (the paper's method)"),

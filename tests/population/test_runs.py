@@ -471,3 +471,19 @@ def test_a_resumed_population_keeps_no_checkpoint_mapped(tmp_path, monkeypatch):
     monkeypatch.setattr(population_train, "_evaluate", looks)
     train_population(configs, tmp_path, progress=False)
     assert mapped and all(lines == [] for lines in mapped)
+
+
+@pytest.mark.parametrize("task, same", [("Reach", True), ("FirstTool", False)])
+def test_crm_trains_as_the_product_dqn_where_the_automaton_has_one_live_state(tmp_path, task, same):
+    """CRM adds a counterfactual experience for each other live automaton state: on a rung
+    whose automaton has one (Reach), there is none, and its runs are product-dqn's seed for
+    seed (the methods' legend says so; a reader took the equal rows for a bug); with more
+    (FirstTool), they are not."""
+    from craftsuite.task_registry import resolve_task
+
+    automaton = resolve_task(task).automaton
+    assert (int((~(automaton.accepting | automaton.rejecting)).sum()) == 1) == same  # CRM's live states
+    runs = {m: train_population(_cell(m, "Grid10", task, seeds=(0,), steps=800), tmp_path / m, progress=False)
+            for m in ("crm", "product-dqn")}
+    (crm,), (product,) = runs["crm"], runs["product-dqn"]
+    assert ((crm / "episodes.csv").read_text() == (product / "episodes.csv").read_text()) == same

@@ -639,20 +639,26 @@ def build_parser() -> argparse.ArgumentParser:
     engine_help = (f"what trains the run: {DEFAULT_ENGINE} (default; the population engine, here a population of "
                    "one); sb3 (one SB3 agent per run, as CraftSuite trained before) only reuses a finished run")
 
-    parser = argparse.ArgumentParser(prog="craftsuite", description=__doc__, formatter_class=_HelpFormatter)
+    parser = argparse.ArgumentParser(prog="craftsuite", formatter_class=_HelpFormatter,
+                                     description="CraftSuite's command line: craftsuite COMMAND --help explains each "
+                                                 "command.")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument("--debug", action="store_true", help=DEBUG_HELP)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_CommandParser)
+
+    def command(name: str, help: str) -> argparse.ArgumentParser:  # its line in the list, atop its own --help too
+        return sub.add_parser(name, help=help, description=help[0].upper() + help[1:].replace("%%", "%") + ".")
+
     methods = ", ".join(METHODS)
     names = ", ".join(s.name for s in ladder())
     task_help = f"a task: {names}; or a task spec file (path/to/task{SPEC_SUFFIX}), registered for this command"
     worlds = ", ".join(_known_worlds())
 
-    p = sub.add_parser("records", help="the run record format (config, result, evaluations, episodes)")
+    p = command("records", "the run record format (config, result, evaluations, episodes)")
     p.add_argument("--markdown", metavar="PATH", help="write it as a docs page to PATH, e.g. docs/records.md")
     p.set_defaults(run=_records)
 
-    p = sub.add_parser("tasks", help="list the tasks (the ladder's rungs, easiest first), formulas, automata, ids")
+    p = command("tasks", "list the tasks (the ladder's rungs, easiest first), formulas, automata, ids")
     p.add_argument("--tag", nargs="+", default=(), help="only the tasks with any of these tags: "
                    + ", ".join(sorted({t for spec in ladder() for t in spec.tags})))
     p.add_argument("--markdown", metavar="PATH", help="write the tasks page (specs, automata, scripted and random "
@@ -661,21 +667,21 @@ def build_parser() -> argparse.ArgumentParser:
                    help="episodes per id for the references of --markdown (default: 100)")
     p.set_defaults(run=_tasks)
 
-    p = sub.add_parser("automaton", help="draw or print a task's automaton")
+    p = command("automaton", "draw or print a task's automaton")
     p.add_argument("task", help=task_help)
     p.add_argument("--out", help="image file (.png, .svg, .pdf or .dot)")
     p.add_argument("--describe", action="store_true", help="print states and guarded transitions")
     p.add_argument("--show-sink", action="store_true", help="also draw the rejecting sink")
     p.set_defaults(run=_automaton)
 
-    p = sub.add_parser("scripted", help="roll out the scripted policy on every id; write pictures")
+    p = command("scripted", "roll out the scripted policy on every id; write pictures")
     p.add_argument("--out", default="out/scripted", help="output directory (default: out/scripted)")
     p.add_argument("--task", help=f"only this task (default: all): {task_help}")
     p.add_argument("--episodes", type=_positive, default=10, help="episodes per id (default: 10)")
     p.add_argument("--seed", type=_seed, default=0, help="first seed (default: 0)")
     p.set_defaults(run=_scripted)
 
-    p = sub.add_parser("teacher", help="train a grid DQN teacher until 90%% greedy success; distil it")
+    p = command("teacher", "train a grid DQN teacher until 90%% greedy success; distil it")
     p.add_argument("task", help=task_help)
     p.add_argument("--out", default="runs/teachers", help="runs directory (default: runs/teachers)")
     p.add_argument("--size", type=int, default=7, help="grid size (default: 7)")
@@ -692,7 +698,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--device", default="cpu", help="the population engine's torch device: cpu (default) or cuda")
     p.set_defaults(run=_teacher)
 
-    p = sub.add_parser("distill", help="distil a teacher (dynamic) or a task's automaton (static) into a table")
+    p = command("distill", "distil a teacher (dynamic) or a task's automaton (static) into a table")
     p.add_argument("source", help="a teacher run directory or teacher .zip (dynamic), or a task name (--static)")
     p.add_argument("--out", required=True, help="the table to write (.npz)")
     p.add_argument("--static", action="store_true", help="value iteration over the automaton alone")
@@ -702,7 +708,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--draw", help="also draw the values on the automaton (.png/.svg/.dot; unseen edges dotted)")
     p.set_defaults(run=_distill)
 
-    p = sub.add_parser("student", help="train one student or baseline run (any method, one seed)")
+    p = command("student", "train one student or baseline run (any method, one seed)")
     p.add_argument("task", help=task_help)
     p.add_argument("--method", default="td3-dynamic", metavar="METHOD",
                    help=f"one of {methods} (craftsuite.methods.METHODS; default: td3-dynamic), or module:name, a "
@@ -730,7 +736,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--device", default="cpu", help="the population engine's torch device: cpu (default) or cuda")
     p.set_defaults(run=_student)
 
-    p = sub.add_parser("transfer", help="a suite end to end: teacher, distillation, students, leaderboard, video")
+    p = command("transfer", "a suite end to end: teacher, distillation, students, leaderboard, video")
     p.add_argument("--suite", default="quick", help="; ".join(f"{n}: {s.description}" for n, s in SUITES.items()))
     p.add_argument("--out", help="output directory (default: runs/<suite>, so suites never share one)")
     p.add_argument("--tags", nargs="+", help="override the suite's rungs: the tasks with any of these tags: "
@@ -781,14 +787,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--device", help="the population engine's torch device: cpu (default) or cuda")
     p.set_defaults(run=_transfer)
 
-    p = sub.add_parser("archive", help="keep finished runs' records in the results archive (results/<suite>)")
+    p = command("archive", "keep finished runs' records in the results archive (results/<suite>)")
     p.add_argument("runs", nargs="+", help="transfer output directories, or directories of student runs")
     p.add_argument("--suite", required=True, help="the suite they are runs of: they are kept in its archive (a run "
                    "of a task, world or method it does not run is skipped, named)")
     p.add_argument("--archive", default="results", help="the archive (default: results)")
     p.set_defaults(run=_archive)
 
-    p = sub.add_parser("leaderboard", help="leaderboard (Markdown, CSV) and learning curves from run directories")
+    p = command("leaderboard", "leaderboard (Markdown, CSV) and learning curves from run directories")
     p.add_argument("runs", nargs="+", help="a transfer output directory, or a directory of student runs; several "
                    "are one leaderboard (e.g. your runs from craftsuite.Recorder beside results/standard), or, with "
                    "--page, a section each")
@@ -805,7 +811,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--worlds", nargs="+", choices=_known_worlds(), help="the runs in these worlds alone")
     p.set_defaults(run=_leaderboard)
 
-    p = sub.add_parser("video", help="record rollouts of a policy as an MP4 (any world of a task)")
+    p = command("video", "record rollouts of a policy as an MP4 (any world of a task)")
     p.add_argument("target", metavar="TASK_OR_ID", help=f"{task_help}, in --world; or a registered id, e.g. "
                    "CraftSuite/BlindCraftsman-Cont-v0")
     p.add_argument("--world", type=_world, help="the task's world: Cont (default), Kinematic or Grid<size>")

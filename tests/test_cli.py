@@ -49,6 +49,10 @@ def test_help_explains_commands(capsys):
     out = capsys.readouterr().out
     for command in ("tasks", "automaton", "scripted"):
         assert command in out
+    assert "``" not in out  # plain text, not the docstring's markup
+    with pytest.raises(SystemExit):  # a command's own help says what it does, as the list does
+        main(["teacher", "--help"])
+    assert "\nTrain a grid DQN teacher until 90% greedy success; distil it.\n" in capsys.readouterr().out
 
 
 def test_video_loads_craftsuite_agents(tmp_path, capsys):

@@ -176,7 +176,12 @@ def markdown() -> str:
              "`craftsuite leaderboard` reads any directory of them and refuses a record that breaks this format, "
              "naming the file, the field and the problem. The archive keeps `episodes.csv` gzipped "
              "(`episodes.csv.gz`). A run directory's name is `student-<task>-<world>-<method>-s<seed>-<key>`, the key "
-             "a hash of its settings: two runs of equal settings are one run.", ""]
+             "a hash of its settings: two runs of equal settings are one run. A trainer's run directory holds "
+             "more beside them, never read as the record: `.lock` (the advisory lock that keeps two live writers "
+             "out, kept once the run is finished: a lock file deleted while another process opens it would let "
+             "two in), the model (`model.zip`) and, where its trainer writes them, checkpoints and TensorBoard logs; "
+             "the archive keeps the four files "
+             "alone (and a teacher's distilled `table.npz`).", ""]
     for name, fields in FILES.items():
         kind = "columns" if name.endswith(".csv") else "fields"
         lines += [f"## `{name}`", "", f"| {kind[:-1]} | takes | required | meaning |", "|---|---|---|---|"]

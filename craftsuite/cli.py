@@ -243,7 +243,7 @@ def _hyper(text: str | None, algorithm: str, flag: str = "--hyper") -> dict:
 def _teacher(args) -> int:
     from .configs import TeacherConfig
     from .files import directory_to_write
-    from .runs import teacher_outcome
+    from .runs import read_result, teacher_outcome
     from .training import train_teacher
 
     directory_to_write(args.out, "--out")
@@ -253,9 +253,8 @@ def _teacher(args) -> int:
                            eval_every=args.eval_every, eval_episodes=args.eval_episodes,
                            hyperparameters=_hyper(args.hyper, "dqn"), n_envs=args.n_envs, engine=args.engine)
     path = train_teacher(config, args.out, device=args.device)
-    text = (path / "result.json").read_text()
-    print(text.strip())
-    result = json.loads(text)
+    print((path / "result.json").read_text().strip())
+    result = read_result(path)
     print(f"teacher run: {path}: {teacher_outcome(result, config.target_success)}")
     if not result["reached_target"]:
         print(f"  its table distils what it learned so far; for a teacher at its target give it more than "
@@ -544,6 +543,8 @@ def _leaderboard(args) -> int:
         return 0
     if len(args.runs) > 1 and not args.out:  # never written into one of them (an archive, maybe)
         raise ValueError("several run directories are one leaderboard: give --out DIR for it")
+    if narrowed and not args.out:  # never over the directory's own board of every run
+        raise ValueError("--tasks and --worlds make a board of some of the runs: give --out DIR for it")
     if args.out:
         directory_to_write(args.out, "--out")
     # several directories are one board: a user's runs beside the archive's, on the same rungs;
@@ -554,9 +555,14 @@ def _leaderboard(args) -> int:
 
     only = " of " + " ".join(f"{flag} {' '.join(values)}" for flag, values in (("--tasks", args.tasks),
                                                                              ("--worlds", args.worlds)) if values)
+    # narrowed, one of several directories may hold none of those runs (an archive without the
+    # user's rung): the board they make together must hold some
     runs = [read_runs(d, suite_cells=len(args.runs) == 1, keep=keep if narrowed else None,
-                      only=only if narrowed else "") for d in args.runs]
+                      only=only if narrowed else "", required=not narrowed or len(args.runs) == 1)
+            for d in args.runs]
     board = runs[0].board if len(runs) == 1 else build(*(r.students for r in runs), keep=keep if narrowed else None)
+    if narrowed and len(runs) > 1 and not board.entries:
+        raise ValueError(f"no finished student runs{only} under {', '.join(str(r.students) for r in runs)}")
     out = Path(args.out or runs[0].path)
     curves = draw_curves(board)  # drawn before the leaderboard is written: a failure leaves no part of it
     path = write_leaderboard(board, out)

@@ -38,14 +38,33 @@ def _fsync(path: Path) -> None:
         os.fsync(f.fileno())
 
 
+def missing_folders(path) -> list[Path]:
+    """The folders at and above ``path`` that do not exist yet, innermost first: those a
+    writer about to make ``path`` would make (and may remove again, ``remove_empty``)."""
+    path = Path(path)
+    return [d for d in (path, *path.parents) if not d.exists()]
+
+
+def remove_empty(folders: list[Path]) -> None:
+    """Remove ``folders`` (innermost first) while each is empty: one that holds something,
+    arrived meanwhile, stops it with the folders above it kept."""
+    try:
+        for folder in folders:
+            folder.rmdir()
+    except OSError:
+        pass
+
+
 @contextlib.contextmanager
 def atomic_path(path) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; once the block ends without an error, the
     file written there replaces ``path``. Its folders are made where missing. On an error
     ``path`` is left as it was, the temporary file is removed, and so are the folders made
-    for it while they are empty."""
+    for it while they are empty (a writer that makes the same new folder at the same moment
+    may find it gone: no caller writes into a new folder from two processes but the
+    automaton cache, which takes a failed write as a miss)."""
     path = Path(path)
-    made = [p for p in reversed(path.parents) if not p.exists()]  # outermost first
+    made = missing_folders(path.parent)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = _temporary(path)
     try:
@@ -56,9 +75,7 @@ def atomic_path(path) -> Iterator[Path]:
         os.replace(tmp, path)
     except BaseException:
         tmp.unlink(missing_ok=True)
-        for folder in reversed(made):  # innermost first; one another writer has filled stays
-            with contextlib.suppress(OSError):
-                folder.rmdir()
+        remove_empty(made)
         raise
     finally:
         tmp.unlink(missing_ok=True)

@@ -179,7 +179,8 @@ def markdown() -> str:
              "a hash of its settings: two runs of equal settings are one run. A trainer's run directory holds "
              "more beside them, never read as the record: `.lock` (the advisory lock that keeps two live writers "
              "out, kept once the run is finished: a lock file deleted while another process opens it would let "
-             "two in), the model (`model.zip`) and, where its trainer writes them, checkpoints and TensorBoard logs; "
+             "two in), `progress.json` (how far a run got), the model (`model.zip`, a teacher's `teacher.zip`) and, "
+             "where its trainer writes them, checkpoints and TensorBoard logs; "
              "the archive keeps the four files "
              "alone (and a teacher's distilled `table.npz`).", ""]
     for name, fields in FILES.items():

@@ -38,7 +38,7 @@ import numpy as np
 
 from .ids import env_id
 from .envs.grid import layout_kwargs
-from .runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, RunError, config_key
+from .runs import EPISODE_FIELDS, EVAL_FIELDS, RunDir, RunError, config_key, evaluation_steps
 
 
 @dataclass(frozen=True)
@@ -218,7 +218,7 @@ class Recorder(gym.Wrapper):
     def scheduled(self) -> list[int]:
         """The steps of the suite's evaluations of this run: every ``eval_every`` transitions
         and at the budget."""
-        return [*range(self.config.eval_every, self.budget, self.config.eval_every), self.budget]
+        return evaluation_steps(self.budget, self.config.eval_every)
 
     @property
     def evaluation_due(self) -> bool:

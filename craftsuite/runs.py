@@ -47,7 +47,7 @@ import shutil
 import socket
 from pathlib import Path
 
-from .files import atomic_write
+from .files import atomic_write, missing_folders, remove_empty
 
 EPISODE_FIELDS = ("step", "return", "length", "success", "seen", "states")
 # the columns every episodes.csv has: records made before ``seen`` and ``states`` have only
@@ -223,6 +223,12 @@ def run_settings(record: dict) -> dict:
 EVAL_SEED = 10**7  # far from training's seeds (the run's seed and its envs' next ones)
 
 
+def evaluation_steps(steps: int, every: int) -> list[int]:
+    """The steps of a run's scheduled evaluations: every ``every`` transitions, and at its
+    budget ``steps`` (a multiple of ``every`` or not), once."""
+    return [*range(every, steps, every), steps]
+
+
 def eval_seed(step: int) -> int:
     """The first episode seed of a run's evaluation at ``step`` (its episodes play the next
     ones), the same rule for every kind of run and engine; evaluations fewer than
@@ -256,8 +262,7 @@ class RunDir:
     # -- ownership -------------------------------------------------------------------------------
     def __enter__(self) -> RunDir:
         self._created = not self.path.exists()
-        # the folders this run makes, its own and any missing above it (a new --out)
-        self._made = [d for d in (self.path, *self.path.parents) if not d.exists()]
+        self._made = missing_folders(self.path)  # its own and any missing above it (a new --out)
         self.path.mkdir(parents=True, exist_ok=True)
         self._acquire()
         try:
@@ -308,11 +313,7 @@ class RunDir:
         if {p.name for p in self.path.iterdir()} <= {"config.json", ".lock"}:
             for name in ("config.json", ".lock"):
                 (self.path / name).unlink(missing_ok=True)
-            try:
-                for made in self._made:  # innermost first; one that is not empty stops it
-                    made.rmdir()
-            except OSError:  # something arrived meanwhile: leave it
-                pass
+            remove_empty(self._made)
 
     def _acquire(self) -> None:
         # An advisory lock held on an open file: the kernel drops it when its owner dies, so a

@@ -43,7 +43,8 @@ def test_scripted_writes_pictures(tmp_path, capsys):
     assert picture.shape[0] == 32 * 10 + PANEL_HEIGHT  # start and end pictures show the status panel
 
 
-def test_help_explains_commands(capsys):
+def test_help_explains_commands(capsys, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "200")  # argparse wraps to the terminal's width
     with pytest.raises(SystemExit):
         main(["--help"])
     out = capsys.readouterr().out
@@ -294,7 +295,7 @@ def test_teacher_says_whether_it_reached_its_target(tmp_path, capsys, monkeypatc
     def trained(config, out, device="cpu"):
         run = tmp_path / "teacher-Reach-Grid7-s0"
         run.mkdir()
-        (run / "result.json").write_text(json.dumps({"steps": 2000, "success": success,
+        (run / "result.json").write_text(json.dumps({"kind": "teacher", "steps": 2000, "success": success,
                                                      "reached_target": success >= config.target_success}))
         return run
 

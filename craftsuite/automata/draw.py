@@ -70,6 +70,7 @@ def image_format(path) -> str:
 
     Raises:
         ValueError: a suffix it cannot draw, naming the path and the ones it can.
+        RuntimeError: a format Graphviz draws, where its ``dot`` is not installed.
     """
     fmt = Path(path).suffix.lstrip(".").lower()
     if fmt not in ("png", "svg", "pdf", "dot", "gv"):

@@ -42,7 +42,7 @@ from .. import stats
 from ..completion import needs_reread
 from ..progress import progress_bar
 from ..record_format import RecordError, check_config, check_episodes, check_evals, check_result
-from ..runs import RunError, flatten, read_config, read_log, read_result, run_settings
+from ..runs import RunError, evaluation_steps, flatten, read_config, read_log, read_result, run_settings
 
 # metrics with a mean and an interval per task and method; a rate lies in [0, 1]
 METRICS = {"success": (0.0, 1.0), "return": (-math.inf, math.inf), "train_success": (0.0, 1.0),
@@ -153,8 +153,7 @@ def run_metrics(run: Path) -> dict | None:
     every, regime = config.get("eval_every"), regime_of(config)
     if regime == SELF_REPORTED and isinstance(every, int) and every > 0:
         # its loop chose when to evaluate: a curve short of the suite's schedule has no comparable area
-        schedule = {*range(every, budget, every), budget}
-        if not schedule <= {step for step, _, _ in evals}:
+        if not set(evaluation_steps(budget, every)) <= {step for step, _, _ in evals}:
             auc = float("nan")
     tail = [e for e in episodes if e[0] > 0.9 * budget]
     if not tail and episodes:  # fewer episodes than the window: the last one

@@ -65,19 +65,21 @@ def superseded(suite, students: Path):
     return test
 
 
-def read_runs(path, *, transfer: bool = False, suite_cells: bool = False, keep=None, only: str = "") -> RunsDirectory:
+def read_runs(path, *, transfer: bool = False, suite_cells: bool = False, keep=None, only: str = "",
+              required: bool = True) -> RunsDirectory:
     """The runs under ``path``; ``transfer``: ``path`` must be a transfer output (with ``students/``);
     ``suite_cells``: in the directory of a suite of this version (``RunsDirectory.name``), its
     runs at budgets the suite no longer asks for, beside runs at the budget it does, are set
     apart (``superseded``, ``Board.apart``). ``keep``: a test of a run's ``config.json``, as
     ``board.build``'s (the runs it holds false for are not read further); ``only``: those runs
-    in words, for the message where none is left (e.g. `` of --tasks Reach``).
+    in words, for the message where none is left (e.g. `` of --tasks Reach``); ``required``:
+    whether a directory with no finished (kept) run is refused (one of several need not be).
 
     Raises:
         FileNotFoundError: no such directory.
-        ValueError: no finished student run in it, with the unfinished counted and each
-            damaged record named; or a damaged ``suite.json``, ``provenance.json`` or
-            ``looks.json`` (``looks.check``).
+        ValueError: no finished student run in it (where ``required``), with the unfinished
+            counted and each damaged record named; or a damaged ``suite.json``,
+            ``provenance.json`` or ``looks.json`` (``looks.check``: not checked with ``keep``).
     """
     from ..provenance import read
 
@@ -91,7 +93,7 @@ def read_runs(path, *, transfer: bool = False, suite_cells: bool = False, keep=N
     asked = SUITES.get(_name(suite, path)) if suite_cells else None
     board = build(students, apart=None if asked is None else superseded(asked, students), keep=keep)
     unfinished = len(board.unfinished) + (len(board.apart.unfinished) if board.apart else 0)
-    if not board.entries and not (board.apart and board.apart.entries):
+    if required and not board.entries and not (board.apart and board.apart.entries):
         raise ValueError(f"no finished student runs{only} under {students}"
                          + (f" ({unfinished} unfinished)" if unfinished else "")
                          + "".join(f"; not read: {reason}" for reason in board.unreadable))

@@ -68,8 +68,17 @@ def test_a_leaderboard_narrowed_to_tasks_and_worlds_reads_their_runs_alone(tmp_p
             "craftsuite leaderboard: error: --tasks and --worlds narrow a leaderboard; a page (--page, --reproduction) "
             "shows every run of its directories: leave them out\n",
     }
+    refused[("--tasks", "Reach")] = ("craftsuite leaderboard: error: --tasks and --worlds make a board of some of "
+                                     "the runs: give --out DIR for it\n")  # not over the directory's own board
     for flags, message in refused.items():
-        assert main(["leaderboard", str(runs), *flags, "--out", str(tmp_path / "c")]) == 2 if "--page" not in flags \
-            else main(["leaderboard", str(runs), *flags]) == 2
+        out = [] if "--page" in flags or flags == ("--tasks", "Reach") else ["--out", str(tmp_path / "c")]
+        assert main(["leaderboard", str(runs), *flags, *out]) == 2
         assert capsys.readouterr().err == message
     assert sorted(p.name for p in tmp_path.iterdir()) == ["b", "runs"]
+    # beside a directory that holds the rung, one that holds none of it is no error
+    mine = tmp_path / "mine"
+    fake_run(mine, "my-agent", 0, [(500, 0.5), (1000, 1.0)], [(995, 1.0, 1)], task="FirstWood", world="Cont")
+    assert main(["leaderboard", str(mine), str(runs), "--tasks", "Reach", "--out", str(tmp_path / "d")]) == 0
+    assert main(["leaderboard", str(mine), str(runs), "--tasks", "FirstTool", "--out", str(tmp_path / "e")]) == 2
+    assert capsys.readouterr().err.endswith(f"error: no finished student runs of --tasks FirstTool under {mine}, "
+                                            f"{runs}\n")

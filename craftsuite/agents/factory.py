@@ -137,7 +137,10 @@ def recorded_algorithm(path) -> str | None:
 def load_agent(path, env=None):
     """Load a saved agent (any CraftSuite method, or a plain stable-baselines3 checkpoint)
     with a clear error for missing or corrupt files. Its class is the one its algorithm
-    names (``recorded_algorithm``)."""
+    names (``recorded_algorithm``). A saved agent holds no replay: an off-policy one is
+    loaded with a replay of one row (SB3 would allocate one of the saved size up front: a
+    CRM student's, a row per live automaton state, can exceed the machine's memory); load
+    a replay after it with ``load_replay_buffer``."""
     import stable_baselines3 as sb3
 
     path = Path(path)
@@ -152,7 +155,7 @@ def load_agent(path, env=None):
             raise ValueError(f"{path} is a {algorithm!r} agent, which this CraftSuite does not know "
                              f"(it knows {list(CLASSES)}): a newer CraftSuite saved it?")
         try:
-            return CLASSES[algorithm].load(path, env=env, device="cpu")
+            return CLASSES[algorithm].load(path, env=env, device="cpu", buffer_size=1)
         except Exception as err:  # damaged inside: whatever SB3 raises
             raise ValueError(f"{path} could not be loaded as {CLASSES[algorithm].__name__}: "
                              f"{type(err).__name__}: {err}") from None

@@ -523,9 +523,13 @@ def save_member(pop: Population, k: int, config, path: Path, table=None) -> None
     at ``path``: what ``load_agent`` and SB3's own ``load`` open."""
     from ..agents.factory import make_agent
 
+    hyper = config.effective()["hyperparameters"]
+    # built with a replay of one row: model.zip holds none, and SB3 allocates a whole one up front
+    # (CRM's, a row per live automaton state: 35 GiB on Diamond Mine's grid); the model says the run's size
     agent = make_agent(config.method, config.env_id, table=table, seed=config.seed, n_envs=1,
                        env_kwargs=config.env_kwargs, automaton_state=config.automaton_state,
-                       **config.effective()["hyperparameters"])
+                       **{**hyper, "buffer_size": 1})
+    agent.buffer_size = hyper["buffer_size"]
     pop.learner.store_member(k, agent)
     agent.num_timesteps, agent.n_updates = pop.num_timesteps, pop.learner.n_updates
     if pop.learner.targets is not None:

@@ -487,3 +487,31 @@ def test_crm_trains_as_the_product_dqn_where_the_automaton_has_one_live_state(tm
             for m in ("crm", "product-dqn")}
     (crm,), (product,) = runs["crm"], runs["product-dqn"]
     assert ((crm / "episodes.csv").read_text() == (product / "episodes.csv").read_text()) == same
+
+
+def test_a_crm_members_model_is_saved_and_loaded_without_a_replay_of_its_size(tmp_path, monkeypatch):
+    """A member's model.zip holds no replay, yet SB3 builds one of the run's size to save it
+    and again to load it: a CRM student's holds a row per live automaton state (35 GiB on
+    Diamond Mine's grid, which stopped a population of 1M-transition runs as it finished).
+    Both are built at one row (CRM's: one a live state); the model still says the run's size."""
+    import zipfile
+
+    from craftsuite.agents import factory
+    from craftsuite.agents.crm import CRMReplayBuffer
+
+    built = []
+    make = factory.make_agent
+
+    def spy(*args, **kwargs):
+        agent = make(*args, **kwargs)
+        built.append(agent.replay_buffer)
+        return agent
+
+    monkeypatch.setattr(factory, "make_agent", spy)
+    [path] = train_population(_cell("crm", "Grid10", "FirstTool", seeds=(0,), steps=600), tmp_path, progress=False)
+    asked = json.loads((path / "config.json").read_text())["effective"]["hyperparameters"]["buffer_size"]
+    [replay] = built
+    assert isinstance(replay, CRMReplayBuffer) and replay.observations.shape[:2] == (1, replay.n_live)  # SB3's rows
+    agent = load_agent(path / "model.zip")
+    assert isinstance(agent.replay_buffer, CRMReplayBuffer) and agent.replay_buffer.observations.shape[0] == 1
+    assert json.loads(zipfile.ZipFile(path / "model.zip").read("data"))["buffer_size"] == asked > 1

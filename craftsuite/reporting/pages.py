@@ -617,7 +617,9 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
                   "and in AUC (the rows come from the leaderboards below; the rules a verdict follows, and what "
                   "\"read k times\" means, come after the table).", "", *compared]
         current = frozenset(SUITES[runs.name].regime for runs in directories if runs.name in SUITES)
-        cheapest = to_decide_markdown(asks(pairs, auc, measured, current), current)
+        teachers = frozenset(t.run_name() for runs in directories if runs.name in SUITES
+                             for t in SUITES[runs.name].teachers().values())
+        cheapest = to_decide_markdown(asks(pairs, auc, measured, current, teachers), current)
         if cheapest:
             lines += ["### What the undecided would ask", "", *cheapest]
     if len(directories) > 1:

@@ -34,6 +34,7 @@ class Ask:
     seeds: int  # a side
     runs: tuple[int, int]  # to add: (distilled, scratch)
     hours: float | None  # of one process at the measured rate (None: no rate for its world)
+    gone: str | None = None  # the teacher the distilled runs read, where today's suites train it no more
 
     @property
     def transitions(self) -> int:
@@ -41,13 +42,25 @@ class Ask:
         return sum(self.runs) * self.entry.budget
 
 
-def asks(pairs, auc, measured: dict[str, dict[str, float]], current: frozenset[str] = frozenset()) -> list[Ask]:
+def teacher_of(entry: Entry) -> str | None:
+    """The teacher run a distilled entry's runs read (its name: its settings' hash), from its
+    first run's record; None where they read none."""
+    from ..runs import read_config
+
+    teacher = read_config(entry.runs[0]).get("effective", {}).get("teacher") if entry.runs else None
+    return teacher.split("/")[0] if teacher else None
+
+
+def asks(pairs, auc, measured: dict[str, dict[str, float]], current: frozenset[str] = frozenset(),
+         teachers: frozenset[str] | None = None) -> list[Ask]:
     """Every comparison of ``pairs`` (read in final greedy success) and ``auc`` (the same
     pairs in AUC) that is undecided with a figure to say: those of the ``current`` learner
     regimes (the ones the page's suites run now, which a campaign adds seeds to) first, then
     quickest first: by the hours at the ``measured`` rates (``timing.rates``: per learner
     regime, per world's name, a world's variants such as another layout sharing its rate),
-    then (and where no rate is known, after the rest) by transitions."""
+    then (and where no rate is known, after the rest) by transitions. ``teachers``: the
+    teacher runs today's suites train (their names); a distilled side whose runs read another
+    is marked (``Ask.gone``): a run of its settings can no longer be made."""
     found = []
     for metric, read in (("success", pairs), ("auc", auc)):
         for entry, base, c in read:
@@ -57,7 +70,8 @@ def asks(pairs, auc, measured: dict[str, dict[str, float]], current: frozenset[s
             runs = (max(0, need - len(entry.seeds)), max(0, need - len(base.seeds)))
             rate = measured.get(entry.regime, {}).get(entry.world)
             hours = sum(runs) * entry.budget / rate / 3600 if rate else None
-            found.append(Ask(entry, base, metric, need, runs, hours))
+            read = teacher_of(entry) if teachers is not None and runs[0] else None
+            found.append(Ask(entry, base, metric, need, runs, hours, read if read not in (teachers or ()) else None))
     # the hours first: the learner regimes' and worlds' rates differ several times over
     return sorted(found, key=lambda a: (a.entry.regime not in current, a.hours is None, a.hours or 0.0,
                                         a.transitions, rung_order(a.entry.task), a.entry.world_label, a.metric))
@@ -74,7 +88,7 @@ def to_decide_markdown(found: list[Ask], current: frozenset[str] = frozenset()) 
         order = f"those of the learner regime the suites run now ({names}) first, each group quickest first"
     rows = [f"| {a.entry.task} | {a.entry.world_label} | {a.entry.regime} | `{a.entry.label}` − `{a.base.label}` "
             f"| {COMPARED[a.metric]} | {a.entry.budget:,} | {len(a.entry.seeds)} / {len(a.base.seeds)} | {a.seeds} "
-            f"| {a.runs[0]} + {a.runs[1]} | {a.transitions:,} "
+            f"| {a.runs[0]}{'*' if a.gone else ''} + {a.runs[1]} | {a.transitions:,} "
             f"| {'?' if a.hours is None else f'{a.hours:.1f}'} |" for a in found]
     return ["| rung | world | learner regime | distilled − scratch | metric | transitions per run "
             "| seeds now (distilled / scratch) | seeds a side asked | runs to add (distilled + scratch) "
@@ -86,4 +100,15 @@ def to_decide_markdown(found: list[Ask], current: frozenset[str] = frozenset()) 
             "and learner regime recorded on a CPU (two processes on two cores each run somewhat below that rate: "
             "docs/performance.md). A spread read from a handful of seeds is itself uncertain, so a figure can move "
             "a long way as seeds are added; fix the seeds of a part before reading any of them. A comparison "
-            "undecided in both metrics has a row for each, of the same runs: the larger figure covers both.", ""]
+            "undecided in both metrics has a row for each, of the same runs: the larger figure covers both."
+            + gone_note(found), ""]
+
+
+def gone_note(found: list[Ask]) -> str:
+    """The sentence on the rows whose distilled side can no longer grow (none: empty)."""
+    gone = sorted({a.gone for a in found if a.gone})
+    if not gone:
+        return ""
+    return (" \\* The distilled runs read a teacher today's suites no longer train (its settings changed, the "
+            f"engine that trained it among them: {', '.join(gone)}): `craftsuite transfer` adds to the scratch side "
+            "only, and the distilled side's seeds stay as they are.")

@@ -79,3 +79,25 @@ def test_the_comparisons_of_the_regime_the_suites_run_now_come_first(tmp_path):
     assert [a.entry.regime for a in now] == ["n-step-wide"] * 2 + ["one-step"] * 2
     assert ("those of the learner regime the suites run now (`n-step-wide`) first, each group quickest first"
             in "\n".join(to_decide_markdown(now, frozenset({"n-step-wide"}))))
+
+
+def test_a_distilled_side_whose_teacher_is_no_longer_trained_is_marked(tmp_path):
+    """A distilled run's key names its teacher: where today's suites train another (the
+    one-step runs read a teacher the SB3 engine trained), more of its runs cannot be made,
+    and the row says so rather than ask for them."""
+    for seed in range(5):
+        fake_run(tmp_path, "dqn", seed, [(10_000, SPREAD[seed])], [(9_500, 1.0)], budget=10_000,
+                 task="TwoToolsHome", world="Grid10")
+        fake_run(tmp_path, "dynamic", seed, [(10_000, SPREAD[seed + 1])], [(9_500, 1.0)], budget=10_000,
+                 task="TwoToolsHome", world="Grid10",
+                 effective={"teacher": "teacher-TwoToolsHome-Grid7-s0-old/table.npz"})
+    board = build(tmp_path)
+    pairs = comparisons([board])
+    for teachers, gone in ((frozenset({"teacher-TwoToolsHome-Grid7-s0-old"}), None),
+                           (frozenset({"teacher-TwoToolsHome-Grid7-s0-new"}), "teacher-TwoToolsHome-Grid7-s0-old")):
+        found = asks(pairs, in_metric(pairs, "auc"), rates(board), teachers=teachers)
+        assert found and all(a.gone == gone for a in found)
+        text = "\n".join(to_decide_markdown(found))
+        assert (f"| {found[0].runs[0]}* + " in text) == (gone is not None)
+        assert ("teacher-TwoToolsHome-Grid7-s0-old): `craftsuite transfer` adds to the scratch side only" in text) \
+            == (gone is not None)

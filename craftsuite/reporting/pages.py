@@ -617,8 +617,9 @@ def write_results_page(run_dirs, path, title: str = "Results") -> Path:
                   "and in AUC (the rows come from the leaderboards below; the rules a verdict follows, and what "
                   "\"read k times\" means, come after the table).", "", *compared]
         current = frozenset(SUITES[runs.name].regime for runs in directories if runs.name in SUITES)
-        teachers = frozenset(t.run_name() for runs in directories if runs.name in SUITES
-                             for t in SUITES[runs.name].teachers().values())
+        suites = [SUITES[runs.name] for runs in directories if runs.name in SUITES]
+        # the teachers today's suites train (none said: no suite's directory, nothing starred)
+        teachers = frozenset(t.run_name() for suite in suites for t in suite.teachers().values()) if suites else None
         cheapest = to_decide_markdown(asks(pairs, auc, measured, current, teachers), current)
         if cheapest:
             lines += ["### What the undecided would ask", "", *cheapest]

@@ -6,6 +6,7 @@ campaign's next part can be chosen by its cost (and fixed before any of its runs
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 from .board import COMPARED, Comparison, Entry, rung_order
@@ -37,9 +38,16 @@ class Ask:
     gone: str | None = None  # the teacher the distilled runs read, where today's suites train it no more
 
     @property
+    def made(self) -> int:
+        """The runs to add that today's suites can make: the scratch side's alone where the
+        distilled side's teacher is gone."""
+        return self.runs[1] + (0 if self.gone else self.runs[0])
+
+    @property
     def transitions(self) -> int:
-        """Of the runs to add (both sides run at one budget: only such pairs are compared)."""
-        return sum(self.runs) * self.entry.budget
+        """Of the runs to add that can be made (both sides run at one budget: only such pairs
+        are compared)."""
+        return self.made * self.entry.budget
 
 
 def teacher_of(entry: Entry) -> str | None:
@@ -68,12 +76,14 @@ def asks(pairs, auc, measured: dict[str, dict[str, float]], current: frozenset[s
             if need is None:
                 continue
             runs = (max(0, need - len(entry.seeds)), max(0, need - len(base.seeds)))
+            teacher = teacher_of(entry) if teachers is not None and runs[0] else None
+            ask = Ask(entry, base, metric, need, runs, None, teacher if teacher not in (teachers or ()) else None)
             rate = measured.get(entry.regime, {}).get(entry.world)
-            hours = sum(runs) * entry.budget / rate / 3600 if rate else None
-            read = teacher_of(entry) if teachers is not None and runs[0] else None
-            found.append(Ask(entry, base, metric, need, runs, hours, read if read not in (teachers or ()) else None))
-    # the hours first: the learner regimes' and worlds' rates differ several times over
-    return sorted(found, key=lambda a: (a.entry.regime not in current, a.hours is None, a.hours or 0.0,
+            found.append(dataclasses.replace(ask, hours=ask.transitions / rate / 3600 if rate else None))
+    # the hours first: the learner regimes' and worlds' rates differ several times over; a row
+    # whose distilled side cannot grow after the rest of its group (it asks runs that cannot be made)
+    return sorted(found, key=lambda a: (a.entry.regime not in current, a.gone is not None, a.hours is None,
+                                        a.hours or 0.0,
                                         a.transitions, rung_order(a.entry.task), a.entry.world_label, a.metric))
 
 
@@ -109,6 +119,6 @@ def gone_note(found: list[Ask]) -> str:
     gone = sorted({a.gone for a in found if a.gone})
     if not gone:
         return ""
-    return (" \\* The distilled runs read a teacher today's suites no longer train (its settings changed, the "
-            f"engine that trained it among them: {', '.join(gone)}): `craftsuite transfer` adds to the scratch side "
-            "only, and the distilled side's seeds stay as they are.")
+    return (" \\* The distilled runs read a teacher trained under settings today's suites no longer use "
+            f"({', '.join(gone)}): `craftsuite transfer` adds to the scratch side only (the row's transitions and "
+            "hours are that side's), and the distilled side's seeds stay as they are.")

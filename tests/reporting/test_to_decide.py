@@ -97,7 +97,10 @@ def test_a_distilled_side_whose_teacher_is_no_longer_trained_is_marked(tmp_path)
                            (frozenset({"teacher-TwoToolsHome-Grid7-s0-new"}), "teacher-TwoToolsHome-Grid7-s0-old")):
         found = asks(pairs, in_metric(pairs, "auc"), rates(board), teachers=teachers)
         assert found and all(a.gone == gone for a in found)
+        a = found[0]
+        assert a.transitions == (a.runs[1] if gone else sum(a.runs)) * 10_000  # runs that can be made alone
         text = "\n".join(to_decide_markdown(found))
-        assert (f"| {found[0].runs[0]}* + " in text) == (gone is not None)
-        assert ("teacher-TwoToolsHome-Grid7-s0-old): `craftsuite transfer` adds to the scratch side only" in text) \
+        assert (f"| {a.runs[0]}* + {a.runs[1]} | {a.transitions:,} |" in text) == (gone is not None)
+        assert ("(teacher-TwoToolsHome-Grid7-s0-old): `craftsuite transfer` adds to the scratch side only" in text) \
             == (gone is not None)
+    assert all(a.gone is None for a in asks(pairs, in_metric(pairs, "auc"), rates(board)))  # no suite: none said

@@ -180,8 +180,7 @@ def markdown() -> str:
              "more beside them, never read as the record: `.lock` (the advisory lock that keeps two live writers "
              "out, kept once the run is finished: a lock file deleted while another process opens it would let "
              "two in), `progress.json` (how far a run got), the model (`model.zip`, a teacher's `teacher.zip`) and, "
-             "where its trainer writes them, checkpoints and TensorBoard logs; "
-             "the archive keeps the four files "
+             "where its trainer writes them, checkpoints and TensorBoard logs; the archive keeps the four files "
              "alone (and a teacher's distilled `table.npz`).", ""]
     for name, fields in FILES.items():
         kind = "columns" if name.endswith(".csv") else "fields"

@@ -6,7 +6,6 @@ campaign's next part can be chosen by its cost (and fixed before any of its runs
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 
 from .board import COMPARED, Comparison, Entry, rung_order
@@ -34,7 +33,7 @@ class Ask:
     metric: str  # one of ``board.COMPARED``
     seeds: int  # a side
     runs: tuple[int, int]  # to add: (distilled, scratch)
-    hours: float | None  # of one process at the measured rate (None: no rate for its world)
+    rate: float | None  # transitions/s of one process its world measured (None: no rate for its world)
     gone: str | None = None  # the teacher the distilled runs read, where today's suites train it no more
 
     @property
@@ -48,6 +47,11 @@ class Ask:
         """Of the runs to add that can be made (both sides run at one budget: only such pairs
         are compared)."""
         return self.made * self.entry.budget
+
+    @property
+    def hours(self) -> float | None:
+        """Of one process, for the runs that can be made, at the measured rate."""
+        return self.transitions / self.rate / 3600 if self.rate else None
 
 
 def teacher_of(entry: Entry) -> str | None:
@@ -77,9 +81,8 @@ def asks(pairs, auc, measured: dict[str, dict[str, float]], current: frozenset[s
                 continue
             runs = (max(0, need - len(entry.seeds)), max(0, need - len(base.seeds)))
             teacher = teacher_of(entry) if teachers is not None and runs[0] else None
-            ask = Ask(entry, base, metric, need, runs, None, teacher if teacher not in (teachers or ()) else None)
-            rate = measured.get(entry.regime, {}).get(entry.world)
-            found.append(dataclasses.replace(ask, hours=ask.transitions / rate / 3600 if rate else None))
+            found.append(Ask(entry, base, metric, need, runs, measured.get(entry.regime, {}).get(entry.world),
+                             teacher if teacher not in (teachers or ()) else None))
     # the hours first: the learner regimes' and worlds' rates differ several times over; a row
     # whose distilled side cannot grow after the rest of its group (it asks runs that cannot be made)
     return sorted(found, key=lambda a: (a.entry.regime not in current, a.gone is not None, a.hours is None,

@@ -37,7 +37,7 @@ import numpy as np
 
 from .completion import needs_reread, reread_in_place, reread_logs
 from .files import atomic_path, atomic_write
-from .runs import RunError, in_use, read_config, read_csv, read_result, record_key
+from .runs import RunError, in_use, read_columns, read_config, read_csv, read_result, record_key
 
 RECORDS = ("config.json", "result.json", "evals.csv", "table.npz")  # kept as they are (table.npz: teachers)
 COMPRESSED = ("episodes.csv",)  # kept as <name>.gz
@@ -86,8 +86,9 @@ def _check_format(run: Path, record: dict, outcome: dict) -> str | None:
     try:
         check_config(record, run / "config.json")
         check_result(outcome, record, run / "result.json")
-        check_evals(read_csv(run / "evals.csv"), outcome["steps"], run / "evals.csv")
-        check_episodes(read_csv(run / "episodes.csv"), outcome["steps"], run / "episodes.csv")
+        check_evals(read_columns(run / "evals.csv", ("step", "success")), outcome["steps"], run / "evals.csv")
+        check_episodes(read_columns(run / "episodes.csv", ("step", "return", "success")), outcome["steps"],
+                       run / "episodes.csv")
     except RecordError as err:
         return f"{err}: the record breaks the record format (docs/records.md)"
     except (ValueError, OSError, EOFError) as err:

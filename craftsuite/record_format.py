@@ -13,6 +13,8 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 
 @dataclass(frozen=True)
 class Field:
@@ -129,40 +131,58 @@ def check_result(result: dict, config: dict, path) -> None:
                               "of another run")
 
 
-def check_evals(rows: list[dict], steps: int, path) -> None:
-    """``evals.csv``'s rows (as read: strings): steps within the run, success a rate, the
-    means finite."""
-    for line, row in enumerate(rows, start=2):
-        step = _number(row, "step", path, line)
-        if step != int(step) or not 0 <= step <= steps:
-            raise RecordError(f"{path}: line {line}: step {row['step']} is not a step of the run (0 to {steps:,} "
-                              "transitions)")
-        success = _number(row, "success", path, line)
-        if not 0 <= success <= 1:
-            raise RecordError(f"{path}: line {line}: success {row['success']} is not a rate in [0, 1]")
-        for name in ("return", "length"):
-            if row.get(name) not in (None, ""):
-                _number(row, name, path, line)
+def check_evals(columns: dict, steps: int, path) -> None:
+    """``evals.csv``'s columns (as read: strings, ``runs.read_columns``): steps within the
+    run, success a rate, the means finite where given."""
+    step = _numbers(columns["step"], "step", path)
+    _refuse_first(columns, "step", path, (step != np.floor(step)) | (step < 0) | (step > steps),
+                  f"is not a step of the run (0 to {steps:,} transitions)")
+    success = _numbers(columns["success"], "success", path)
+    _refuse_first(columns, "success", path, (success < 0) | (success > 1), "is not a rate in [0, 1]")
+    for name in ("return", "length"):
+        cells = columns.get(name, ())
+        given = [i for i, value in enumerate(cells) if value != ""]
+        _numbers([cells[i] for i in given], name, path, given)
 
 
-def check_episodes(rows: list[dict], steps: int, path) -> None:
-    """``episodes.csv``'s rows (as read: strings): steps within the run, returns finite."""
-    for line, row in enumerate(rows, start=2):
-        step = _number(row, "step", path, line)
-        if not 0 <= step <= steps:
-            raise RecordError(f"{path}: line {line}: step {row['step']} is not a step of the run (0 to {steps:,} "
-                              "transitions)")
-        _number(row, "return", path, line)
+def check_episodes(columns: dict, steps: int, path) -> None:
+    """``episodes.csv``'s columns (as read: strings): steps within the run, returns finite,
+    success 0 or 1."""
+    step = _numbers(columns["step"], "step", path)
+    _refuse_first(columns, "step", path, (step < 0) | (step > steps),
+                  f"is not a step of the run (0 to {steps:,} transitions)")
+    _numbers(columns["return"], "return", path)
+    won = _numbers(columns["success"], "success", path)
+    _refuse_first(columns, "success", path, (won != 0) & (won != 1), "is not 0 or 1")
 
 
-def _number(row: dict, name: str, path, line: int) -> float:
+def _numbers(cells, name: str, path, rows: list[int] | None = None) -> np.ndarray:
+    """A column's cells as finite floats, or a RecordError naming the first line that is
+    none (``rows``: each cell's row, where the cells are some of the column's; a log's first
+    row is its line 2)."""
+    def line(i: int) -> int:
+        return (i if rows is None else rows[i]) + 2
+
     try:
-        value = float(row[name])
-    except (KeyError, TypeError, ValueError):
-        raise RecordError(f"{path}: line {line}: {name} {row.get(name)!r} is not a number") from None
-    if not math.isfinite(value):
-        raise RecordError(f"{path}: line {line}: {name} is {row[name]}: a record holds finite numbers")
-    return value
+        array = np.asarray(cells, dtype=float).reshape(-1)
+    except (TypeError, ValueError):  # a cell that is no number: found one by one, to name it
+        for i, value in enumerate(cells):
+            try:
+                float(value)
+            except (TypeError, ValueError):
+                raise RecordError(f"{path}: line {line(i)}: {name} {value!r} is not a number") from None
+        raise  # (numpy refused what float() takes: not a cell's fault)
+    first = np.flatnonzero(~np.isfinite(array))
+    if first.size:
+        raise RecordError(f"{path}: line {line(first[0])}: {name} is {cells[first[0]]}: a record holds finite numbers")
+    return array
+
+
+def _refuse_first(columns: dict, name: str, path, bad: np.ndarray, problem: str) -> None:
+    """A RecordError naming the first line where ``bad`` holds, with its cell and ``problem``."""
+    first = np.flatnonzero(bad)
+    if first.size:
+        raise RecordError(f"{path}: line {first[0] + 2}: {name} {columns[name][first[0]]} {problem}")
 
 
 def markdown() -> str:

@@ -37,6 +37,7 @@ dies, so a killed run can be started again at once (it resumes).
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import dataclasses
 import fcntl
@@ -444,7 +445,9 @@ def teacher_outcome(result: dict, target: float) -> str:
 
 def read_csv(path, fields: tuple[str, ...] = (), required: bool = False) -> list[dict]:
     """A run's CSV log as rows (none if it is missing); ``<name>.gz`` beside a missing
-    ``<name>`` is read instead (the results archive keeps ``episodes.csv`` compressed).
+    ``<name>`` is read instead (the results archive keeps ``episodes.csv`` compressed). Rows
+    are read as ``csv.DictReader`` reads them, less those short of the header (a torn last
+    line; blank lines skipped, a long row's extra fields a list under None).
 
     Args:
         fields: the columns the caller reads; given, a log that cannot hold them is refused
@@ -456,6 +459,37 @@ def read_csv(path, fields: tuple[str, ...] = (), required: bool = False) -> list
         ValueError: with ``fields``, an empty log, a header without one of them, or a short
             row before the last (a kill tears the last line only).
     """
+    header, rows = _log_rows(path, fields, required)
+    if header is None:
+        return []
+    n, out = len(header), []
+    for row in rows:
+        if len(row) == n:
+            out.append(dict(zip(header, row)))
+        elif len(row) > n:
+            out.append({**dict(zip(header, row)), None: row[n:]})
+    return out
+
+
+def read_columns(path, fields: tuple[str, ...], required: bool = False) -> dict[str, tuple[str, ...]]:
+    """A run's CSV log as columns, each header name to its rows' strings, by the rules of
+    ``read_csv`` (the same rows; ``fields`` must be in the header). A reader of many logs
+    (a results page reads millions of rows) keeps columns, not a dict a row.
+
+    Raises:
+        FileNotFoundError, ValueError: as ``read_csv`` with ``fields``.
+    """
+    header, rows = _log_rows(path, fields, required)
+    if header is None:
+        return {name: () for name in fields}
+    if rows and len(rows[-1]) < len(header):  # a torn last line (_check_log refused a short one before it)
+        rows.pop()
+    return dict(zip(header, zip(*rows))) if rows else {name: () for name in header}
+
+
+def _log_rows(path, fields: tuple[str, ...], required: bool) -> tuple[list[str] | None, list[list[str]]]:
+    """A CSV log's header and non-blank rows, as lists of strings (no header: a missing log
+    not ``required``, or an empty one when no ``fields`` are asked for)."""
     import gzip
 
     path = Path(path)
@@ -467,45 +501,27 @@ def read_csv(path, fields: tuple[str, ...] = (), required: bool = False) -> list
     elif required:
         raise FileNotFoundError(f"{path} is missing")
     else:
-        return []
+        return None, []
     with opened as f:
-        header, rows = _dict_rows(csv.reader(f))
+        reader = csv.reader(f)
+        header = next(reader, None)
+        rows = [row for row in reader if row]
     if fields:
         _check_log(header, rows, fields)
-    return [row for row in rows if None not in row.values()]  # a torn last line
-
-
-def _dict_rows(reader) -> tuple[list[str] | None, list[dict]]:
-    """The header and rows of a CSV as ``csv.DictReader`` reads them (blank lines skipped; a
-    short row's missing fields None, a long row's extra fields a list under None), in about
-    two thirds of its time: a results page reads millions of rows."""
-    header = next(reader, None)
-    if header is None:
-        return None, []
-    n, rows = len(header), []
-    for row in reader:
-        if len(row) == n:
-            rows.append(dict(zip(header, row)))
-        elif row:
-            d = dict(zip(header, row))
-            if len(row) > n:
-                d[None] = row[n:]
-            else:
-                d.update(dict.fromkeys(header[len(row):]))
-            rows.append(d)
     return header, rows
 
 
-def _check_log(header: list[str] | None, rows: list[dict], fields: tuple[str, ...]) -> None:
+def _check_log(header: list[str] | None, rows: list[list[str]], fields: tuple[str, ...]) -> None:
     """Raise ValueError where a log's header and rows cannot be the log of ``fields``."""
     if not header:
         raise ValueError("the file is empty, without even its header")
     lacking = [f for f in fields if f not in header]
     if lacking:
         raise ValueError(f"its header lacks {', '.join(lacking)}: it reads {','.join(header)[:60]!r}")
-    short = [i for i, row in enumerate(rows[:-1]) if None in row.values()]
-    if short:
-        raise ValueError(f"its line {short[0] + 2} has fewer fields than its header; only a last line, torn by a "
+    n = len(header)
+    short = next((i for i, row in enumerate(rows[:-1]) if len(row) < n), None)
+    if short is not None:
+        raise ValueError(f"its line {short + 2} has fewer fields than its header; only a last line, torn by a "
                          "kill, may")
 
 
@@ -516,8 +532,26 @@ def read_log(path, fields: tuple[str, ...], row=dict, required: bool = False) ->
     Raises:
         RunError: a log that is missing (``required``) or does not read as the log's, naming the file.
     """
-    try:
+    with reading_log(path):
         return [row(r) for r in read_csv(path, fields, required)]
+
+
+def read_log_columns(path, fields: tuple[str, ...], required: bool = False) -> dict[str, tuple[str, ...]]:
+    """``read_log`` as columns (``read_columns``): for readers of many logs.
+
+    Raises:
+        RunError: as ``read_log``.
+    """
+    with reading_log(path):
+        return read_columns(path, fields, required)
+
+
+@contextlib.contextmanager
+def reading_log(path):
+    """Within it, a log at ``path`` that does not read (or whose cells do not convert) is
+    raised as a RunError naming the file: a damaged record."""
+    try:
+        yield
     except FileNotFoundError:  # before OSError: not damaged bytes, but no file
         raise RunError(f"{path} is missing: the run's record is damaged (a finished run has evaluated at least "
                        "once, at its end)") from None

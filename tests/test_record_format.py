@@ -42,9 +42,22 @@ CONFIG = {"task": "Reach", "world": "Cont", "method": "my-sac", "seed": 0, "step
      "machine must be a string"),
     (lambda: check_result({"kind": "student", "steps": 1000, "seed": 4}, CONFIG, "r.json"),
      "seed 4 is not config.json's \\(0\\): the result of another run"),
-    (lambda: check_evals([{"step": "1000", "success": "inf"}], 1000, "e.csv"), "e.csv: line 2: success is inf"),
-    (lambda: check_evals([{"step": "500.5", "success": "1"}], 1000, "e.csv"), "step 500.5 is not a step of the run"),
-    (lambda: check_episodes([{"step": "10", "return": ""}], 1000, "p.csv"), "p.csv: line 2: return '' is not a"),
+    (lambda: check_evals({"step": ("1000",), "success": ("inf",)}, 1000, "e.csv"), "e.csv: line 2: success is inf"),
+    (lambda: check_evals({"step": ("500", "500.5"), "success": ("1", "1")}, 1000, "e.csv"),
+     "e.csv: line 3: step 500.5 is not a step of the run"),
+    (lambda: check_evals({"step": ("500", "1000"), "success": ("0.5", "1.5")}, 1000, "e.csv"),
+     "line 3: success 1.5 is not a rate in \\[0, 1\\]"),
+    # an empty mean is allowed (not measured), and does not shift the line named after it
+    (lambda: check_evals({"step": ("500", "1000", "1000"), "success": ("1", "1", "1"), "length": ("", "4", "x")},
+                         1000, "e.csv"), "e.csv: line 4: length 'x' is not a number"),
+    (lambda: check_evals({"step": ("500", "1000"), "success": ("1", "1"), "return": ("", "-inf")}, 1000, "e.csv"),
+     "e.csv: line 3: return is -inf"),
+    (lambda: check_episodes({"step": ("10",), "return": ("",), "success": ("0",)}, 1000, "p.csv"),
+     "p.csv: line 2: return '' is not a"),
+    (lambda: check_episodes({"step": ("10", "2000"), "return": ("1", "1"), "success": ("0", "1")}, 1000, "p.csv"),
+     "p.csv: line 3: step 2000 is not a step of the run"),
+    (lambda: check_episodes({"step": ("10", "20"), "return": ("1", "1"), "success": ("0", "0.5")}, 1000, "p.csv"),
+     "p.csv: line 3: success 0.5 is not 0 or 1"),
 ])
 def test_a_record_that_breaks_the_format_is_named(check, message):
     with pytest.raises(RecordError, match=message):
@@ -55,5 +68,6 @@ def test_a_good_record_passes():
     check_config(CONFIG, "c.json")
     check_result({"kind": "student", "steps": 1010, "updates": 3, "task": "Reach", "seconds_share": 12.5,
                   "members": 5, "machine": "Linux x86_64, 2 cores"}, CONFIG, "r.json")
-    check_evals([{"step": "1000", "success": "0.5", "return": "1.5", "length": ""}], 1010, "e.csv")
-    check_episodes([{"step": "10", "return": "-3.0"}], 1010, "p.csv")
+    check_evals({"step": ("1000",), "success": ("0.5",), "return": ("1.5",), "length": ("",)}, 1010, "e.csv")
+    check_episodes({"step": ("10", "20"), "return": ("-3.0", "1"), "success": ("0", "1")}, 1010, "p.csv")
+    check_episodes({"step": (), "return": (), "success": ()}, 1010, "p.csv")  # no episode yet

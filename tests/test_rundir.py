@@ -10,7 +10,7 @@ import pytest
 
 from craftsuite.configs import StudentConfig
 from craftsuite.files import atomic_write
-from craftsuite.runs import EPISODE_FIELDS, RunDir, RunError, load_config, read_csv, settings
+from craftsuite.runs import EPISODE_FIELDS, RunDir, RunError, load_config, read_columns, read_csv, settings
 
 
 def test_two_live_runs_never_share_a_directory(tmp_path):
@@ -83,6 +83,30 @@ def test_read_csv_reads_rows_as_the_standard_dict_reader_does(tmp_path):
     assert read_csv(tmp_path / "empty.csv") == []
     with pytest.raises(ValueError, match="empty"):
         read_csv(tmp_path / "empty.csv", fields=("step",))
+
+
+def test_read_columns_holds_the_rows_read_csv_reads(tmp_path):
+    """The columnar reading (a page's) is the row reading transposed: the same rows, a torn
+    last line left out, a short row before it refused, the archive's .gz read alike."""
+    import gzip
+
+    path = tmp_path / "e.csv"
+    path.write_text("step,return,success\n\n1,0.5,0\n3,\"-1,5\",1\n4,2,1,extra\n5,0.")
+    rows = read_csv(path, ("step", "return"))
+    columns = read_columns(path, ("step", "return"))
+    assert columns == {name: tuple(r[name] for r in rows) for name in ("step", "return", "success")}
+    assert columns["return"] == ("0.5", "-1,5", "2")
+    packed = tmp_path / "p.csv.gz"
+    packed.write_bytes(gzip.compress(path.read_bytes()))
+    assert read_columns(tmp_path / "p.csv", ("step",)) == columns
+    path.write_text("step,return\n1\n2,3\n")
+    with pytest.raises(ValueError, match="line 2 has fewer fields than its header"):
+        read_columns(path, ("step",))
+    path.write_text("step,return\n")  # a header and no episode yet
+    assert read_columns(path, ("step",)) == {"step": (), "return": ()}
+    assert read_columns(tmp_path / "missing.csv", ("step",)) == {"step": ()}
+    with pytest.raises(FileNotFoundError):
+        read_columns(tmp_path / "missing.csv", ("step",), required=True)
 
 
 def test_atomic_write_leaves_no_temporary_files(tmp_path):

@@ -42,7 +42,7 @@ from .. import stats
 from ..completion import needs_reread
 from ..progress import progress_bar
 from ..record_format import RecordError, check_config, check_episodes, check_evals, check_result
-from ..runs import RunError, evaluation_steps, flatten, read_config, read_log, read_result, run_settings
+from ..runs import RunError, evaluation_steps, flatten, read_config, read_log_columns, read_result, run_settings
 
 # metrics with a mean and an interval per task and method; a rate lies in [0, 1]
 METRICS = {"success": (0.0, 1.0), "return": (-math.inf, math.inf), "train_success": (0.0, 1.0),
@@ -135,9 +135,9 @@ def run_metrics(run: Path) -> dict | None:
                        f"format {config.get('format', 1)}); keep it in a results archive (craftsuite archive "
                        "RUNS --suite S), which re-reads it as completion")
     # the record as the format has it (craftsuite.record_format): one line naming what breaks it
-    raw_episodes = read_log(run / "episodes.csv", ("step", "return", "success"))
+    raw_episodes = read_log_columns(run / "episodes.csv", ("step", "return", "success"))
     # no episodes.csv is no episode yet (a budget shorter than an episode); no evals.csv, damage
-    raw_evals = read_log(run / "evals.csv", ("step", "success"), required=True)
+    raw_evals = read_log_columns(run / "evals.csv", ("step", "success"), required=True)
     try:
         check_config(config, run / "config.json")
         check_result(result, config, run / "result.json")
@@ -146,34 +146,37 @@ def run_metrics(run: Path) -> dict | None:
     except RecordError as err:
         raise RunError(f"{err}: the record breaks the record format (docs/records.md)") from None
     budget = int(config["steps"])
-    # (step, return, won) per training episode; (step, greedy success, mean length) per evaluation
-    episodes = [(int(e["step"]), float(e["return"]), int(e["success"])) for e in raw_episodes]
-    evals = [(int(float(e["step"])), float(e["success"]), float(e.get("length") or "nan")) for e in raw_evals]
-    auc = float(np.mean([s for _, s, _ in evals])) if evals else float("nan")
+    # per training episode: the step it ended at, its return, completed (0/1); per evaluation:
+    # its step and greedy success (the checks above read them as numbers)
+    episodes = np.array([np.asarray(raw_episodes[name], dtype=float).reshape(-1)
+                         for name in ("step", "return", "success")]).T.reshape(-1, 3)
+    evals = np.array([np.asarray(raw_evals[name], dtype=float).reshape(-1) for name in ("step", "success")]).T
+    success = evals[:, 1]
+    auc = float(success.mean()) if len(evals) else float("nan")
     every, regime = config.get("eval_every"), regime_of(config)
     if regime == SELF_REPORTED and isinstance(every, int) and every > 0:
         # its loop chose when to evaluate: a curve short of the suite's schedule has no comparable area
-        if not set(evaluation_steps(budget, every)) <= {step for step, _, _ in evals}:
+        if not set(evaluation_steps(budget, every)) <= set(evals[:, 0].astype(int).tolist()):
             auc = float("nan")
-    tail = [e for e in episodes if e[0] > 0.9 * budget]
-    if not tail and episodes:  # fewer episodes than the window: the last one
+    tail = episodes[episodes[:, 0] > 0.9 * budget]
+    if not len(tail) and len(episodes):  # fewer episodes than the window: the last one
         tail = episodes[-1:]
-    success = [s for _, s, _ in evals]
-    reached = next((step for step, s, _ in evals if s >= THRESHOLD), None)
+    lengths = raw_evals.get("length") or ()
+    reached = next((int(step) for step, s in evals if s >= THRESHOLD), None)
     world, world_kwargs = world_of(config)
     return {
         "task": config["task"], "world": world, "world_kwargs": world_kwargs, "method": config["method"],
         "regime": regime, "seed": config["seed"], "budget": budget, "steps": result["steps"],
         "updates": result.get("updates"),
-        "success": success[-1] if success else float("nan"),
-        "return": float(np.mean([r for _, r, _ in tail])) if tail else float("nan"),
-        "train_success": float(np.mean([won for _, _, won in tail])) if tail else float("nan"),
+        "success": float(success[-1]) if len(success) else float("nan"),
+        "return": float(tail[:, 1].mean()) if len(tail) else float("nan"),
+        "train_success": float(tail[:, 2].mean()) if len(tail) else float("nan"),
         "auc": auc,
         "steps_to_80": reached,
-        "length": evals[-1][2] if evals else float("nan"),  # mean decisions of the last evaluation's episodes
+        # mean decisions of the last evaluation's episodes
+        "length": float(lengths[-1] or "nan") if lengths else float("nan"),
         "finished_by": finishing_session(config),
-        "curves": Curves(np.array(episodes, dtype=float).reshape(-1, 3),
-                         np.array([(step, s) for step, s, _ in evals], dtype=float).reshape(-1, 2)),
+        "curves": Curves(episodes, evals),
     }
 
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..reached import bits
-from ..runs import EPISODE_CORE, RunError, read_config, read_log
+from ..runs import EPISODE_CORE, RunError, read_config, read_log_columns, reading_log
 
 
 @dataclass(frozen=True)
@@ -106,6 +106,11 @@ def _edge_name(automaton, source: int, target: int) -> str:
     return automaton.guard(source, target, sink_free=True)
 
 
+def _won(text) -> int:
+    """A ``success`` cell: 1 for a completed episode."""
+    return int(float(text))
+
+
 def _mask(text) -> int | None:
     """A ``seen`` or ``states`` cell: None where the row has none (logged before the column)."""
     return None if text in (None, "") else int(text)
@@ -125,10 +130,13 @@ def episode_progress(run) -> Progress | None:
     if not isinstance(budget, int) or isinstance(budget, bool) or budget <= 0:
         raise RunError(f"{run / 'config.json'} records no transitions budget (steps): not a student's record")
     spec = _spec(run, config)
-    path = run / "episodes.csv"  # (or the archive's episodes.csv.gz: read_log reads either)
+    path = run / "episodes.csv"  # (or the archive's episodes.csv.gz: read_log_columns reads either)
     # (completed, seen, states) per episode; a log without the columns reads as None in them
-    episodes = read_log(path, EPISODE_CORE, lambda r: (int(float(r["success"])), _mask(r.get("seen")),
-                                                        _mask(r.get("states"))))
+    log = read_log_columns(path, EPISODE_CORE)
+    won = log["success"]
+    with reading_log(path):
+        episodes = list(zip(map(_won, won), map(_mask, log.get("seen") or [None] * len(won)),
+                            map(_mask, log.get("states") or [None] * len(won))))
     if episodes and all(seen is None or states is None for _, seen, states in episodes):
         return None
     try:
@@ -255,5 +263,7 @@ def completed_per_100k(run) -> float:
     budget = read_config(run).get("steps")
     if not isinstance(budget, int) or isinstance(budget, bool) or budget <= 0:
         raise RunError(f"{run / 'config.json'} records no transitions budget (steps): not a student's record")
-    won = read_log(run / "episodes.csv", EPISODE_CORE, lambda r: int(float(r["success"])))
-    return sum(won) * 100_000 / budget
+    path = run / "episodes.csv"
+    with reading_log(path):
+        won = sum(map(_won, read_log_columns(path, EPISODE_CORE)["success"]))
+    return won * 100_000 / budget

@@ -79,20 +79,21 @@ def check_record(run: Path, kind: str | None = None) -> str | None:
 def _check_format(run: Path, record: dict, outcome: dict) -> str | None:
     """Why a student's record breaks the record format (``craftsuite.record_format``; None:
     it keeps it). A teacher's result follows its own rules: it stops at its target."""
-    from .record_format import RecordError, check_config, check_episodes, check_evals, check_result
+    from .record_format import RecordError, check_config, check_episodes, check_evals, check_result, required
 
     if outcome.get("kind") != "student":
         return None
+    log = None  # the log being read
     try:
         check_config(record, run / "config.json")
         check_result(outcome, record, run / "result.json")
-        check_evals(read_columns(run / "evals.csv", ("step", "success")), outcome["steps"], run / "evals.csv")
-        check_episodes(read_columns(run / "episodes.csv", ("step", "return", "success")), outcome["steps"],
-                       run / "episodes.csv")
+        for name, check in (("evals.csv", check_evals), ("episodes.csv", check_episodes)):
+            log = run / name
+            check(read_columns(log, required(name)), outcome["steps"], log)
     except RecordError as err:
         return f"{err}: the record breaks the record format (docs/records.md)"
     except (ValueError, OSError, EOFError) as err:
-        return f"{run / 'episodes.csv'} does not read as a run's log ({err}): the record is damaged"
+        return f"{log or run} does not read as a run's log ({err}): the record is damaged"
     return None
 
 

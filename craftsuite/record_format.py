@@ -81,6 +81,11 @@ EPISODES = (
 FILES = {"config.json": CONFIG, "result.json": RESULT, "evals.csv": EVALS, "episodes.csv": EPISODES}
 
 
+def required(name: str) -> tuple[str, ...]:
+    """The fields or columns every record's ``name`` (a key of ``FILES``) holds."""
+    return tuple(f.name for f in FILES[name] if f.required)
+
+
 class RecordError(ValueError):
     """A record that breaks the format: its message names the file, the field and the problem."""
 
@@ -149,19 +154,19 @@ def check_episodes(columns: dict, steps: int, path) -> None:
     """``episodes.csv``'s columns (as read: strings): steps within the run, returns finite,
     success 0 or 1."""
     step = _numbers(columns["step"], "step", path)
-    _refuse_first(columns, "step", path, (step < 0) | (step > steps),
+    _refuse_first(columns, "step", path, (step != np.floor(step)) | (step < 0) | (step > steps),
                   f"is not a step of the run (0 to {steps:,} transitions)")
     _numbers(columns["return"], "return", path)
     won = _numbers(columns["success"], "success", path)
     _refuse_first(columns, "success", path, (won != 0) & (won != 1), "is not 0 or 1")
 
 
-def _numbers(cells, name: str, path, rows: list[int] | None = None) -> np.ndarray:
+def _numbers(cells, name: str, path, positions: list[int] | None = None) -> np.ndarray:
     """A column's cells as finite floats, or a RecordError naming the first line that is
-    none (``rows``: each cell's row, where the cells are some of the column's; a log's first
-    row is its line 2)."""
+    none (``positions``: each cell's row index, where the cells are some of the column's; a
+    log's first row, index 0, is its line 2)."""
     def line(i: int) -> int:
-        return (i if rows is None else rows[i]) + 2
+        return (i if positions is None else positions[i]) + 2
 
     try:
         array = np.asarray(cells, dtype=float).reshape(-1)

@@ -446,8 +446,8 @@ def teacher_outcome(result: dict, target: float) -> str:
 def read_csv(path, fields: tuple[str, ...] = (), required: bool = False) -> list[dict]:
     """A run's CSV log as rows (none if it is missing); ``<name>.gz`` beside a missing
     ``<name>`` is read instead (the results archive keeps ``episodes.csv`` compressed). Rows
-    are read as ``csv.DictReader`` reads them, less those short of the header (a torn last
-    line; blank lines skipped, a long row's extra fields a list under None).
+    are read as ``csv.DictReader`` reads them (blank lines skipped, a long row's extra fields
+    a list under None), less any row short of the header: a torn line.
 
     Args:
         fields: the columns the caller reads; given, a log that cannot hold them is refused
@@ -482,9 +482,8 @@ def read_columns(path, fields: tuple[str, ...], required: bool = False) -> dict[
     header, rows = _log_rows(path, fields, required)
     if header is None:
         return {name: () for name in fields}
-    if rows and len(rows[-1]) < len(header):  # a torn last line (_check_log refused a short one before it)
-        rows.pop()
-    return dict(zip(header, zip(*rows))) if rows else {name: () for name in header}
+    whole = [row for row in rows if len(row) >= len(header)]  # less a torn line, as read_csv
+    return dict(zip(header, zip(*whole))) if whole else {name: () for name in header}
 
 
 def _log_rows(path, fields: tuple[str, ...], required: bool) -> tuple[list[str] | None, list[list[str]]]:

@@ -215,6 +215,10 @@ def test_a_run_given_for_its_directory_names_the_directory(tmp_path, capsys):
 @pytest.mark.parametrize("file, text, problem", [
     ("evals.csv", "step,success,return,episodes\n1000,0.5,nan,4\n", "evals.csv: line 2: return is nan"),
     ("evals.csv", "step,success,return,episodes\n9000,0.5,1.0,4\n", "step 9000 is not a step of the run"),
+    ("episodes.csv", "step,return,length,success\n10,1.0,10,1\n20,1.0,10,0.5\n", "line 3: success 0.5 is not 0 or 1"),
+    ("episodes.csv", "step,return,length,success\n10.5,1.0,10,1\n", "line 2: step 10.5 is not a step of the run"),
+    ("episodes.csv", "step,return,success\n10,1.0,1\n", "episodes.csv does not read as a run's log (its header "
+     "lacks length"),
     ("result.json", json.dumps({"kind": "student", "steps": 10}), "steps 10 is short of the budget"),
     ("result.json", json.dumps({"kind": "student", "steps": 1000, "task": "DungeonQuest"}), "another run's result"),
 ])

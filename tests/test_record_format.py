@@ -56,6 +56,8 @@ CONFIG = {"task": "Reach", "world": "Cont", "method": "my-sac", "seed": 0, "step
      "p.csv: line 2: return '' is not a"),
     (lambda: check_episodes({"step": ("10", "2000"), "return": ("1", "1"), "success": ("0", "1")}, 1000, "p.csv"),
      "p.csv: line 3: step 2000 is not a step of the run"),
+    (lambda: check_episodes({"step": ("10", "20.5"), "return": ("1", "1"), "success": ("0", "1")}, 1000, "p.csv"),
+     "p.csv: line 3: step 20.5 is not a step of the run"),
     (lambda: check_episodes({"step": ("10", "20"), "return": ("1", "1"), "success": ("0", "0.5")}, 1000, "p.csv"),
      "p.csv: line 3: success 0.5 is not 0 or 1"),
 ])

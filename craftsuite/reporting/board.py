@@ -42,6 +42,7 @@ from .. import stats
 from ..completion import needs_reread
 from ..progress import progress_bar
 from ..record_format import RecordError, check_config, check_episodes, check_evals, check_result
+from ..record_format import required as required_columns
 from ..runs import RunError, evaluation_steps, flatten, read_config, read_log_columns, read_result, run_settings
 
 # metrics with a mean and an interval per task and method; a rate lies in [0, 1]
@@ -135,9 +136,9 @@ def run_metrics(run: Path) -> dict | None:
                        f"format {config.get('format', 1)}); keep it in a results archive (craftsuite archive "
                        "RUNS --suite S), which re-reads it as completion")
     # the record as the format has it (craftsuite.record_format): one line naming what breaks it
-    raw_episodes = read_log_columns(run / "episodes.csv", ("step", "return", "success"))
+    raw_episodes = read_log_columns(run / "episodes.csv", required_columns("episodes.csv"))
     # no episodes.csv is no episode yet (a budget shorter than an episode); no evals.csv, damage
-    raw_evals = read_log_columns(run / "evals.csv", ("step", "success"), required=True)
+    raw_evals = read_log_columns(run / "evals.csv", required_columns("evals.csv"), required=True)
     try:
         check_config(config, run / "config.json")
         check_result(result, config, run / "result.json")
@@ -146,11 +147,9 @@ def run_metrics(run: Path) -> dict | None:
     except RecordError as err:
         raise RunError(f"{err}: the record breaks the record format (docs/records.md)") from None
     budget = int(config["steps"])
-    # per training episode: the step it ended at, its return, completed (0/1); per evaluation:
-    # its step and greedy success (the checks above read them as numbers)
-    episodes = np.array([np.asarray(raw_episodes[name], dtype=float).reshape(-1)
-                         for name in ("step", "return", "success")]).T.reshape(-1, 3)
-    evals = np.array([np.asarray(raw_evals[name], dtype=float).reshape(-1) for name in ("step", "success")]).T
+    # the curves' arrays (Curves), from cells the checks above read as numbers
+    episodes = np.array([np.asarray(raw_episodes[name], dtype=float) for name in ("step", "return", "success")]).T
+    evals = np.array([np.asarray(raw_evals[name], dtype=float) for name in ("step", "success")]).T
     success = evals[:, 1]
     auc = float(success.mean()) if len(evals) else float("nan")
     every, regime = config.get("eval_every"), regime_of(config)

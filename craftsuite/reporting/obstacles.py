@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..reached import bits
-from ..runs import EPISODE_CORE, RunError, read_config, read_log_columns, reading_log
+from ..runs import EPISODE_CORE, RunError, read_columns, read_config, reading_log
 
 
 @dataclass(frozen=True)
@@ -130,11 +130,11 @@ def episode_progress(run) -> Progress | None:
     if not isinstance(budget, int) or isinstance(budget, bool) or budget <= 0:
         raise RunError(f"{run / 'config.json'} records no transitions budget (steps): not a student's record")
     spec = _spec(run, config)
-    path = run / "episodes.csv"  # (or the archive's episodes.csv.gz: read_log_columns reads either)
+    path = run / "episodes.csv"  # (or the archive's episodes.csv.gz: read_columns reads either)
     # (completed, seen, states) per episode; a log without the columns reads as None in them
-    log = read_log_columns(path, EPISODE_CORE)
-    won = log["success"]
-    with reading_log(path):
+    with reading_log(path):  # (the cells' conversions too)
+        log = read_columns(path, EPISODE_CORE)
+        won = log["success"]
         episodes = list(zip(map(_won, won), map(_mask, log.get("seen") or [None] * len(won)),
                             map(_mask, log.get("states") or [None] * len(won))))
     if episodes and all(seen is None or states is None for _, seen, states in episodes):
@@ -265,5 +265,5 @@ def completed_per_100k(run) -> float:
         raise RunError(f"{run / 'config.json'} records no transitions budget (steps): not a student's record")
     path = run / "episodes.csv"
     with reading_log(path):
-        won = sum(map(_won, read_log_columns(path, EPISODE_CORE)["success"]))
+        won = sum(map(_won, read_columns(path, EPISODE_CORE)["success"]))
     return won * 100_000 / budget

@@ -24,6 +24,7 @@ import json
 from pathlib import Path
 
 from .files import atomic_write
+from .record_format import required
 from .runs import (EPISODE_CORE, EVAL_FIELDS, FORMAT, RunError, counts_acceptance, csv_text, read_config, read_log,
                    read_result)
 
@@ -120,5 +121,5 @@ def reread_logs(run: Path, config: dict) -> tuple[list[dict], list[dict]]:
         RunError: as ``reread``, or a log that does not read, naming the file.
     """
     # the columns of every record's log: one made before ``seen`` and ``states`` has only these
-    return reread(config, read_log(run / "episodes.csv", EPISODE_CORE),
+    return reread(config, read_log(run / "episodes.csv", required("episodes.csv")),
                   read_log(run / "evals.csv", EVAL_FIELDS, required=True))

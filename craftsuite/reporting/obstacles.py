@@ -14,7 +14,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..reached import bits
-from ..runs import EPISODE_CORE, RunError, read_columns, read_config, reading_log
+from ..record_format import required
+from ..runs import RunError, read_columns, read_config, reading_log
 
 
 @dataclass(frozen=True)
@@ -133,7 +134,7 @@ def episode_progress(run) -> Progress | None:
     path = run / "episodes.csv"  # (or the archive's episodes.csv.gz: read_columns reads either)
     # (completed, seen, states) per episode; a log without the columns reads as None in them
     with reading_log(path):  # (the cells' conversions too)
-        log = read_columns(path, EPISODE_CORE)
+        log = read_columns(path, required("episodes.csv"))
         won = log["success"]
         episodes = list(zip(map(_won, won), map(_mask, log.get("seen") or [None] * len(won)),
                             map(_mask, log.get("states") or [None] * len(won))))
@@ -265,5 +266,5 @@ def completed_per_100k(run) -> float:
         raise RunError(f"{run / 'config.json'} records no transitions budget (steps): not a student's record")
     path = run / "episodes.csv"
     with reading_log(path):
-        won = sum(map(_won, read_columns(path, EPISODE_CORE)["success"]))
+        won = sum(map(_won, read_columns(path, required("episodes.csv"))["success"]))
     return won * 100_000 / budget

@@ -157,8 +157,15 @@ def check_episodes(columns: dict, steps: int, path) -> None:
     _refuse_first(columns, "step", path, (step != np.floor(step)) | (step < 0) | (step > steps),
                   f"is not a step of the run (0 to {steps:,} transitions)")
     _numbers(columns["return"], "return", path)
+    completions(columns, path)
+
+
+def completions(columns: dict, path) -> np.ndarray:
+    """``episodes.csv``'s ``success`` column (as read: strings) as 0/1 floats, one per
+    training episode, or a RecordError naming the first line that is neither."""
     won = _numbers(columns["success"], "success", path)
     _refuse_first(columns, "success", path, (won != 0) & (won != 1), "is not 0 or 1")
+    return won
 
 
 def _numbers(cells, name: str, path, positions: list[int] | None = None) -> np.ndarray:

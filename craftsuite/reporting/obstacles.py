@@ -13,8 +13,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..reached import bits
-from ..record_format import required
+import numpy as np
+
+from ..record_format import RecordError, completions, required
 from ..runs import RunError, read_columns, read_config, reading_log
 
 
@@ -107,14 +108,8 @@ def _edge_name(automaton, source: int, target: int) -> str:
     return automaton.guard(source, target, sink_free=True)
 
 
-def _won(text) -> int:
-    """A ``success`` cell: 1 for a completed episode."""
-    return int(float(text))
-
-
-def _mask(text) -> int | None:
-    """A ``seen`` or ``states`` cell: None where the row has none (logged before the column)."""
-    return None if text in (None, "") else int(text)
+# a row logged before the ``seen`` and ``states`` columns came: no mask (a real one is never negative)
+_NONE = np.iinfo(np.int64).min
 
 
 def episode_progress(run) -> Progress | None:
@@ -127,55 +122,90 @@ def episode_progress(run) -> Progress | None:
     """
     run = Path(run)
     config = read_config(run)
-    budget = config.get("steps")
-    if not isinstance(budget, int) or isinstance(budget, bool) or budget <= 0:
-        raise RunError(f"{run / 'config.json'} records no transitions budget (steps): not a student's record")
+    budget = _budget(run, config)
     spec = _spec(run, config)
     path = run / "episodes.csv"  # (or the archive's episodes.csv.gz: read_columns reads either)
-    # (completed, seen, states) per episode; a log without the columns reads as None in them
-    with reading_log(path):  # (the cells' conversions too)
-        log = read_columns(path, required("episodes.csv"))
-        won = log["success"]
-        episodes = list(zip(map(_won, won), map(_mask, log.get("seen") or [None] * len(won)),
-                            map(_mask, log.get("states") or [None] * len(won))))
-    if episodes and all(seen is None or states is None for _, seen, states in episodes):
+    log, completed = _episodes(path)
+    with reading_log(path):  # (the masks' conversions too)
+        seen, states = (_masks(log, name, len(completed)) for name in ("seen", "states"))
+    if len(completed) and not ((seen != _NONE) & (states != _NONE)).any():
         return None
     try:
-        return summarize(spec.automaton, spec.name, budget, episodes)
+        return summarize(spec.automaton, spec.name, budget, completed, seen, states)
     except ValueError as err:
         raise RunError(f"{path}: {err}: the record was made with another automaton") from None
 
 
-def summarize(automaton, task: str, budget: int, episodes: list[tuple[int, int | None, int | None]]) -> Progress:
-    """The ``Progress`` of one run of ``budget`` transitions from its episodes' (completed,
-    seen, states), in the bits of ``automaton`` (a None: a row logged before the columns).
+def _masks(log: dict, name: str, n: int) -> np.ndarray:
+    """The ``seen`` or ``states`` column of a log's columns as int64 masks, ``_NONE`` where a
+    row has none (an empty cell, or no column at all).
+
+    Raises:
+        ValueError: a cell that is no integer, or one beyond 64 bits.
+    """
+    out = np.full(n, _NONE, dtype=np.int64)
+    if name not in log:
+        return out
+    text = np.asarray(log[name], dtype=str)
+    given = text != ""
+    try:
+        out[given] = text[given].astype(np.int64)
+    except OverflowError:
+        raise ValueError(f"a {name} cell holds more bits than 64") from None
+    return out
+
+
+def _episodes(path: Path) -> tuple[dict, np.ndarray]:
+    """A run's ``episodes.csv`` as columns, and its episodes' completions (0/1) as the record
+    format checks them."""
+    with reading_log(path):
+        log = read_columns(path, required("episodes.csv"))
+    try:
+        return log, completions(log, path)
+    except RecordError as err:
+        raise RunError(f"{err}: the record breaks the record format (docs/records.md)") from None
+
+
+def _budget(run: Path, config: dict) -> int:
+    budget = config.get("steps")
+    if not isinstance(budget, int) or isinstance(budget, bool) or budget <= 0:
+        raise RunError(f"{run / 'config.json'} records no transitions budget (steps): not a student's record")
+    return budget
+
+
+def summarize(automaton, task: str, budget: int, completed, seen, states) -> Progress:
+    """The ``Progress`` of one run of ``budget`` transitions from its episodes: per episode,
+    completed (0/1), ``seen`` and ``states`` in the bits of ``automaton`` (``_NONE`` in both:
+    a row logged before the columns, not counted in the shares).
 
     Raises:
         ValueError: an episode with bits the automaton has no proposition or state for.
     """
+    completed, seen, states = (np.asarray(x).reshape(-1) for x in (completed, seen, states))
     n_props, n_states = len(automaton.propositions), automaton.n_states
     far = distances(automaton)
-    seen_counts, state_counts, closest_counts = [0] * n_props, [0] * n_states, {}
-    marked = 0
-    for number, (_, seen, states) in enumerate(episodes, start=1):
-        if seen is None or states is None:
-            continue
-        if seen < 0 or states < 0 or seen >> n_props or states >> n_states:
-            raise ValueError(f"episode {number} (line {number + 1}: seen {seen}, states {states}) names "
-                             f"propositions or states that task {task!r} does not have ({n_props} propositions, "
-                             f"{n_states} states)")
-        marked += 1
-        for i in bits(seen):
-            seen_counts[i] += 1
-        visited = bits(states)
-        for q in visited:
-            state_counts[q] += 1
-        near = [far[q] for q in visited if far[q] is not None]
-        if near:
-            closest_counts[min(near)] = closest_counts.get(min(near), 0) + 1
-    completed = sum(won for won, _, _ in episodes)
-    return _progress(task, 1, budget, len(episodes), completed, completed * 100_000 / budget, marked,
-                     automaton.propositions, seen_counts, state_counts, closest_counts, tuple(far),
+    marked = (seen != _NONE) & (states != _NONE)
+    seen, states = seen[marked], states[marked]
+    wrong = (seen < 0) | (states < 0) | ((seen >> n_props) != 0) | ((states >> n_states) != 0)
+    if wrong.any():
+        first = int(np.flatnonzero(wrong)[0])
+        number = int(np.flatnonzero(marked)[first]) + 1
+        raise ValueError(f"episode {number} (line {number + 1}: seen {seen[first]}, states {states[first]}) names "
+                         f"propositions or states that task {task!r} does not have ({n_props} propositions, "
+                         f"{n_states} states)")
+    seen_counts = [int(((seen >> i) & 1).sum()) for i in range(n_props)]
+    visits = [((states >> q) & 1) == 1 for q in range(n_states)]
+    state_counts = [int(v.sum()) for v in visits]
+    # each episode's closest visited state: the fewest edges to acceptance among those it visited
+    closest = np.full(len(states), np.iinfo(np.int64).max)
+    for q, dq in enumerate(far):
+        if dq is not None:
+            closest = np.where(visits[q], np.minimum(closest, dq), closest)
+    near, counts = np.unique(closest[closest != np.iinfo(np.int64).max], return_counts=True)
+    done = int(np.asarray(completed).sum())
+    return _progress(task, 1, budget, len(completed), done, done * 100_000 / budget, int(marked.sum()),
+                     automaton.propositions, seen_counts, state_counts,
+                     {int(d): int(c) for d, c in zip(near, counts)}, tuple(far),
                      tuple(distances(automaton, forward=True)))
 
 
@@ -261,10 +291,5 @@ def completed_per_100k(run) -> float:
     """A run's completed training episodes per 100k transitions of its budget, from its log's
     ``success`` column (every record has it, old ones too)."""
     run = Path(run)
-    budget = read_config(run).get("steps")
-    if not isinstance(budget, int) or isinstance(budget, bool) or budget <= 0:
-        raise RunError(f"{run / 'config.json'} records no transitions budget (steps): not a student's record")
-    path = run / "episodes.csv"
-    with reading_log(path):
-        won = sum(map(_won, read_columns(path, required("episodes.csv"))["success"]))
-    return won * 100_000 / budget
+    budget = _budget(run, read_config(run))
+    return float(_episodes(run / "episodes.csv")[1].sum()) * 100_000 / budget

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from craftsuite.automata import Automaton
-from craftsuite.reporting.obstacles import distances, episode_progress, method_progress, pool, summarize
+from craftsuite.reporting.obstacles import completed_per_100k, distances, episode_progress, method_progress, pool
+from craftsuite.reporting.obstacles import summarize as summarize_arrays
 from craftsuite.runs import EPISODE_CORE, EPISODE_FIELDS, RunError, write_csv
 from craftsuite.task_registry import resolve_task
 
@@ -26,6 +27,12 @@ def _hand_made() -> Automaton:
                       [4, 1, 4, 3]],  # 4
                      dtype=np.int16)
     return Automaton("hand-made", ("a", "b"), delta, np.array([False, False, True, False, False]))
+
+
+def summarize(automaton, task, budget, episodes):
+    """``summarize`` of episodes written as (completed, seen, states) rows."""
+    completed, seen, states = (np.array(column, dtype=np.int64) for column in zip(*episodes))
+    return summarize_arrays(automaton, task, budget, completed, seen, states)
 
 
 def test_distances_count_edges_to_acceptance_without_self_loops_or_the_sink():
@@ -118,6 +125,14 @@ def test_bad_records_are_named(tmp_path):
     garbled = _run(tmp_path, rows=[(300, -20.0, 200, 0, "x", 0b01)], seed=1)
     with pytest.raises(RunError, match=r"episodes.csv does not read as a run's log"):
         episode_progress(garbled)
+    huge = _run(tmp_path, rows=[(300, -20.0, 200, 0, 0, 2**64)], seed=6)
+    with pytest.raises(RunError, match=r"episodes.csv does not read as a run's log .*states cell holds more bits"):
+        episode_progress(huge)
+    # a completion is 0 or 1, as the record format has it (the board refuses the same log)
+    half = _run(tmp_path, rows=[(300, -20.0, 200, 0.5, 0, 0b01)], seed=7)
+    for read in (episode_progress, completed_per_100k):
+        with pytest.raises(RunError, match=r"episodes.csv: line 2: success 0.5 is not 0 or 1: the record breaks"):
+            read(half)
     unknown = _run(tmp_path, task="NoSuchTask", rows=REACH, seed=2)
     with pytest.raises(RunError, match=r"config.json: task 'NoSuchTask' is unknown here"):
         episode_progress(unknown)

@@ -136,9 +136,10 @@ def check_result(result: dict, config: dict, path) -> None:
                               "of another run")
 
 
-def check_evals(columns: dict, steps: int, path) -> None:
+def check_evals(columns: dict, steps: int, path) -> dict[str, np.ndarray]:
     """``evals.csv``'s columns (as read: strings, ``runs.read_columns``): steps within the
-    run, success a rate, the means finite where given."""
+    run, success a rate, the means finite where given. Returns the ``step`` and ``success``
+    columns as the floats it read (a reader then converts nothing twice)."""
     step = _numbers(columns["step"], "step", path)
     _refuse_first(columns, "step", path, (step != np.floor(step)) | (step < 0) | (step > steps),
                   f"is not a step of the run (0 to {steps:,} transitions)")
@@ -148,16 +149,18 @@ def check_evals(columns: dict, steps: int, path) -> None:
         cells = columns.get(name, ())
         given = [i for i, value in enumerate(cells) if value != ""]
         _numbers([cells[i] for i in given], name, path, given)
+    return {"step": step, "success": success}
 
 
-def check_episodes(columns: dict, steps: int, path) -> None:
+def check_episodes(columns: dict, steps: int, path) -> dict[str, np.ndarray]:
     """``episodes.csv``'s columns (as read: strings): steps within the run, returns finite,
-    success 0 or 1."""
+    success 0 or 1. Returns the ``step``, ``return`` and ``success`` columns as the floats it
+    read."""
     step = _numbers(columns["step"], "step", path)
     _refuse_first(columns, "step", path, (step != np.floor(step)) | (step < 0) | (step > steps),
                   f"is not a step of the run (0 to {steps:,} transitions)")
-    _numbers(columns["return"], "return", path)
-    completions(columns, path)
+    return {"step": step, "return": _numbers(columns["return"], "return", path),
+            "success": completions(columns, path)}
 
 
 def completions(columns: dict, path) -> np.ndarray:

@@ -142,14 +142,14 @@ def run_metrics(run: Path) -> dict | None:
     try:
         check_config(config, run / "config.json")
         check_result(result, config, run / "result.json")
-        check_evals(raw_evals, result["steps"], run / "evals.csv")
-        check_episodes(raw_episodes, result["steps"], run / "episodes.csv")
+        eval_columns = check_evals(raw_evals, result["steps"], run / "evals.csv")
+        episode_columns = check_episodes(raw_episodes, result["steps"], run / "episodes.csv")
     except RecordError as err:
         raise RunError(f"{err}: the record breaks the record format (docs/records.md)") from None
     budget = int(config["steps"])
-    # the curves' arrays (Curves), from cells the checks above read as numbers
-    episodes = np.array([np.asarray(raw_episodes[name], dtype=float) for name in ("step", "return", "success")]).T
-    evals = np.array([np.asarray(raw_evals[name], dtype=float) for name in ("step", "success")]).T
+    # the curves' arrays (Curves), as the checks above read them
+    episodes = np.column_stack([episode_columns[name] for name in ("step", "return", "success")])
+    evals = np.column_stack([eval_columns[name] for name in ("step", "success")])
     success = evals[:, 1]
     auc = float(success.mean()) if len(evals) else float("nan")
     every, regime = config.get("eval_every"), regime_of(config)

@@ -167,6 +167,7 @@ def _episodes(path: Path) -> tuple[dict, np.ndarray]:
 
 
 def _budget(run: Path, config: dict) -> int:
+    """A student's transitions budget, as its ``config.json`` records it."""
     budget = config.get("steps")
     if not isinstance(budget, int) or isinstance(budget, bool) or budget <= 0:
         raise RunError(f"{run / 'config.json'} records no transitions budget (steps): not a student's record")
@@ -202,7 +203,7 @@ def summarize(automaton, task: str, budget: int, completed, seen, states) -> Pro
         if dq is not None:
             closest = np.where(visits[q], np.minimum(closest, dq), closest)
     near, counts = np.unique(closest[closest != np.iinfo(np.int64).max], return_counts=True)
-    done = int(np.asarray(completed).sum())
+    done = int(completed.sum())
     return _progress(task, 1, budget, len(completed), done, done * 100_000 / budget, int(marked.sum()),
                      automaton.propositions, seen_counts, state_counts,
                      {int(d): int(c) for d, c in zip(near, counts)}, tuple(far),

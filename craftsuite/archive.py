@@ -79,7 +79,8 @@ def check_record(run: Path, kind: str | None = None) -> str | None:
 def _check_format(run: Path, record: dict, outcome: dict) -> str | None:
     """Why a student's record breaks the record format (``craftsuite.record_format``; None:
     it keeps it). A teacher's result follows its own rules: it stops at its target."""
-    from .record_format import RecordError, check_config, check_episodes, check_evals, check_result, required
+    from .record_format import (RecordError, breaks_format, check_config, check_episodes, check_evals, check_result,
+                                required)
 
     if outcome.get("kind") != "student":
         return None
@@ -91,7 +92,7 @@ def _check_format(run: Path, record: dict, outcome: dict) -> str | None:
             log = run / name
             check(read_columns(log, required(name)), outcome["steps"], log)
     except RecordError as err:
-        return f"{err}: the record breaks the record format (docs/records.md)"
+        return breaks_format(err)
     except (ValueError, OSError, EOFError) as err:
         return f"{log or run} does not read as a run's log ({err}): the record is damaged"
     return None

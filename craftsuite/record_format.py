@@ -90,6 +90,11 @@ class RecordError(ValueError):
     """A record that breaks the format: its message names the file, the field and the problem."""
 
 
+def breaks_format(err: RecordError) -> str:
+    """What a reader of records says of one that ``err`` refused."""
+    return f"{err}: the record breaks the record format (docs/records.md)"
+
+
 def _int(value) -> bool:
     return isinstance(value, int) and not isinstance(value, bool)
 

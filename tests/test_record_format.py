@@ -3,6 +3,7 @@ checks every reader makes name the file, the line and the field they refuse."""
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from craftsuite.cli import main
@@ -70,6 +71,11 @@ def test_a_good_record_passes():
     check_config(CONFIG, "c.json")
     check_result({"kind": "student", "steps": 1010, "updates": 3, "task": "Reach", "seconds_share": 12.5,
                   "members": 5, "machine": "Linux x86_64, 2 cores"}, CONFIG, "r.json")
-    check_evals({"step": ("1000",), "success": ("0.5",), "return": ("1.5",), "length": ("",)}, 1010, "e.csv")
-    check_episodes({"step": ("10", "20"), "return": ("-3.0", "1"), "success": ("0", "1")}, 1010, "p.csv")
-    check_episodes({"step": (), "return": (), "success": ()}, 1010, "p.csv")  # no episode yet
+    evals = check_evals({"step": ("1000",), "success": ("0.5",), "return": ("1.5",), "length": ("",)}, 1010, "e.csv")
+    episodes = check_episodes({"step": ("10", "20"), "return": ("-3.0", "1"), "success": ("0", "1")}, 1010, "p.csv")
+    none = check_episodes({"step": (), "return": (), "success": ()}, 1010, "p.csv")  # no episode yet
+    # the checks give the columns they read as floats, for a reader that would parse them again
+    assert {k: v.tolist() for k, v in evals.items()} == {"step": [1000.0], "success": [0.5]}
+    assert {k: v.tolist() for k, v in episodes.items()} == {"step": [10.0, 20.0], "return": [-3.0, 1.0],
+                                                            "success": [0.0, 1.0]}
+    assert all(v.dtype == np.float64 and v.shape == (0,) for v in none.values()) and len(none) == 3

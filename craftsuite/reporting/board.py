@@ -41,7 +41,7 @@ import numpy as np
 from .. import stats
 from ..completion import needs_reread
 from ..progress import progress_bar
-from ..record_format import RecordError, check_config, check_episodes, check_evals, check_result
+from ..record_format import RecordError, breaks_format, check_config, check_episodes, check_evals, check_result
 from ..record_format import required as required_columns
 from ..runs import RunError, evaluation_steps, flatten, read_config, read_log_columns, read_result, run_settings
 
@@ -145,7 +145,7 @@ def run_metrics(run: Path) -> dict | None:
         eval_columns = check_evals(raw_evals, result["steps"], run / "evals.csv")
         episode_columns = check_episodes(raw_episodes, result["steps"], run / "episodes.csv")
     except RecordError as err:
-        raise RunError(f"{err}: the record breaks the record format (docs/records.md)") from None
+        raise RunError(breaks_format(err)) from None
     budget = int(config["steps"])
     # the curves' arrays (Curves), as the checks above read them
     episodes = np.column_stack([episode_columns[name] for name in ("step", "return", "success")])

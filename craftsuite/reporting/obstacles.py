@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..record_format import RecordError, completions, required
+from ..record_format import RecordError, breaks_format, completions, required
 from ..runs import RunError, read_columns, read_config, reading_log
 
 
@@ -108,10 +108,6 @@ def _edge_name(automaton, source: int, target: int) -> str:
     return automaton.guard(source, target, sink_free=True)
 
 
-# a row logged before the ``seen`` and ``states`` columns came: no mask (a real one is never negative)
-_NONE = np.iinfo(np.int64).min
-
-
 def episode_progress(run) -> Progress | None:
     """What the training episodes of the run at ``run`` reached; None for a record made before
     ``episodes.csv`` had its ``seen`` and ``states`` columns (no episode carries them).
@@ -125,37 +121,49 @@ def episode_progress(run) -> Progress | None:
     budget = _budget(run, config)
     spec = _spec(run, config)
     path = run / "episodes.csv"  # (or the archive's episodes.csv.gz: read_columns reads either)
-    log, completed = _episodes(path)
-    with reading_log(path):  # (the masks' conversions too)
-        seen, states = (_masks(log, name, len(completed)) for name in ("seen", "states"))
-    if len(completed) and not ((seen != _NONE) & (states != _NONE)).any():
+    log, completed = _read_episodes(path)
+    with reading_log(path):  # (a mask that does not read: the file named)
+        (seen, seen_given), (states, states_given) = (_masks(log, name, len(completed)) for name in ("seen", "states"))
+    marked = seen_given & states_given
+    if len(completed) and not marked.any():
         return None
     try:
-        return summarize(spec.automaton, spec.name, budget, completed, seen, states)
+        return summarize(spec.automaton, spec.name, budget, completed, seen, states, marked)
     except ValueError as err:
         raise RunError(f"{path}: {err}: the record was made with another automaton") from None
 
 
-def _masks(log: dict, name: str, n: int) -> np.ndarray:
-    """The ``seen`` or ``states`` column of a log's columns as int64 masks, ``_NONE`` where a
-    row has none (an empty cell, or no column at all).
+def _masks(log: dict, name: str, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The ``seen`` or ``states`` column of a log's ``n`` rows as int64 masks, and whether each
+    row has one (not an empty cell, logged before the column came, nor a log without it).
 
     Raises:
-        ValueError: a cell that is no integer, or one beyond 64 bits.
+        ValueError: the first cell that is no integer, or none a 64-bit mask holds, named by its line.
     """
-    out = np.full(n, _NONE, dtype=np.int64)
-    if name not in log:
-        return out
-    text = np.asarray(log[name], dtype=str)
-    given = text != ""
-    try:
-        out[given] = text[given].astype(np.int64)
-    except OverflowError:
-        raise ValueError(f"a {name} cell holds more bits than 64") from None
-    return out
+    values, given = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=bool)
+    cells = log.get(name)
+    if cells is None:
+        return values, given
+    given = np.fromiter((cell != "" for cell in cells), dtype=bool, count=n)
+    try:  # int() as the log's writer wrote them (numpy's own parsing of strings drops NUL bytes)
+        values[given] = np.fromiter((int(cell) for cell in cells if cell != ""), dtype=np.int64,
+                                    count=int(given.sum()))
+    except (ValueError, OverflowError):
+        for line, cell in enumerate(cells, start=2):  # the first cell that is no mask, named
+            if cell == "":
+                continue
+            try:
+                mask = int(cell)
+            except ValueError:
+                raise ValueError(f"line {line}: {name} {cell!r} is not an integer") from None
+            if not -2**63 <= mask < 2**63:
+                raise ValueError(f"line {line}: {name} {cell} is beyond a signed 64-bit mask (every task's "
+                                 "propositions and states are its bits 0 to 62)") from None
+        raise
+    return values, given
 
 
-def _episodes(path: Path) -> tuple[dict, np.ndarray]:
+def _read_episodes(path: Path) -> tuple[dict, np.ndarray]:
     """A run's ``episodes.csv`` as columns, and its episodes' completions (0/1) as the record
     format checks them."""
     with reading_log(path):
@@ -163,7 +171,7 @@ def _episodes(path: Path) -> tuple[dict, np.ndarray]:
     try:
         return log, completions(log, path)
     except RecordError as err:
-        raise RunError(f"{err}: the record breaks the record format (docs/records.md)") from None
+        raise RunError(breaks_format(err)) from None
 
 
 def _budget(run: Path, config: dict) -> int:
@@ -174,23 +182,24 @@ def _budget(run: Path, config: dict) -> int:
     return budget
 
 
-def summarize(automaton, task: str, budget: int, completed, seen, states) -> Progress:
+def summarize(automaton, task: str, budget: int, completed, seen, states, marked=None) -> Progress:
     """The ``Progress`` of one run of ``budget`` transitions from its episodes: per episode,
-    completed (0/1), ``seen`` and ``states`` in the bits of ``automaton`` (``_NONE`` in both:
-    a row logged before the columns, not counted in the shares).
+    completed (0/1), ``seen`` and ``states`` in the bits of ``automaton``, and ``marked``:
+    whether its row has both (not one logged, before the columns came, by an earlier session
+    of a resumed run; the shares count the marked episodes alone; default: every one).
 
     Raises:
-        ValueError: an episode with bits the automaton has no proposition or state for.
+        ValueError: a marked episode with bits the automaton has no proposition or state for.
     """
-    completed, seen, states = (np.asarray(x).reshape(-1) for x in (completed, seen, states))
+    completed, seen, states = (np.asarray(x, dtype=np.int64) for x in (completed, seen, states))
+    marked = np.ones(len(completed), dtype=bool) if marked is None else np.asarray(marked, dtype=bool)
     n_props, n_states = len(automaton.propositions), automaton.n_states
     far = distances(automaton)
-    marked = (seen != _NONE) & (states != _NONE)
     seen, states = seen[marked], states[marked]
     wrong = (seen < 0) | (states < 0) | ((seen >> n_props) != 0) | ((states >> n_states) != 0)
     if wrong.any():
         first = int(np.flatnonzero(wrong)[0])
-        number = int(np.flatnonzero(marked)[first]) + 1
+        number = int(np.flatnonzero(marked)[first]) + 1  # counting every episode, marked or not
         raise ValueError(f"episode {number} (line {number + 1}: seen {seen[first]}, states {states[first]}) names "
                          f"propositions or states that task {task!r} does not have ({n_props} propositions, "
                          f"{n_states} states)")
@@ -198,11 +207,12 @@ def summarize(automaton, task: str, budget: int, completed, seen, states) -> Pro
     visits = [((states >> q) & 1) == 1 for q in range(n_states)]
     state_counts = [int(v.sum()) for v in visits]
     # each episode's closest visited state: the fewest edges to acceptance among those it visited
-    closest = np.full(len(states), np.iinfo(np.int64).max)
+    unreached = np.iinfo(np.int64).max  # an episode that visited no state acceptance can be reached from
+    closest = np.full(len(states), unreached)
     for q, dq in enumerate(far):
         if dq is not None:
             closest = np.where(visits[q], np.minimum(closest, dq), closest)
-    near, counts = np.unique(closest[closest != np.iinfo(np.int64).max], return_counts=True)
+    near, counts = np.unique(closest[closest != unreached], return_counts=True)
     done = int(completed.sum())
     return _progress(task, 1, budget, len(completed), done, done * 100_000 / budget, int(marked.sum()),
                      automaton.propositions, seen_counts, state_counts,
@@ -293,4 +303,5 @@ def completed_per_100k(run) -> float:
     ``success`` column (every record has it, old ones too)."""
     run = Path(run)
     budget = _budget(run, read_config(run))
-    return float(_episodes(run / "episodes.csv")[1].sum()) * 100_000 / budget
+    _, completed = _read_episodes(run / "episodes.csv")
+    return float(completed.sum()) * 100_000 / budget

@@ -10,7 +10,7 @@ import pytest
 
 from craftsuite.automata import Automaton
 from craftsuite.reporting.obstacles import completed_per_100k, distances, episode_progress, method_progress, pool
-from craftsuite.reporting.obstacles import summarize as summarize_arrays
+from craftsuite.reporting.obstacles import summarize
 from craftsuite.runs import EPISODE_CORE, EPISODE_FIELDS, RunError, write_csv
 from craftsuite.task_registry import resolve_task
 
@@ -29,10 +29,14 @@ def _hand_made() -> Automaton:
     return Automaton("hand-made", ("a", "b"), delta, np.array([False, False, True, False, False]))
 
 
-def summarize(automaton, task, budget, episodes):
-    """``summarize`` of episodes written as (completed, seen, states) rows."""
-    completed, seen, states = (np.array(column, dtype=np.int64) for column in zip(*episodes))
-    return summarize_arrays(automaton, task, budget, completed, seen, states)
+def summarize_rows(automaton, task, budget, episodes):
+    """``summarize`` of episodes written as (completed, seen, states) rows, None where a row
+    has no mask (logged before the columns came)."""
+    completed = [won for won, _, _ in episodes]
+    marked = [seen is not None and states is not None for _, seen, states in episodes]
+    seen = [mask or 0 for _, mask, _ in episodes]
+    states = [mask or 0 for _, _, mask in episodes]
+    return summarize(automaton, task, budget, completed, seen, states, marked)
 
 
 def test_distances_count_edges_to_acceptance_without_self_loops_or_the_sink():
@@ -46,24 +50,31 @@ def test_furthest_is_the_visited_state_closest_to_acceptance():
     automaton = _hand_made()
     # (completed, seen, states): one reached 1, one wandered to 4 and died in the sink, one stayed at 0
     episodes = [(0, 0b01, 0b00011), (0, 0b11, 0b11001), (0, 0b00, 0b00001)]
-    progress = summarize(automaton, "hand-made", 1_000, episodes)
+    progress = summarize_rows(automaton, "hand-made", 1_000, episodes)
     assert (progress.furthest.state, progress.furthest.distance) == (1, 1)
     assert progress.furthest.share == pytest.approx(1 / 3)
     assert progress.closest_share == pytest.approx({1: 1 / 3, 2: 2 / 3})
     assert progress.state_share == pytest.approx({0: 1.0, 1: 1 / 3, 2: 0.0, 3: 1 / 3, 4: 1 / 3})
     assert progress.seen_share == pytest.approx({"a": 2 / 3, "b": 1 / 3})
     # the sink, whatever it is next to, is never the furthest: it cannot get to acceptance
-    stuck = summarize(automaton, "hand-made", 1_000, [(0, 0b11, 0b01001)])
+    stuck = summarize_rows(automaton, "hand-made", 1_000, [(0, 0b11, 0b01001)])
     assert (stuck.furthest.state, stuck.furthest.distance, stuck.furthest.share) == (0, 2, 1.0)
     # an accepted episode: distance 0, whatever the others reached
-    done = summarize(automaton, "hand-made", 1_000, [(1, 0b11, 0b00111), (0, 0b10, 0b10001), (0, 0b10, 0b10001)])
+    done = summarize_rows(automaton, "hand-made", 1_000, [(1, 0b11, 0b00111), (0, 0b10, 0b10001), (0, 0b10, 0b10001)])
     assert (done.furthest.state, done.furthest.distance) == (2, 0) and done.furthest.share == pytest.approx(1 / 3)
     assert done.completed_per_100k == pytest.approx(100.0)
     # 0 and 4 are both 2 away: 4, a step from the start, is further along
-    tie = summarize(automaton, "hand-made", 1_000, [(0, 0b10, 0b10001)])
+    tie = summarize_rows(automaton, "hand-made", 1_000, [(0, 0b10, 0b10001)])
     assert (tie.furthest.state, tie.furthest.distance, tie.furthest.share) == (4, 2, 1.0)
     with pytest.raises(ValueError, match="episode 1 .*states 32"):
-        summarize(automaton, "hand-made", 1_000, [(0, 0, 0b100000)])  # a state the automaton does not have
+        summarize_rows(automaton, "hand-made", 1_000, [(0, 0, 0b100000)])  # a state the automaton does not have
+    # rows without a mask (either of the two) are episodes, but not in the shares; an episode's
+    # number counts them all
+    partly = summarize_rows(automaton, "hand-made", 1_000, [(1, None, 0b00111), (0, 0b01, None), (0, 0b01, 0b00011)])
+    assert (partly.episodes, partly.completed, partly.marked) == (3, 1, 1)
+    assert partly.state_share == pytest.approx({0: 1.0, 1: 1.0, 2: 0.0, 3: 0.0, 4: 0.0})
+    with pytest.raises(ValueError, match=r"episode 3 \(line 4: seen -9223372036854775808"):
+        summarize_rows(automaton, "hand-made", 1_000, [(0, None, None), (0, 0b01, 0b00011), (0, -2**63, 0b1)])
 
 
 def _run(root, task="Reach", world="Grid10", budget=1_000, rows=(), fields=EPISODE_FIELDS, seed=0, **config):
@@ -125,9 +136,13 @@ def test_bad_records_are_named(tmp_path):
     garbled = _run(tmp_path, rows=[(300, -20.0, 200, 0, "x", 0b01)], seed=1)
     with pytest.raises(RunError, match=r"episodes.csv does not read as a run's log"):
         episode_progress(garbled)
-    huge = _run(tmp_path, rows=[(300, -20.0, 200, 0, 0, 2**64)], seed=6)
-    with pytest.raises(RunError, match=r"episodes.csv does not read as a run's log .*states cell holds more bits"):
+    huge = _run(tmp_path, rows=[(300, -20.0, 200, 0, 0, 1), (420, -20.0, 200, 0, 0, 2**63)], seed=6)
+    with pytest.raises(RunError, match=r"episodes.csv does not read as a run's log .*line 3: states "
+                                       "9223372036854775808 is beyond a signed 64-bit mask"):
         episode_progress(huge)
+    nul = _run(tmp_path, rows=[(300, -20.0, 200, 0, 0, "1\x00")], seed=8)  # what a crash leaves in a torn file
+    with pytest.raises(RunError, match=r"line 2: states '1\\x00' is not an integer"):
+        episode_progress(nul)
     # a completion is 0 or 1, as the record format has it (the board refuses the same log)
     half = _run(tmp_path, rows=[(300, -20.0, 200, 0.5, 0, 0b01)], seed=7)
     for read in (episode_progress, completed_per_100k):

@@ -123,7 +123,8 @@ def episode_progress(run) -> Progress | None:
     path = run / "episodes.csv"  # (or the archive's episodes.csv.gz: read_columns reads either)
     log, completed = _read_episodes(path)
     with reading_log(path):  # (a mask that does not read: the file named)
-        (seen, seen_given), (states, states_given) = (_masks(log, name, len(completed)) for name in ("seen", "states"))
+        seen, seen_given = _masks(log, "seen", len(completed))
+        states, states_given = _masks(log, "states", len(completed))
     marked = seen_given & states_given
     if len(completed) and not marked.any():
         return None

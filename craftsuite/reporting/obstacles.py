@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..record_format import RecordError, breaks_format, completions, required
+from ..record_format import RecordError, breaks_format, check_config, completions, required
 from ..runs import RunError, read_columns, read_config, reading_log
 
 
@@ -176,11 +176,13 @@ def _read_episodes(path: Path) -> tuple[dict, np.ndarray]:
 
 
 def _budget(run: Path, config: dict) -> int:
-    """A student's transitions budget, as its ``config.json`` records it."""
-    budget = config.get("steps")
-    if not isinstance(budget, int) or isinstance(budget, bool) or budget <= 0:
-        raise RunError(f"{run / 'config.json'} records no transitions budget (steps): not a student's record")
-    return budget
+    """A student's transitions budget, as its ``config.json`` records it (the record format's
+    check of a config, whose ``steps`` is that budget)."""
+    try:
+        check_config(config, run / "config.json")
+    except RecordError as err:
+        raise RunError(breaks_format(err)) from None
+    return config["steps"]
 
 
 def summarize(automaton, task: str, budget: int, completed, seen, states, marked=None) -> Progress:

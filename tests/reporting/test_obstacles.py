@@ -161,7 +161,7 @@ def test_bad_records_are_named(tmp_path):
     record = json.loads((teacher / "config.json").read_text())
     del record["steps"]
     (teacher / "config.json").write_text(json.dumps({**record, "max_steps": 1_000}))
-    with pytest.raises(RunError, match="no transitions budget"):
+    with pytest.raises(RunError, match=r"config.json: lacks steps: the record breaks the record format"):
         episode_progress(teacher)
 
 

@@ -16,7 +16,7 @@ def _task(argument: str, world: str | None = None) -> str:
     command picks a world (e.g. ``the world with --world``), said where an id was given.
 
     Raises:
-        KeyError: an unknown task name, listing the known ones.
+        UnknownName: an unknown task name (a KeyError), listing the closest and the known ones.
         SpecError: a spec file that is missing or cannot be used.
         ValueError: an id (or something shaped like one) where a task goes.
     """
@@ -42,7 +42,7 @@ def _registered(task: str, world: str) -> str:
     name = env_id(task, world)
     if name not in gym.registry:
         worlds = [parse_id(i)[1] for i in registered_ids() if parse_id(i)[0] == task]
-        raise ValueError(f"task {task!r} has no {world} world; its worlds: {worlds}")
+        raise ValueError(f"task {task!r} has no {world} world; its worlds: {', '.join(worlds)}")
     return name
 
 
@@ -394,11 +394,9 @@ def _transfer(args) -> int:
     from .methods import resolve_method
     from .provenance import command_line
     from .suite_runner import TimeLimitReached, WorkerLost, transfer
-    from .suites import SUITES
+    from .suites import suite_named
 
-    if args.suite not in SUITES:
-        raise KeyError(f"unknown suite {args.suite!r}; suites: {sorted(SUITES)}")
-    suite = SUITES[args.suite]
+    suite = suite_named(args.suite)
     if args.tags is not None or args.tasks is not None:  # the rungs given replace the suite's
         suite = dataclasses.replace(suite, tags=tuple(args.tags or ()),
                                     tasks=tuple(_task(t, "the worlds with --worlds") for t in args.tasks or ()))
@@ -440,7 +438,7 @@ def _transfer(args) -> int:
     settings = {"student_steps", "teacher_max_steps", "eval_every", "dqn_overrides", "teacher_hyperparameters",
                 "cont_world_kwargs", "kinematic_world_kwargs", "td3_overrides", "engine"}
     # and a rung, world or method the suite does not run would be filed under a suite it is not part of
-    registered = SUITES[args.suite]
+    registered = suite_named(args.suite)
     beyond = ({s.name for s in suite.rungs()} - {s.name for s in registered.rungs()}
               or set(suite.worlds) - set(registered.worlds) or set(suite.methods) - set(registered.methods))
     own = suite.archived and not settings & set(changes) and not beyond
@@ -477,16 +475,15 @@ def _archive(args) -> int:
     from .archive import add, scan, size
     from .files import directory_to_write
     from .provenance import command_line, read, record_session, start_session
-    from .suites import SUITES
+    from .suites import suite_named
 
-    if args.suite not in SUITES:
-        raise KeyError(f"unknown suite {args.suite!r}; suites: {sorted(SUITES)}")
+    suite = suite_named(args.suite)
     session = start_session(command_line())
     directory_to_write(args.archive, "--archive")
     archive = directory_to_write(Path(args.archive) / args.suite, "--archive")
     read(archive)  # a damaged provenance.json there, named before anything is kept
     # every source read and checked before anything is kept: a refused command leaves the archive as it was
-    sources = [scan(source, SUITES[args.suite]) for source in args.runs]
+    sources = [scan(source, suite) for source in args.runs]
     for source in sources:
         for reason in source.skipped:
             print(f"skipped {reason}")

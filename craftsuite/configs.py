@@ -126,7 +126,8 @@ class StudentConfig:
             raise ValueError(f"world_kwargs must be a dict of gymnasium.make keywords, got {self.world_kwargs!r}")
         owned = sorted({"product", "layout_seed"} & set(self.world_kwargs))
         if owned:
-            raise ValueError(f"world_kwargs may not set {owned}: the method sets product, layout_seed its own field")
+            raise ValueError(f"world_kwargs may not set {', '.join(owned)}: the method sets product, layout_seed its "
+                             "own field")
 
     @property
     def env_id(self) -> str:
@@ -162,7 +163,7 @@ class StudentConfig:
 
 def _check_engine(engine) -> None:
     if engine not in ENGINES:
-        raise ValueError(f"engine must be one of {list(ENGINES)}, got {engine!r}")
+        raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
 
 
 def _check_n_envs(n_envs) -> None:

@@ -42,21 +42,21 @@ def protocol(env: str, suite: str = "standard", step: int | None = None):
         ValueError: not a CraftSuite id, an unknown suite, or a task the suite has no
             budget for while no ``step`` is given; each named with its fix.
     """
-    from .suites import SUITES
+    from .suites import SUITES, suite_named
     from .task_registry import resolve_task
 
     if not (isinstance(env, str) and is_id(env)):
         parse_id(env)  # its message names the id's form
-    if suite not in SUITES:
-        raise ValueError(f"unknown suite {suite!r}; suites: {sorted(SUITES)}")
+    chosen = suite_named(suite)
     task, world = parse_id(env)
     spec = resolve_task(task)
-    config = _scratch_config(SUITES[suite], spec, world)
+    config = _scratch_config(chosen, spec, world)
     if config is None:  # no budget for its level in this world: the rung is another suite's
         theirs = [name for name, s in SUITES.items() if _scratch_config(s, spec, world) is not None]
         theirs = [name for name in theirs if world in SUITES[name].worlds] or theirs  # those running it first
         raise ValueError(f"{task} in {world} is not a rung of the {suite!r} suite, whose protocol (budget, "
-                         f"evaluations) an evaluation follows: give suite= one of {theirs or sorted(SUITES)}")
+                         f"evaluations) an evaluation follows: give suite= one of "
+                         + ", ".join(repr(name) for name in theirs or sorted(SUITES)))
     return config, config.steps if step is None else step
 
 

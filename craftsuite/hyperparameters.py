@@ -10,6 +10,7 @@ from collections.abc import Mapping
 from types import MappingProxyType
 
 from .methods import ALGORITHMS
+from .names import unknown_name
 
 # The algorithms' settings before a run's overrides. The authors' DQN, changed where a
 # small MLP on one env needs it (measured when the teachers were tuned): a hard target
@@ -119,7 +120,7 @@ def hyperparameter_examples(algorithm: str) -> dict:
     """Every setting ``algorithm`` takes from a run, with an example value of each: its
     CraftSuite default, else the library's."""
     if algorithm not in ALGORITHMS:
-        raise KeyError(f"unknown algorithm {algorithm!r}; algorithms: {list(ALGORITHMS)}")
+        raise unknown_name("algorithm", algorithm, ALGORITHMS)
     return {**(TD3_MORE if algorithm == "td3" else DQN_MORE), **(TD3_DEFAULTS if algorithm == "td3" else DQN_DEFAULTS)}
 
 
@@ -163,7 +164,7 @@ def check_hyperparameters(algorithm: str, overrides: Mapping | None, source: str
             raise HyperparameterError(f"{source}: {name} must be {bound} ({shown}), got {value!r}")
         choices = DQN_CHOICES.get(name) if algorithm == "dqn" else None
         if choices and value not in choices:
-            raise HyperparameterError(f"{source}: {name} must be one of {list(choices)}, got {value!r}")
+            raise HyperparameterError(f"{source}: {name} must be one of {', '.join(choices)}, got {value!r}")
     return overrides
 
 

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 
 from .ids import WORLD_KINDS
+from .names import unknown_name
 
 # the algorithm family of each world kind: DQN needs discrete moves, TD3 continuous thrust
 ALGORITHMS = MappingProxyType({"dqn": "Grid", "td3": "Cont"})
@@ -56,11 +57,11 @@ class Method:
     def __post_init__(self):
         where = f"METHODS row {self.name!r}"
         if self.world not in WORLD_KINDS:
-            raise MethodError(f"{where}: world {self.world!r} does not exist; worlds: {list(WORLD_KINDS)}")
+            raise MethodError(f"{where}: world {self.world!r} does not exist; worlds: {', '.join(WORLD_KINDS)}")
         if ALGORITHMS.get(self.algorithm) != self.world:
             fits = [a for a, w in ALGORITHMS.items() if w == self.world]
             raise MethodError(f"{where}: algorithm {self.algorithm!r} does not run in the {self.world} world; "
-                              f"use one of {fits}")
+                              f"use one of {', '.join(fits)}")
         if self.distill not in DISTILLATIONS:
             raise MethodError(f"{where}: distill must be one of {list(DISTILLATIONS)}, got {self.distill!r}")
         if self.shaping not in DISTILLATIONS:
@@ -74,7 +75,7 @@ class Method:
                               f"got {self.potential_sign!r}")
         unknown = sorted(set(self.target) - set(TARGET_DEFAULTS))
         if unknown or (self.target and self.distill is None):
-            raise MethodError(f"{where}: target takes {sorted(TARGET_DEFAULTS)} and only with distill; "
+            raise MethodError(f"{where}: target takes {', '.join(sorted(TARGET_DEFAULTS))} and only with distill; "
                               f"got {self.target!r}")
         object.__setattr__(self, "target", MappingProxyType(dict(self.target)))  # a row of a read-only table
 
@@ -285,11 +286,11 @@ def _product_of(kind: str) -> str | None:
 
 
 def check_methods(names) -> None:
-    """Raise KeyError naming the unknown methods and the known ones."""
+    """Raise UnknownName (a KeyError) naming the unknown methods, the closest known ones and every known one."""
     unknown = [n for n in names if n not in METHODS]
     if unknown:
-        raise KeyError(f"unknown method(s) {unknown}; methods: {list(METHODS)} (a row of your own: "
-                       "module:name, whose module calls craftsuite.methods.register_method)")
+        raise unknown_name("method", unknown, METHODS, "(a row of your own: module:name, whose module calls "
+                           "craftsuite.methods.register_method)")
 
 
 load_entry_points()

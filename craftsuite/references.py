@@ -38,7 +38,7 @@ def reference(env_id: str, policy: str, episodes: int = 100, seed: int = 0) -> R
     from .scripted import scripted_policy
 
     if policy not in POLICIES:
-        raise ValueError(f"policy must be one of {POLICIES}, got {policy!r}")
+        raise ValueError(f"policy must be one of {', '.join(POLICIES)}, got {policy!r}")
     env = gym.make(env_id)
     if policy == "scripted":
         act = scripted_policy(env)

@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .hyperparameters import hyperparameter_examples
+from .names import unknown_name
 
 
 @dataclass(frozen=True)
@@ -88,7 +89,7 @@ def order(name: str) -> tuple:
 
 def check_regime(name: str) -> Regime:
     if name not in REGIMES:
-        raise ValueError(f"unknown learner regime {name!r}; regimes: {list(REGIMES)}")
+        raise unknown_name("learner regime", name, REGIMES)
     return REGIMES[name]
 
 

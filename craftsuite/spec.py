@@ -68,6 +68,7 @@ from typing import Any
 from .automata import Automaton, LTLfSyntaxError, compile_ltlf, parse
 from .automata.ltlf import atoms
 from .ids import TASK_NAME
+from .names import unknown_name
 from .paths import assets_dir, tasks_dir
 
 __all__ = [
@@ -365,7 +366,7 @@ class _Reader:
     def keys(self, data: dict, allowed: set[str], where: str):
         unknown = set(data) - allowed
         if unknown:
-            self.fail(where, f"unknown key(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
+            self.fail(where, str(unknown_name("key", sorted(unknown), sorted(allowed))))
 
     def int(self, data: dict, key: str, where: str, default=None, minimum: int = 0) -> int:
         value = data.get(key, default)
@@ -393,7 +394,7 @@ class _Reader:
         data = self.table(data, where)
         for name, n in data.items():
             if name not in known:
-                self.fail(where, f"unknown inventory name {name!r}; known: {sorted(known)}")
+                self.fail(where, str(unknown_name("inventory name", name, sorted(known))))
             if not isinstance(n, int) or isinstance(n, bool) or n < 1:
                 self.fail(f"{where}.{name}", f"must be a positive integer, got {n!r}")
         return dict(data)
@@ -611,7 +612,7 @@ def _recipes(r: _Reader, raw_recipes: list, raw_places: dict, inventory: set[str
         r.keys(rec, {"at", "consume", "produce", "repeat"}, where)
         at = rec.get("at")
         if at is not None and at not in raw_places:
-            r.fail(f"{where}.at", f"unknown place {at!r}; places: {sorted(raw_places)}")
+            r.fail(f"{where}.at", str(unknown_name("place", at, sorted(raw_places))))
         repeat = rec.get("repeat", False)
         if not isinstance(repeat, bool):
             r.fail(f"{where}.repeat", f"must be true or false, got {repeat!r}")
@@ -639,11 +640,11 @@ def _propositions(r: _Reader, data: dict, raw_places: dict, inventory: set[str])
         (kind, arg), = table.items()
         if kind == "obtained":
             if arg not in inventory:
-                r.fail(f"{where}.obtained", f"unknown inventory name {arg!r}; known: {sorted(inventory)}")
+                r.fail(f"{where}.obtained", str(unknown_name("inventory name", arg, sorted(inventory))))
             props.append(Proposition(prop, kind, arg))
         elif kind == "arrived":
             if arg not in raw_places:
-                r.fail(f"{where}.arrived", f"unknown place {arg!r}; places: {sorted(raw_places)}")
+                r.fail(f"{where}.arrived", str(unknown_name("place", arg, sorted(raw_places))))
             props.append(Proposition(prop, kind, arg))
         elif kind in COUNTED:
             counts = r.counts(arg, f"{where}.{kind}", inventory)
@@ -665,8 +666,8 @@ def _formula(r: _Reader, data: dict, props: tuple[Proposition, ...]) -> str:
         r.fail("formula", str(err))
     unknown = atoms(ast) - {p.name for p in props}
     if unknown:
-        r.fail("formula", f"uses unknown proposition(s) {sorted(unknown)}; declared in "
-                          f"[propositions]: {[p.name for p in props]}")
+        r.fail("formula", str(unknown_name("proposition", sorted(unknown), [p.name for p in props],
+                                           "(declared in [propositions])")))
     return formula
 
 

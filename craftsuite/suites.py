@@ -14,6 +14,7 @@ from pathlib import Path
 from .configs import DEFAULT_ENGINE, StudentConfig, TeacherConfig
 from .ids import CONT, KINEMATIC, WORLD_KINDS, world_kind
 from .methods import METHODS, check_methods, methods_for
+from .names import unknown_name
 from .regimes import check_regime
 from .spec import TaskSpec
 from .task_registry import ladder, resolve_task
@@ -165,8 +166,8 @@ class Suite:
                     out += [self.student_config(spec, world, method, seed, table)
                             for seed in range(self.seeds_for(spec, world))]
         if not out:
-            raise ValueError(f"no method of {list(self.methods)} runs in the worlds {list(self.worlds)} "
-                             f"({', '.join(f'{w}: {methods_for(w)}' for w in self.worlds)})")
+            raise ValueError(f"no method of {', '.join(self.methods)} runs in the worlds {', '.join(self.worlds)} "
+                             f"({'; '.join(f'{w}: ' + ', '.join(methods_for(w)) for w in self.worlds)})")
         return out
 
     def student_config(self, spec: TaskSpec, world: str, method: str, seed: int = 0,
@@ -297,3 +298,14 @@ SUITES = {s.name: s for s in (
                                                                     "buffer_size": 200_000},
           **DQN_REGIME),
 )}
+
+
+def suite_named(name: str) -> Suite:
+    """The suite called ``name``.
+
+    Raises:
+        UnknownName: no such suite (a KeyError and a ValueError), naming the suites.
+    """
+    if name not in SUITES:
+        raise unknown_name("suite", name, SUITES)
+    return SUITES[name]

@@ -18,6 +18,7 @@ from collections.abc import Mapping
 from functools import lru_cache
 from pathlib import Path
 
+from .names import unknown_name
 from .spec import TaskSpec, builtin_specs, load_spec
 
 SPEC_SUFFIX = ".toml"  # a task argument ending so names a spec file, not a task
@@ -45,14 +46,13 @@ def ladder(*tags: str) -> list[TaskSpec]:
     ``tags``, only those that carry any of them.
 
     Raises:
-        KeyError: a tag that no task spec carries, naming the tags in use.
+        UnknownName: a tag that no task spec carries (a KeyError), naming the tags in use.
     """
     known = tasks().values()
     in_use = sorted({t for spec in known for t in spec.tags})
     unknown = [t for t in tags if t not in in_use]
     if unknown:
-        raise KeyError(f"no task spec has {'tag' if len(unknown) == 1 else 'tags'} {unknown} in its 'tags' field; "
-                       f"tags in use: {in_use}")
+        raise unknown_name("tag", unknown, in_use, "(the tags the task specs' 'tags' fields hold)")
     return sorted((s for s in known if not tags or set(tags) & set(s.tags)), key=lambda s: s.rung)
 
 
@@ -79,7 +79,7 @@ def resolve_task(task: str | TaskSpec | Mapping) -> TaskSpec:
     """The spec of a task given by name, by spec, or as data (``carried``).
 
     Raises:
-        KeyError: an unknown name, listing the known ones.
+        UnknownName: an unknown name (a KeyError), listing the closest and every known one.
         SpecError: data that is no valid spec.
     """
     if isinstance(task, TaskSpec):
@@ -92,8 +92,8 @@ def resolve_task(task: str | TaskSpec | Mapping) -> TaskSpec:
         return _from_data(text)
     known = tasks()
     if task not in known:
-        raise KeyError(f"unknown task {task!r}; known tasks: {sorted(known)} "
-                       f"(or a spec file, path/to/task{SPEC_SUFFIX}; add one with craftsuite.register_task)")
+        raise unknown_name("task", task, sorted(known),
+                           f"(or a spec file, path/to/task{SPEC_SUFFIX}; add one with craftsuite.register_task)")
     return known[task]
 
 

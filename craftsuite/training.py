@@ -71,10 +71,9 @@ def train_teacher(config: TeacherConfig, root, progress: bool = True, device: st
 def train_student(config: StudentConfig, root, progress: bool = True, device: str = "cpu") -> Path:
     """A student (or baseline) run under ``root``; returns its directory. ``device``: the
     population engine's torch device."""
-    from .methods import METHODS
+    from .methods import check_methods
 
-    if config.method not in METHODS:
-        raise KeyError(f"unknown method {config.method!r}; methods: {sorted(METHODS)}")
+    check_methods([config.method])
     if config.engine == "sb3":
         return finished_sb3_run(config, root)
     from .population import train_population

@@ -55,8 +55,8 @@ def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
 
 @pytest.mark.parametrize("command,message", [
     (["student", "BlindCraftsman", "--method", "td3", "--env", '{"frame_skp": 10}'],
-     "--env: unknown keyword 'frame_skp' for the MuJoCo world; it accepts render_mode, width, height, "
-     "frame_skip, status_panel, max_episode_steps"),
+     "--env: unknown keyword 'frame_skp' (did you mean frame_skip?) for the MuJoCo world; it accepts render_mode, "
+     "width, height, frame_skip, status_panel, max_episode_steps"),
     (["student", "BlindCraftsman", "--method", "dqn", "--world", "Grid7", "--env", '{"width": 480}'],
      "--env: width: the grid world draws every cell 32 pixels a side"),
     (["student", "BlindCraftsman", "--method", "dqn", "--world", "Grid7", "--hyper", '{"batch_size": -1}'],

@@ -146,7 +146,7 @@ def test_the_leaderboard_sets_self_reported_runs_beside_every_regimes_own(tmp_pa
 @pytest.mark.parametrize("env,suite,message", [
     # the quick suite runs Reach in MuJoCo alone: its protocol has no grid budget to follow
     ("CraftSuite/Reach-Grid10-v0", "quick", "Reach in Grid10 is not a rung of the 'quick' suite, whose protocol "
-     "(budget, evaluations) an evaluation follows: give suite= one of ['standard', 'paper']"),
+     "(budget, evaluations) an evaluation follows: give suite= one of 'standard', 'paper'"),
     # the standard suite has a grid budget, but runs no Grid7: a record there would sit beside none of its runs
     ("CraftSuite/Reach-Grid7-v0", "standard", "the 'standard' suite runs no Grid7 world (its worlds: Grid10, Cont): "
      "record in one of them, e.g. CraftSuite/Reach-Grid10-v0"),

@@ -51,7 +51,7 @@ def test_a_student_trains_and_is_evaluated_in_the_world_its_config_names(tmp_pat
     assert {int(e["length"]) for e in read_csv(path / "episodes.csv")} == {40}  # 200 steps: 5 truncated episodes
     assert [kwargs for _, kwargs in seen] == [world, world]
     assert json.loads((path / "result.json").read_text())["env_kwargs"] == world  # for its video
-    with pytest.raises(ValueError, match=r"may not set \['product'\]"):
+    with pytest.raises(ValueError, match=r"may not set product: "):
         StudentConfig(world_kwargs={"product": False})
 
 

@@ -106,7 +106,8 @@ class AutomatonQTable:
             with np.load(path, allow_pickle=False) as f:
                 missing = [name for name in ("q", "counts", "meta") if name not in f.files]
                 if missing:
-                    raise DistillationError(f"{where}: it lacks the arrays {missing} (it has {sorted(f.files)})")
+                    raise DistillationError(f"{where}: it lacks the arrays {', '.join(missing)} (it has "
+                                            f"{', '.join(sorted(f.files)) or 'none'})")
                 meta = json.loads(str(f["meta"]))
                 q, counts = f["q"], f["counts"]
         except DistillationError:

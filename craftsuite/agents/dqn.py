@@ -113,9 +113,9 @@ class AutomatonDQN(AutomatonAlgorithm, DQN):
                  target_update_unit: str = "transitions", features_extractor: str = "flatten",
                  layer_norm: bool = False, replay_buffer_kwargs: dict | None = None, **kwargs):
         if loss not in LOSSES:
-            raise ValueError(f"loss must be one of {list(LOSSES)}, got {loss!r}")
+            raise ValueError(f"loss must be one of {', '.join(LOSSES)}, got {loss!r}")
         if target_update_unit not in TARGET_UPDATE_UNITS:
-            raise ValueError(f"target_update_unit must be one of {list(TARGET_UPDATE_UNITS)}, "
+            raise ValueError(f"target_update_unit must be one of {', '.join(TARGET_UPDATE_UNITS)}, "
                              f"got {target_update_unit!r}")
         if env is not None:  # None when SB3 loads a saved agent: its policy_kwargs hold the extractor already
             kwargs["policy_kwargs"] = features_policy_kwargs(features_extractor, env, kwargs.get("policy_kwargs"))

@@ -72,7 +72,7 @@ def features_policy_kwargs(name: str, env, policy_kwargs: dict | None) -> dict:
     if name == "flatten":
         return policy_kwargs
     if name not in FEATURES_EXTRACTORS:
-        raise ValueError(f"features_extractor must be one of {list(FEATURES_EXTRACTORS)}, got {name!r}")
+        raise ValueError(f"features_extractor must be one of {', '.join(FEATURES_EXTRACTORS)}, got {name!r}")
     base = env.get_attr("unwrapped", [0])[0] if isinstance(env, VecEnv) else env.unwrapped
     layout = getattr(base, "observation_layout", None)
     if not isinstance(layout, dict) or "planes" not in layout:

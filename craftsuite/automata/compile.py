@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..files import atomic_path
+from ..names import unknown_name
 from .dfa import MAX_PROPOSITIONS, Automaton, minimize
 from .ltlf import LTLfSyntaxError, atoms, parse
 from .progression import progress_to_dfa
@@ -53,10 +54,7 @@ def _check(formula: str, propositions) -> tuple[tuple[str, ...], tuple]:
     ast = parse(formula)
     unknown = atoms(ast) - set(props)
     if unknown:
-        raise ValueError(
-            f"formula {formula!r} uses unknown propositions {sorted(unknown)}; "
-            f"declared: {list(props)}"
-        )
+        raise unknown_name("proposition", sorted(unknown), props, f"(declared for formula {formula!r})")
     return props, ast
 
 

@@ -8,6 +8,8 @@ from functools import cached_property
 
 import numpy as np
 
+from ..names import unknown_name
+
 MAX_PROPOSITIONS = 16  # the dense table has 2**n columns
 
 
@@ -93,9 +95,7 @@ class Automaton:
             try:
                 bits |= 1 << self.propositions.index(name)
             except ValueError:
-                raise KeyError(
-                    f"unknown proposition {name!r}; this automaton has {list(self.propositions)}"
-                ) from None
+                raise unknown_name("proposition", name, self.propositions, "(this automaton's)") from None
         return bits
 
     def labels(self, mask: int) -> frozenset[str]:

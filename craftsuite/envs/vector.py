@@ -46,6 +46,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from ..names import unknown_name
 from ..spec import TaskSpec
 from ..wrappers import AutomatonObservation
 from .cells import EMPTY, MOVES
@@ -290,8 +291,7 @@ def check_num_envs(num_envs) -> None:
 def _check_kwargs(world: str, kwargs: dict, accepted: tuple[str, ...]) -> None:
     unknown = sorted(set(kwargs) - set(accepted))
     if unknown:
-        raise ValueError(f"unknown keyword(s) {unknown} for the vectorized {world} world; "
-                         f"it accepts {', '.join(accepted)}")
+        raise unknown_name("keyword", unknown, accepted, f"(what the vectorized {world} world accepts)")
     if kwargs.get("render_mode") is not None:
         raise ValueError(f"render_mode={kwargs['render_mode']!r}: the vectorized {world} world does not render; "
                          "make the single env to render (gymnasium.make(id, render_mode=...))")

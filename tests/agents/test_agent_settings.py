@@ -136,7 +136,7 @@ def test_table_errors_name_the_file_and_the_problem(tmp_path, automaton):
     assert "allow_pickle" not in str(err.value)
     other = tmp_path / "other.npz"
     np.savez(other, q=np.zeros((2, 2)))
-    with pytest.raises(DistillationError, match=r"other.npz .* lacks the arrays \['counts', 'meta'\]"):
+    with pytest.raises(DistillationError, match=r"other.npz .* lacks the arrays counts, meta \(it has q\)"):
         AutomatonQTable.load(other)
     good = static_distillation(automaton).save(tmp_path / "t.npz")
     cut = tmp_path / "cut.npz"

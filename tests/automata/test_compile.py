@@ -166,7 +166,8 @@ def test_syntax_errors_name_the_problem(bad, message):
 
 
 def test_unknown_proposition_is_named():
-    with pytest.raises(ValueError, match="unknown propositions \\['gold'\\]"):
+    with pytest.raises(ValueError,
+                       match=r"^unknown proposition 'gold'; propositions: wood \(declared for formula 'F\(gold\)'\)$"):
         compile_ltlf("F(gold)", ("wood",), cache=False)
 
 

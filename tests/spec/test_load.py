@@ -75,7 +75,8 @@ def test_good_spec_loads(tmp_path):
 
 BAD = [
     # (edit to GOOD, field named, problem named)
-    (('F(coin) & G(!trap)', 'F(coin) & G(!lava)'), "formula", "unknown proposition(s) ['lava']"),
+    (('F(coin) & G(!trap)', 'F(coin) & G(!lava)'), "formula", "unknown proposition 'lava'; "
+     "propositions: coin, trap (declared in [propositions])"),
     (('F(coin) & G(!trap)', 'F(coin & '), "formula", "expected"),
     (('coin = { obtained = "coin" }', 'coin = { obtained = "gem" }'), "propositions.coin.obtained",
      "unknown inventory name 'gem'"),
@@ -85,7 +86,7 @@ BAD = [
     (("count = 2", "count = -2"), "items.coin.count", "must be >= 0"),
     (("count = 2", "count = 30"), "grid.sizes", "do not fit a 5x5 grid"),
     (("count = 2", "count = 2\nrequires = { gem = 1 }"), "items.coin.requires", "unknown inventory name 'gem'"),
-    (("count = 2", "count = 2\nwings = 3"), "items.coin", "unknown key(s) ['wings']"),
+    (("count = 2", "count = 2\nwings = 3"), "items.coin", "unknown key 'wings'; keys: "),
     (('name = "Treasure"', 'name = "treasure hunt"'), "name", "CamelCase"),
     (("max_steps = 50", "max_steps = 50\nobstacles = [[9, 9]]"), "grid.obstacles", "outside the 5x5 grid"),
     (("[places.trap]", "[places.trap]\nplacement = \"middle\""), "places.trap.placement", "'random' or 'corner'"),
@@ -101,7 +102,7 @@ BAD = [
     (("count = 2", "count = 2\nkinematic = { label = \"cell\" }"), "items.coin.kinematic.label",
      "only a place can be labelled by its cell"),
     (("[places.trap]", "[places.trap]\nkinematic = { ends = true }"), "places.trap.kinematic",
-     "unknown key(s) ['ends']"),
+     "unknown key 'ends'; keys: consumable, ends_episode, label"),
     (("[places.trap]", "[places.trap]\nkinematic = { requires = { gem = 1 } }"), "places.trap.kinematic.requires",
      "unknown inventory name 'gem'"),
     (('trap = { arrived = "trap" }', 'trap = { exactly = { coin = 0 } }'), "propositions.trap.exactly.coin",

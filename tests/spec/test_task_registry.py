@@ -34,7 +34,7 @@ def test_a_spec_as_data_rebuilds_itself(name):
 
 
 def test_unknown_task_names_the_known_ones():
-    with pytest.raises(KeyError, match="unknown task 'Nope'; known tasks: .*'Reach'.*spec file"):
+    with pytest.raises(KeyError, match="unknown task 'Nope'; tasks: .* Reach, .*spec file"):
         task_registry.resolve_task("Nope")
 
 

@@ -1,0 +1,46 @@
+"""The one wording of a name CraftSuite does not know (a task, a suite, a method, an
+algorithm): the name as given, the known names closest to it, and every known one, on one
+line, as ``gym.make`` answers an unknown id with the ids it knows.
+
+``UnknownName`` is both a ``KeyError`` (a lookup by name failed, as ``dict[name]`` would say)
+and a ``ValueError`` (bad input, as the rest of CraftSuite's refusals are), so code catching
+either keeps working; its ``str()`` is the message itself, where a ``KeyError``'s would print
+it quoted.
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Iterable
+
+
+class UnknownName(KeyError, ValueError):
+    """A name that is none of the known ones (see the module's docstring)."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else ""
+
+
+def closest(name: str, known: Iterable[str]) -> list[str]:
+    """The known names a misspelling of ``name`` most likely meant (case aside), best first."""
+    by_lower = {k.lower(): k for k in known}
+    return [by_lower[k] for k in difflib.get_close_matches(str(name).lower(), by_lower, n=3, cutoff=0.6)]
+
+
+def suggested(name, known: Iterable[str]) -> str:
+    """``name`` quoted, with the known names it most likely meant: ``'ToolHme' (did you mean ToolHome?)``."""
+    near = closest(name, known)
+    return f"{name!r}" + (f" (did you mean {' or '.join(near)}?)" if near else "")
+
+
+def unknown_name(kind: str, names, known: Iterable[str], hint: str = "", plural: str | None = None) -> UnknownName:
+    """The error for ``names`` (one name, or a list of them), none of them among ``known``:
+    ``unknown task 'ToolHme' (did you mean ToolHome?); tasks: A, B, ...`` and ``hint`` (how
+    to add one of one's own, say) after the list. ``plural``: ``kind``'s plural, where an
+    ``s`` does not make it."""
+    known = [str(k) for k in known]
+    names = list(names) if isinstance(names, (list, tuple, set, frozenset)) else [names]
+    plural = plural or f"{kind}s"
+    listed = ", ".join(suggested(n, known) for n in names)
+    return UnknownName(f"unknown {kind if len(names) == 1 else plural} {listed}; {plural}: {', '.join(known)}"
+                       + (f" {hint}" if hint else ""))

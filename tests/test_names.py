@@ -1,0 +1,45 @@
+"""An unknown name (task, suite, method, algorithm, tag) is said one way everywhere: the name,
+the closest known ones, every known one, on one line, unquoted."""
+
+import pytest
+
+import craftsuite
+from craftsuite.hyperparameters import hyperparameter_examples
+from craftsuite.methods import check_methods
+from craftsuite.names import UnknownName, closest, unknown_name
+from craftsuite.suites import suite_named
+from craftsuite.task_registry import resolve_task
+
+
+def test_the_message_names_the_closest_and_every_known_name():
+    err = unknown_name("task", "ToolHme", ["Reach", "ToolHome", "TwoToolsHome"], "(or a spec file)")
+    assert str(err) == ("unknown task 'ToolHme' (did you mean ToolHome or TwoToolsHome?); "
+                        "tasks: Reach, ToolHome, TwoToolsHome (or a spec file)")
+    assert isinstance(err, KeyError) and isinstance(err, ValueError)  # callers catching either keep working
+    assert str(unknown_name("suite", "zzz", ["quick", "hard"])) == "unknown suite 'zzz'; suites: quick, hard"
+
+
+def test_several_names_each_get_their_suggestion():
+    err = unknown_name("method", ["dqnn", "zzz"], ["dqn", "crm"])
+    assert str(err) == "unknown methods 'dqnn' (did you mean dqn?), 'zzz'; methods: dqn, crm"
+    assert str(unknown_name("bus", "x", ["y"], plural="buses")) == "unknown bus 'x'; buses: y"
+
+
+def test_closest_ignores_case_and_keeps_the_known_spelling():
+    assert closest("toolhome", ["ToolHome", "Reach"]) == ["ToolHome"]
+    assert closest("qqqq", ["ToolHome", "Reach"]) == []
+
+
+@pytest.mark.parametrize("look_up, start", [
+    (lambda: resolve_task("Blindcraftsman"), "unknown task 'Blindcraftsman' (did you mean BlindCraftsman"),
+    (lambda: suite_named("standrd"), "unknown suite 'standrd' (did you mean standard?); suites: quick, standard"),
+    (lambda: check_methods(["td3-dinamic"]), "unknown method 'td3-dinamic' (did you mean td3-dynamic"),
+    (lambda: hyperparameter_examples("sac"), "unknown algorithm 'sac'; algorithms: dqn, td3"),
+    (lambda: craftsuite.evaluate(lambda obs: 0, "CraftSuite/Reach-Grid10-v0", suite="hrd"),
+     "unknown suite 'hrd' (did you mean hard?)"),
+])
+def test_each_lookup_says_it_the_one_way(look_up, start):
+    with pytest.raises(UnknownName) as caught:
+        look_up()
+    message = str(caught.value)
+    assert message.startswith(start) and "[" not in message and "\n" not in message

@@ -212,7 +212,7 @@ class Recorder(gym.Wrapper):
     def next_evaluation(self) -> int:
         """The step of the next evaluation the suite's schedule holds (the budget: the last)."""
         done = self.evaluated[-1] if self.evaluated else 0
-        return min(self.budget, (done // self.config.eval_every + 1) * self.config.eval_every)
+        return next((step for step in self.scheduled if step > done), self.budget)
 
     @property
     def scheduled(self) -> list[int]:
@@ -227,10 +227,8 @@ class Recorder(gym.Wrapper):
     def _due_step(self) -> int:
         """The latest step of the schedule that the transitions have reached: an evaluation
         called late is that step's (a step skipped leaves the run's curve short: the board
-        reads its AUC as not measured)."""
-        if self.transitions >= self.budget:  # the last evaluation is the budget's, a multiple of the interval or not
-            return self.budget
-        return self.transitions // self.config.eval_every * self.config.eval_every
+        reads its AUC as not measured). Called when one is due, so one has been reached."""
+        return [step for step in self.scheduled if step <= self.transitions][-1]
 
     def evaluate(self, policy):
         """The suite's evaluation at the schedule's step now due (its seeds are that

@@ -396,7 +396,7 @@ def _transfer(args) -> int:
     from .suite_runner import TimeLimitReached, WorkerLost, transfer
     from .suites import suite_named
 
-    suite = suite_named(args.suite)
+    suite = registered = suite_named(args.suite)
     if args.tags is not None or args.tasks is not None:  # the rungs given replace the suite's
         suite = dataclasses.replace(suite, tags=tuple(args.tags or ()),
                                     tasks=tuple(_task(t, "the worlds with --worlds") for t in args.tasks or ()))
@@ -438,7 +438,6 @@ def _transfer(args) -> int:
     settings = {"student_steps", "teacher_max_steps", "eval_every", "dqn_overrides", "teacher_hyperparameters",
                 "cont_world_kwargs", "kinematic_world_kwargs", "td3_overrides", "engine"}
     # and a rung, world or method the suite does not run would be filed under a suite it is not part of
-    registered = suite_named(args.suite)
     beyond = ({s.name for s in suite.rungs()} - {s.name for s in registered.rungs()}
               or set(suite.worlds) - set(registered.worlds) or set(suite.methods) - set(registered.methods))
     own = suite.archived and not settings & set(changes) and not beyond

@@ -39,8 +39,9 @@ def protocol(env: str, suite: str = "standard", step: int | None = None):
     step whose seeds the evaluation plays (None: the run's last evaluation, at its budget).
 
     Raises:
-        ValueError: not a CraftSuite id, an unknown suite, or a task the suite has no
-            budget for while no ``step`` is given; each named with its fix.
+        ValueError: not a CraftSuite id, an unknown suite or task (``names.UnknownName``,
+            also a KeyError), or a task the suite has no budget for while no ``step`` is
+            given; each named with its fix.
     """
     from .suites import SUITES, suite_named
     from .task_registry import resolve_task

@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from types import MappingProxyType
 
 from .methods import ALGORITHMS
-from .names import unknown_name
+from .names import suggested, unknown_name
 
 # The algorithms' settings before a run's overrides. The authors' DQN, changed where a
 # small MLP on one env needs it (measured when the teachers were tuned): a hard target
@@ -118,7 +118,11 @@ def _forms(example) -> tuple[tuple[type, ...], str]:
 
 def hyperparameter_examples(algorithm: str) -> dict:
     """Every setting ``algorithm`` takes from a run, with an example value of each: its
-    CraftSuite default, else the library's."""
+    CraftSuite default, else the library's.
+
+    Raises:
+        UnknownName: an algorithm that is not one of ``ALGORITHMS`` (a KeyError and a ValueError).
+    """
     if algorithm not in ALGORITHMS:
         raise unknown_name("algorithm", algorithm, ALGORITHMS)
     return {**(TD3_MORE if algorithm == "td3" else DQN_MORE), **(TD3_DEFAULTS if algorithm == "td3" else DQN_DEFAULTS)}
@@ -145,7 +149,8 @@ def check_hyperparameters(algorithm: str, overrides: Mapping | None, source: str
     overrides = dict(overrides or {})
     unknown = sorted(set(overrides) - set(examples))
     if unknown:
-        raise HyperparameterError(f"{source}: {algorithm.upper()} has no setting {', '.join(map(repr, unknown))}; "
+        raise HyperparameterError(f"{source}: {algorithm.upper()} has no setting "
+                                  f"{', '.join(suggested(k, examples) for k in unknown)}; "
                                   f"its settings: {', '.join(sorted(examples))}")
     defaults = TD3_DEFAULTS if algorithm == "td3" else DQN_DEFAULTS
     for name, value in overrides.items():

@@ -7,6 +7,7 @@ One ``Labeller`` per task, shared by every world of the task. Events (``obtained
 
 from __future__ import annotations
 
+from .names import unknown_name
 from .spec import TaskSpec
 
 
@@ -16,7 +17,7 @@ class Labeller:
         by_name = {p.name: p for p in spec.propositions}
         missing = set(order) - set(by_name)
         if missing:
-            raise KeyError(f"task {spec.name} defines no proposition(s) {sorted(missing)}")
+            raise unknown_name("proposition", sorted(missing), sorted(by_name), f"(task {spec.name}'s)")
         slot = {n: i for i, n in enumerate(spec.inventory)}
         kind = {o.name: k for k, o in enumerate(spec.objects)}
         self.propositions = tuple(order)

@@ -63,9 +63,11 @@ class Method:
             raise MethodError(f"{where}: algorithm {self.algorithm!r} does not run in the {self.world} world; "
                               f"use one of {', '.join(fits)}")
         if self.distill not in DISTILLATIONS:
-            raise MethodError(f"{where}: distill must be one of {list(DISTILLATIONS)}, got {self.distill!r}")
+            raise MethodError(f"{where}: distill must be one of {', '.join(map(repr, DISTILLATIONS))}, "
+                              f"got {self.distill!r}")
         if self.shaping not in DISTILLATIONS:
-            raise MethodError(f"{where}: shaping must be one of {list(DISTILLATIONS)}, got {self.shaping!r}")
+            raise MethodError(f"{where}: shaping must be one of {', '.join(map(repr, DISTILLATIONS))}, "
+                              f"got {self.shaping!r}")
         if self.shaping and (self.crm or self.distill or not self.product):
             raise MethodError(f"{where}: shaping is a method of its own: with the automaton state, without a "
                               "distilled target or CRM")

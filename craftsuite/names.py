@@ -1,6 +1,7 @@
-"""The one wording of a name CraftSuite does not know (a task, a suite, a method, an
-algorithm): the name as given, the known names closest to it, and every known one, on one
-line, as ``gym.make`` answers an unknown id with the ids it knows.
+"""The one wording of a name CraftSuite does not know (a task, suite, method, algorithm,
+learner regime, tag; a spec's key, place, inventory name or proposition; a world's keyword):
+the name as given, the known names closest to it, and every known one, on one line, as
+``gym.make`` answers an unknown id with the ids it knows.
 
 ``UnknownName`` is both a ``KeyError`` (a lookup by name failed, as ``dict[name]`` would say)
 and a ``ValueError`` (bad input, as the rest of CraftSuite's refusals are), so code catching
@@ -21,26 +22,33 @@ class UnknownName(KeyError, ValueError):
         return str(self.args[0]) if self.args else ""
 
 
-def closest(name: str, known: Iterable[str]) -> list[str]:
-    """The known names a misspelling of ``name`` most likely meant (case aside), best first."""
+def closest(name: object, known: Iterable[str]) -> list[str]:
+    """The known names a misspelling of ``name`` most likely meant (case aside; difflib's
+    3 best above its 0.6 similarity), best first."""
     by_lower = {k.lower(): k for k in known}
-    return [by_lower[k] for k in difflib.get_close_matches(str(name).lower(), by_lower, n=3, cutoff=0.6)]
+    return [by_lower[k] for k in difflib.get_close_matches(str(name).lower(), by_lower)]
 
 
-def suggested(name, known: Iterable[str]) -> str:
+def suggested(name: object, known: Iterable[str]) -> str:
     """``name`` quoted, with the known names it most likely meant: ``'ToolHme' (did you mean ToolHome?)``."""
     near = closest(name, known)
     return f"{name!r}" + (f" (did you mean {' or '.join(near)}?)" if near else "")
 
 
-def unknown_name(kind: str, names, known: Iterable[str], hint: str = "", plural: str | None = None) -> UnknownName:
-    """The error for ``names`` (one name, or a list of them), none of them among ``known``:
-    ``unknown task 'ToolHme' (did you mean ToolHome?); tasks: A, B, ...`` and ``hint`` (how
-    to add one of one's own, say) after the list. ``plural``: ``kind``'s plural, where an
-    ``s`` does not make it."""
+def unknown_text(kind: str, names: object, known: Iterable[str], hint: str = "", plural: str | None = None) -> str:
+    """The sentence for ``names`` (a list of names, in the order to name them; anything else
+    is one name), none of them among ``known``: ``unknown task 'ToolHme' (did you mean
+    ToolHome?); tasks: A, B, ...``, then ``hint`` (how to add one of one's own, say).
+    ``plural``: ``kind``'s plural, where an ``s`` does not make it."""
     known = [str(k) for k in known]
-    names = list(names) if isinstance(names, (list, tuple, set, frozenset)) else [names]
+    names = names if isinstance(names, list) else [names]
     plural = plural or f"{kind}s"
     listed = ", ".join(suggested(n, known) for n in names)
-    return UnknownName(f"unknown {kind if len(names) == 1 else plural} {listed}; {plural}: {', '.join(known)}"
-                       + (f" {hint}" if hint else ""))
+    return f"unknown {kind if len(names) == 1 else plural} {listed}; {plural}: {', '.join(known)}" + (
+        f" {hint}" if hint else "")
+
+
+def unknown_name(kind: str, names: object, known: Iterable[str], hint: str = "",
+                 plural: str | None = None) -> UnknownName:
+    """``unknown_text``'s sentence as the error to raise."""
+    return UnknownName(unknown_text(kind, names, known, hint, plural))

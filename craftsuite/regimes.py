@@ -88,6 +88,11 @@ def order(name: str) -> tuple:
 
 
 def check_regime(name: str) -> Regime:
+    """The learner regime called ``name``.
+
+    Raises:
+        UnknownName: no such regime (a KeyError and a ValueError), naming the regimes.
+    """
     if name not in REGIMES:
         raise unknown_name("learner regime", name, REGIMES)
     return REGIMES[name]

@@ -68,7 +68,7 @@ from typing import Any
 from .automata import Automaton, LTLfSyntaxError, compile_ltlf, parse
 from .automata.ltlf import atoms
 from .ids import TASK_NAME
-from .names import unknown_name
+from .names import unknown_text
 from .paths import assets_dir, tasks_dir
 
 __all__ = [
@@ -366,7 +366,7 @@ class _Reader:
     def keys(self, data: dict, allowed: set[str], where: str):
         unknown = set(data) - allowed
         if unknown:
-            self.fail(where, str(unknown_name("key", sorted(unknown), sorted(allowed))))
+            self.fail(where, unknown_text("key", sorted(unknown), sorted(allowed)))
 
     def int(self, data: dict, key: str, where: str, default=None, minimum: int = 0) -> int:
         value = data.get(key, default)
@@ -394,7 +394,7 @@ class _Reader:
         data = self.table(data, where)
         for name, n in data.items():
             if name not in known:
-                self.fail(where, str(unknown_name("inventory name", name, sorted(known))))
+                self.fail(where, unknown_text("inventory name", name, sorted(known)))
             if not isinstance(n, int) or isinstance(n, bool) or n < 1:
                 self.fail(f"{where}.{name}", f"must be a positive integer, got {n!r}")
         return dict(data)
@@ -515,7 +515,7 @@ def _object_tables(r: _Reader, data: dict) -> tuple[dict, dict]:
             r.fail(f"items/places.{obj}", "names must be lower-case identifiers")
     both = set(raw_items) & set(raw_places)
     if both:
-        r.fail("places", f"{sorted(both)} declared both as item and place")
+        r.fail("places", f"{', '.join(sorted(both))} declared both as item and place")
     if not raw_items and not raw_places:
         r.fail("items", "a task needs at least one item or place")
     return raw_items, raw_places
@@ -544,7 +544,8 @@ def _items(r: _Reader, raw_items: dict, inventory: set[str], looks: _Looks) -> t
         r.keys(table, {"count", "reward", "capacity", "requires", "excludes", "color", "symbol", "kinematic"}, where)
         excludes = table.get("excludes", [])
         if not isinstance(excludes, list) or any(e not in inventory for e in excludes):
-            r.fail(f"{where}.excludes", f"must list inventory names from {sorted(inventory)}, got {excludes!r}")
+            r.fail(f"{where}.excludes",
+                   f"must list inventory names from {', '.join(sorted(inventory))}, got {excludes!r}")
         capacity = table.get("capacity")
         if capacity is not None:
             capacity = r.int(table, "capacity", where, minimum=1)
@@ -612,7 +613,7 @@ def _recipes(r: _Reader, raw_recipes: list, raw_places: dict, inventory: set[str
         r.keys(rec, {"at", "consume", "produce", "repeat"}, where)
         at = rec.get("at")
         if at is not None and at not in raw_places:
-            r.fail(f"{where}.at", str(unknown_name("place", at, sorted(raw_places))))
+            r.fail(f"{where}.at", unknown_text("place", at, sorted(raw_places)))
         repeat = rec.get("repeat", False)
         if not isinstance(repeat, bool):
             r.fail(f"{where}.repeat", f"must be true or false, got {repeat!r}")
@@ -640,11 +641,11 @@ def _propositions(r: _Reader, data: dict, raw_places: dict, inventory: set[str])
         (kind, arg), = table.items()
         if kind == "obtained":
             if arg not in inventory:
-                r.fail(f"{where}.obtained", str(unknown_name("inventory name", arg, sorted(inventory))))
+                r.fail(f"{where}.obtained", unknown_text("inventory name", arg, sorted(inventory)))
             props.append(Proposition(prop, kind, arg))
         elif kind == "arrived":
             if arg not in raw_places:
-                r.fail(f"{where}.arrived", str(unknown_name("place", arg, sorted(raw_places))))
+                r.fail(f"{where}.arrived", unknown_text("place", arg, sorted(raw_places)))
             props.append(Proposition(prop, kind, arg))
         elif kind in COUNTED:
             counts = r.counts(arg, f"{where}.{kind}", inventory)
@@ -666,8 +667,8 @@ def _formula(r: _Reader, data: dict, props: tuple[Proposition, ...]) -> str:
         r.fail("formula", str(err))
     unknown = atoms(ast) - {p.name for p in props}
     if unknown:
-        r.fail("formula", str(unknown_name("proposition", sorted(unknown), [p.name for p in props],
-                                           "(declared in [propositions])")))
+        r.fail("formula", unknown_text("proposition", sorted(unknown), [p.name for p in props],
+                                       "(declared in [propositions])"))
     return formula
 
 

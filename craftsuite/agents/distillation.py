@@ -52,8 +52,8 @@ class AutomatonQTable:
         if self.fingerprint != automaton.fingerprint or self.q.shape != automaton.delta.shape:
             raise DistillationError(
                 f"this {self.kind} table was distilled for automaton {self.fingerprint} over "
-                f"{list(self.propositions)} ({self.q.shape[0]} states x {self.q.shape[1]} labels), not for "
-                f"{automaton.fingerprint} over {list(automaton.propositions)} ({automaton.formula!r}, "
+                f"{', '.join(self.propositions)} ({self.q.shape[0]} states x {self.q.shape[1]} labels), not for "
+                f"{automaton.fingerprint} over {', '.join(automaton.propositions)} ({automaton.formula!r}, "
                 f"{automaton.delta.shape[0]} states x {automaton.delta.shape[1]} labels)"
             )
 

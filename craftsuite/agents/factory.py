@@ -153,7 +153,7 @@ def load_agent(path, env=None):
     if algorithm is not None:
         if algorithm not in CLASSES:
             raise ValueError(f"{path} is a {algorithm!r} agent, which this CraftSuite does not know "
-                             f"(it knows {list(CLASSES)}): a newer CraftSuite saved it?")
+                             f"(it knows {', '.join(CLASSES)}): a newer CraftSuite saved it?")
         try:
             return CLASSES[algorithm].load(path, env=env, device="cpu", buffer_size=1)
         except Exception as err:  # damaged inside: whatever SB3 raises

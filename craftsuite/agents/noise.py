@@ -48,14 +48,14 @@ def make_action_noise(spec: dict, dim: int, seed: int = 0, n_envs: int = 1) -> A
     in each of ``n_envs`` envs: one independent process per env. (SB3 vectorises a single
     noise by deep copies, which would give every env the same persistent draws.)"""
     if not isinstance(spec, dict) or spec.get("type") not in NOISES:
-        raise ValueError(f"action_noise must be an ActionNoise or a spec {{'type': one of {sorted(NOISES)}, "
+        raise ValueError(f"action_noise must be an ActionNoise or a spec {{'type': one of {', '.join(sorted(NOISES))}, "
                          f"'sigma': ...}}, got {spec!r}")
     kind, params = spec["type"], {k: v for k, v in spec.items() if k != "type"}
     missing = [k for k in NOISES[kind] if k not in params]
     unknown = [k for k in params if k not in NOISES[kind]]
     if missing or unknown:
-        raise ValueError(f"action_noise {kind!r} takes {list(NOISES[kind])}; "
-                         f"missing {missing}, unknown {unknown}: {spec!r}")
+        raise ValueError(f"action_noise {kind!r} takes {', '.join(NOISES[kind])}; "
+                         f"missing {', '.join(missing) or 'none'}, unknown {', '.join(unknown) or 'none'}: {spec!r}")
     try:
         params = {k: float(v) for k, v in params.items()}
     except (TypeError, ValueError):

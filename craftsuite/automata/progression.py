@@ -25,6 +25,7 @@ from collections import deque
 
 import numpy as np
 
+from ..names import unknown_name
 from .ltlf import atoms
 
 TRUE, FALSE = 0, 1
@@ -257,5 +258,5 @@ def progress_to_dfa(ast, propositions: tuple[str, ...]) -> tuple[np.ndarray, np.
     """
     unknown = atoms(ast) - set(propositions)
     if unknown:
-        raise ValueError(f"formula uses undeclared propositions: {sorted(unknown)}")
+        raise unknown_name("proposition", sorted(unknown), propositions, "(declared)")
     return _Compiler(ast, propositions).run()

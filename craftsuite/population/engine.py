@@ -58,11 +58,11 @@ def check_supported(method: str, settings: dict) -> None:
     if "device" in settings:  # SB3's keyword; the engine's device is its run's, not a setting (nor in the run key)
         why = "device among the settings: the device is the command's --device (train_population's device)"
     elif unknown:
-        why = f"the settings {unknown}"
+        why = f"the settings {', '.join(unknown)}"
     elif settings.get("optimize_memory_usage"):
         why = "optimize_memory_usage (its replay keeps next observations; a grid's as their nonzero entries)"
     elif sorted(set(settings.get("policy_kwargs") or {}) - _POLICY_KWARGS):
-        why = f"policy_kwargs {sorted(set(settings['policy_kwargs']) - _POLICY_KWARGS)}"
+        why = f"policy_kwargs {', '.join(sorted(set(settings['policy_kwargs']) - _POLICY_KWARGS))}"
     elif (bad_widths := _refused(hidden_widths, settings.get("policy_kwargs") or {}, algorithm, [64])):
         why = bad_widths
     elif not _train_every(settings.get("train_freq", 1)):

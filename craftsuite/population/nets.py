@@ -162,7 +162,8 @@ def activation_of(activation_fn) -> callable:
     try:
         return ACTIVATIONS[activation_fn]
     except KeyError:
-        raise ValueError(f"the population engine supports the activations {[a.__name__ for a in ACTIVATIONS]}, "
+        raise ValueError("the population engine supports the activations "
+                         f"{', '.join(a.__name__ for a in ACTIVATIONS)}, "
                          f"not {activation_fn!r}: use one of them") from None
 
 

@@ -535,7 +535,7 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
     (``reporting.looks``); an undecided one's seeds to decide are figured at the level of its
     next reading, ``looks + 1``."""
     if metric not in COMPARED:
-        raise ValueError(f"no comparison in {metric!r}: compare in one of {sorted(COMPARED)}")
+        raise ValueError(f"no comparison in {metric!r}: compare in one of {', '.join(sorted(COMPARED))}")
     mine, theirs = entry.values[metric], baseline.values[metric]
     level = stats.shared_level(looks)
     diff = stats.difference(mine, theirs, level)

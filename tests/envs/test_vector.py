@@ -183,7 +183,7 @@ def test_registered_ids_make_native_vector_envs():
 def test_keywords_and_actions_are_checked():
     grid_id, kinematic_id = "CraftSuite/Reach-Grid7-v0", "CraftSuite/Reach-Kinematic-v0"
     mode = {"vectorization_mode": "vector_entry_point"}
-    with pytest.raises(ValueError, match=r"^unknown keyword 'frame_skip'; keywords: product"):
+    with pytest.raises(ValueError, match=r"^unknown keyword 'frame_skip' for the vectorized kinematic world; it "):
         gym.make_vec(kinematic_id, num_envs=2, frame_skip=3, **mode)
     with pytest.raises(ValueError, match="does not render.*gymnasium.make"):
         gym.make_vec(grid_id, num_envs=2, render_mode="rgb_array", **mode)

@@ -12,7 +12,10 @@ it quoted.
 from __future__ import annotations
 
 import difflib
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
+from typing import TypeVar
+
+T = TypeVar("T")
 
 
 class UnknownName(KeyError, ValueError):
@@ -52,3 +55,10 @@ def unknown_name(kind: str, names: object, known: Iterable[str], hint: str = "",
                  plural: str | None = None) -> UnknownName:
     """``unknown_text``'s sentence as the error to raise."""
     return UnknownName(unknown_text(kind, names, known, hint, plural))
+
+
+def look_up(table: Mapping[str, T], name: str, kind: str) -> T:
+    """``table[name]``, or an ``UnknownName`` naming the ``kind``'s known names (``table``'s, in its order)."""
+    if name not in table:
+        raise unknown_name(kind, name, table)
+    return table[name]

@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .hyperparameters import hyperparameter_examples
-from .names import unknown_name
+from .names import look_up
 
 
 @dataclass(frozen=True)
@@ -93,9 +93,7 @@ def check_regime(name: str) -> Regime:
     Raises:
         UnknownName: no such regime (a KeyError and a ValueError), naming the regimes.
     """
-    if name not in REGIMES:
-        raise unknown_name("learner regime", name, REGIMES)
-    return REGIMES[name]
+    return look_up(REGIMES, name, "learner regime")
 
 
 def describe(name: str) -> str:

@@ -14,7 +14,7 @@ from pathlib import Path
 from .configs import DEFAULT_ENGINE, StudentConfig, TeacherConfig
 from .ids import CONT, KINEMATIC, WORLD_KINDS, world_kind
 from .methods import METHODS, check_methods, methods_for
-from .names import unknown_name
+from .names import look_up
 from .regimes import check_regime
 from .spec import TaskSpec
 from .task_registry import ladder, resolve_task
@@ -306,6 +306,4 @@ def suite_named(name: str) -> Suite:
     Raises:
         UnknownName: no such suite (a KeyError and a ValueError), naming the suites.
     """
-    if name not in SUITES:
-        raise unknown_name("suite", name, SUITES)
-    return SUITES[name]
+    return look_up(SUITES, name, "suite")

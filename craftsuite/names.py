@@ -51,6 +51,15 @@ def unknown_text(kind: str, names: object, known: Iterable[str], hint: str = "",
         f" {hint}" if hint else "")
 
 
+def unknown_keywords(keywords: list, accepted: Iterable[str], world: str) -> str:
+    """The sentence for keywords a world's constructor does not take (``world``: which,
+    e.g. ``the MuJoCo world``): in ``gymnasium.make``'s terms, keyword arguments, not names
+    looked up in a table."""
+    accepted = [str(k) for k in accepted]
+    return (f"unknown keyword{'s' if len(keywords) > 1 else ''} {', '.join(suggested(k, accepted) for k in keywords)} "
+            f"for {world}; it accepts {', '.join(accepted)}")
+
+
 def unknown_name(kind: str, names: object, known: Iterable[str], hint: str = "",
                  plural: str | None = None) -> UnknownName:
     """``unknown_text``'s sentence as the error to raise."""

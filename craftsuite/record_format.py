@@ -104,7 +104,10 @@ def _finite(value) -> bool:
 
 
 def check_config(config: dict, path) -> None:
-    """``config.json``'s required fields, and the types of those a reader uses."""
+    """``config.json``'s required fields, and the types of those a reader uses (a teacher's
+    config, which caps its run at ``max_steps`` and has no budget, named as one)."""
+    if "steps" not in config and "max_steps" in config:
+        raise RecordError(f"{path} is a teacher's (max_steps, not steps), not a student's record")
     missing = [f.name for f in CONFIG if f.required and f.name not in config]
     if missing:
         raise RecordError(f"{path}: lacks {', '.join(missing)}")

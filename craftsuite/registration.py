@@ -17,7 +17,7 @@ import gymnasium as gym
 
 from .ids import CONT, NAMESPACE, cont_id, grid_id, grid_size, kinematic_id, parse_id, world_kind
 from .ids import KINEMATIC as KINEMATIC_WORLD
-from .names import suggested
+from .names import unknown_keywords
 from .spec import KINEMATIC_CONFIG, TaskSpec
 from .task_registry import add_task, carried, tasks
 
@@ -70,9 +70,7 @@ def check_world_kwargs(world: str, kwargs, source: str | None = None) -> None:
         from .rendering.grid import TILE
 
         raise ValueError(f"{prefix}{', '.join(unknown)}: " + why[0].format(tile=TILE, frame=7 * TILE))
-    raise ValueError(f"{prefix}unknown keyword{'s' if len(unknown) > 1 else ''} "
-                     f"{', '.join(suggested(k, accepted) for k in unknown)} "
-                     f"for the {_WORLD_NAMES[kind]} world; it accepts {', '.join(accepted)}")
+    raise ValueError(prefix + unknown_keywords(unknown, accepted, f"the {_WORLD_NAMES[kind]} world"))
 
 
 def _entry_key(world: str) -> str:

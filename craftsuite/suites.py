@@ -98,8 +98,8 @@ class Suite:
             return self.budgets[kind][spec.name]
         if spec.level not in self.budgets.get(kind, {}):
             raise ValueError(f"suite {self.name!r} has no {kind} budget for {spec.name}'s level {spec.level!r} "
-                             f"(tags {', '.join(spec.tags)}); budgets: {self.budgets}. Give every run the same "
-                             "budget (--steps N, Suite.student_steps) or tag the task with a level the suite has")
+                             f"(tags: {', '.join(spec.tags) or 'none'}); budgets: {self.budgets}. Give every run the "
+                             "same budget (--steps N, Suite.student_steps) or tag the task with a level the suite has")
         return self.budgets[kind][spec.level]
 
     def seeds_for(self, spec: TaskSpec, world: str) -> int:

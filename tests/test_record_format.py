@@ -33,6 +33,8 @@ CONFIG = {"task": "Reach", "world": "Cont", "method": "my-sac", "seed": 0, "step
     (lambda: check_config({**CONFIG, "steps": None}, "c.json"), "c.json: steps .* must be an integer > 0"),
     (lambda: check_config({k: v for k, v in CONFIG.items() if k != "world"}, "c.json"), "c.json: lacks world"),
     (lambda: check_config({**CONFIG, "seed": -1}, "c.json"), "seed must be an integer >= 0, got -1"),
+    (lambda: check_config({"task": "Reach", "max_steps": 10_000, "seed": 0}, "c.json"),
+     r"^c.json is a teacher's \(max_steps, not steps\), not a student's record$"),
     (lambda: check_result({"kind": "student", "steps": 999}, CONFIG, "r.json"), "steps 999 is short of the budget"),
     (lambda: check_result({"kind": "student", "steps": 1000, "updates": -2}, CONFIG, "r.json"), "updates must be"),
     (lambda: check_result({"kind": "student", "steps": 1000, "seconds_share": -1.0}, CONFIG, "r.json"),

@@ -54,8 +54,9 @@ def make_action_noise(spec: dict, dim: int, seed: int = 0, n_envs: int = 1) -> A
     missing = [k for k in NOISES[kind] if k not in params]
     unknown = [k for k in params if k not in NOISES[kind]]
     if missing or unknown:
-        raise ValueError(f"action_noise {kind!r} takes {', '.join(NOISES[kind])}; "
-                         f"missing {', '.join(missing) or 'none'}, unknown {', '.join(unknown) or 'none'}: {spec!r}")
+        wrong = [f"missing {', '.join(missing)}"] if missing else []
+        wrong += [f"unknown {', '.join(map(str, unknown))}"] if unknown else []
+        raise ValueError(f"action_noise {kind!r} takes {', '.join(NOISES[kind])}; {', '.join(wrong)}: {spec!r}")
     try:
         params = {k: float(v) for k, v in params.items()}
     except (TypeError, ValueError):

@@ -258,5 +258,5 @@ def progress_to_dfa(ast, propositions: tuple[str, ...]) -> tuple[np.ndarray, np.
     """
     unknown = atoms(ast) - set(propositions)
     if unknown:
-        raise unknown_name("proposition", sorted(unknown), propositions, "(declared)")
+        raise unknown_name("proposition", sorted(unknown), propositions, "(the formula's declared ones)")
     return _Compiler(ast, propositions).run()

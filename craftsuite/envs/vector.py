@@ -46,7 +46,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from ..names import suggested
+from ..names import unknown_keywords
 from ..spec import TaskSpec
 from ..wrappers import AutomatonObservation
 from .cells import EMPTY, MOVES
@@ -291,9 +291,7 @@ def check_num_envs(num_envs) -> None:
 def _check_kwargs(world: str, kwargs: dict, accepted: tuple[str, ...]) -> None:
     unknown = sorted(set(kwargs) - set(accepted))
     if unknown:
-        raise ValueError(f"unknown keyword{'s' if len(unknown) > 1 else ''} "
-                         f"{', '.join(suggested(k, accepted) for k in unknown)} for the vectorized {world} world; "
-                         f"it accepts {', '.join(accepted)}")
+        raise ValueError(unknown_keywords(unknown, accepted, f"the vectorized {world} world"))
     if kwargs.get("render_mode") is not None:
         raise ValueError(f"render_mode={kwargs['render_mode']!r}: the vectorized {world} world does not render; "
                          "make the single env to render (gymnasium.make(id, render_mode=...))")

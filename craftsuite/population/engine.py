@@ -58,7 +58,7 @@ def check_supported(method: str, settings: dict) -> None:
     if "device" in settings:  # SB3's keyword; the engine's device is its run's, not a setting (nor in the run key)
         why = "device among the settings: the device is the command's --device (train_population's device)"
     elif unknown:
-        why = f"the settings {', '.join(unknown)}"
+        why = f"the settings {', '.join(map(str, unknown))}"
     elif settings.get("optimize_memory_usage"):
         why = "optimize_memory_usage (its replay keeps next observations; a grid's as their nonzero entries)"
     elif sorted(set(settings.get("policy_kwargs") or {}) - _POLICY_KWARGS):

@@ -178,9 +178,6 @@ def _read_episodes(path: Path) -> tuple[dict, np.ndarray]:
 def _budget(run: Path, config: dict) -> int:
     """A student's transitions budget, as its ``config.json`` records it (the record format's
     check of a config, whose ``steps`` is that budget)."""
-    if "steps" not in config and "max_steps" in config:  # a teacher's: its max_steps is a cap, not a budget
-        raise RunError(f"{run / 'config.json'} is a teacher's record (max_steps, not steps): the training episodes "
-                       "read here are a student's")
     try:
         check_config(config, run / "config.json")
     except RecordError as err:

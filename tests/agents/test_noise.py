@@ -35,8 +35,8 @@ def test_specs_build_their_noise(spec, kind):
 @pytest.mark.parametrize("spec, message", [
     ({"type": "pink", "sigma": 0.3}, "one of"),
     ({"sigma": 0.3}, "one of"),
-    ({"type": "persistent", "sigma": 0.6}, r"missing resample, unknown none"),
-    ({"type": "normal", "sigma": 0.3, "theta": 0.1}, r"missing none, unknown theta"),
+    ({"type": "persistent", "sigma": 0.6}, r"takes sigma, resample; missing resample: "),
+    ({"type": "normal", "sigma": 0.3, "theta": 0.1}, r"takes sigma; unknown theta: "),
     ({"type": "persistent", "sigma": 0.6, "resample": 0}, "resample is a probability"),
     ({"type": "normal", "sigma": float("nan")}, "sigma must be >= 0"),
     ({"type": "normal", "sigma": "big"}, "takes numbers"),

@@ -161,7 +161,7 @@ def test_bad_records_are_named(tmp_path):
     record = json.loads((teacher / "config.json").read_text())
     del record["steps"]
     (teacher / "config.json").write_text(json.dumps({**record, "max_steps": 1_000}))
-    with pytest.raises(RunError, match=r"config.json is a teacher's record \(max_steps, not steps\)"):
+    with pytest.raises(RunError, match=r"config.json is a teacher's \(max_steps, not steps\), not a student's record"):
         episode_progress(teacher)
     (teacher / "config.json").write_text(json.dumps(record))  # neither: a student's record with its budget lost
     with pytest.raises(RunError, match=r"config.json: lacks steps: the record breaks the record format"):

@@ -14,7 +14,7 @@ from pathlib import Path
 from .configs import DEFAULT_ENGINE, StudentConfig, TeacherConfig
 from .ids import CONT, KINEMATIC, WORLD_KINDS, world_kind
 from .methods import METHODS, check_methods, methods_for
-from .names import look_up
+from .names import look_up, suggested
 from .regimes import check_regime
 from .spec import TaskSpec
 from .task_registry import ladder, resolve_task
@@ -125,8 +125,8 @@ class Suite:
                                  f"e.g. {{{kind!r}: {{'ToolHome': 20}}}}")
             for rung, seeds in by.items():
                 if rung not in known:
-                    raise ValueError(f"suite {self.name!r}: rung_seeds[{kind!r}] names {rung!r}, which is no "
-                                     f"registered rung; known: {', '.join(sorted(known))}")
+                    raise ValueError(f"suite {self.name!r}: rung_seeds[{kind!r}] names {suggested(rung, known)}, "
+                                     f"which is no registered rung; known: {', '.join(sorted(known))}")
                 if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
                     raise ValueError(f"suite {self.name!r}: rung_seeds[{kind!r}][{rung!r}] is {seeds!r}; give a "
                                      "whole number of seeds, 1 or more")

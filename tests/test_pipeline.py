@@ -231,7 +231,8 @@ def test_suite_selection_errors_name_the_problem(tmp_path):
         dataclasses.replace(quick, rung_seeds={"Grid10": {"Reach": 20}}).student_configs(tmp_path)
     with pytest.raises(ValueError, match=r"rung_seeds\['Grid'\] is 20; map rung names to seeds"):
         dataclasses.replace(quick, rung_seeds={"Grid": 20}).student_configs(tmp_path)
-    with pytest.raises(ValueError, match=r"rung_seeds\['Cont'\] names 'Reech', which is no registered rung"):
+    with pytest.raises(ValueError,
+                       match=r"rung_seeds\['Cont'\] names 'Reech' \(did you mean Reach\?\), which is no registered"):
         dataclasses.replace(quick, rung_seeds={"Cont": {"Reech": 20}}).student_configs(tmp_path)
     with pytest.raises(ValueError, match=r"rung_seeds\['Cont'\]\['Reach'\] is 2.5; give a whole number"):
         dataclasses.replace(quick, rung_seeds={"Cont": {"Reach": 2.5}}).student_configs(tmp_path)

@@ -40,9 +40,10 @@ def protocol(env: str, suite: str = "standard", step: int | None = None):
 
     Raises:
         ValueError: not a CraftSuite id, an unknown suite or task (``names.UnknownName``,
-            also a KeyError), or a task the suite has no budget for while no ``step`` is
-            given; each named with its fix.
+            also a KeyError), a task the suite has no budget for, or a suite whose own
+            settings are wrong (its learner regime, say); each named with its fix.
     """
+    from .methods import scratch
     from .suites import SUITES, suite_named
     from .task_registry import resolve_task
 
@@ -51,25 +52,14 @@ def protocol(env: str, suite: str = "standard", step: int | None = None):
     chosen = suite_named(suite)
     task, world = parse_id(env)
     spec = resolve_task(task)
-    config = _scratch_config(chosen, spec, world)
-    if config is None:  # no budget for its level in this world: the rung is another suite's
-        theirs = [name for name, s in SUITES.items() if _scratch_config(s, spec, world) is not None]
+    if not chosen.has_budget(spec, world):  # the rung is another suite's
+        theirs = [name for name, s in SUITES.items() if s.has_budget(spec, world)]
         theirs = [name for name in theirs if world in SUITES[name].worlds] or theirs  # those running it first
         raise ValueError(f"{task} in {world} is not a rung of the {suite!r} suite, whose protocol (budget, "
                          f"evaluations) an evaluation follows: give suite= one of "
                          + ", ".join(repr(name) for name in theirs or sorted(SUITES)))
+    config = chosen.student_config(spec, world, scratch(world))
     return config, config.steps if step is None else step
-
-
-def _scratch_config(suite, spec, world: str):
-    """``suite``'s config of a scratch student of ``spec``'s rung in ``world``; None where
-    the suite has no budget for it."""
-    from .methods import scratch
-
-    try:
-        return suite.student_config(spec, world, scratch(world))
-    except ValueError:
-        return None
 
 
 def evaluate(policy, env: str, *, suite: str = "standard", step: int | None = None, episodes: int | None = None,

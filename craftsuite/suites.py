@@ -89,6 +89,12 @@ class Suite:
         chosen.update({name: resolve_task(name) for name in self.tasks})
         return sorted(chosen.values(), key=lambda s: s.rung)
 
+    def has_budget(self, spec: TaskSpec, world: str) -> bool:
+        """Whether the suite gives a student of ``spec``'s rung a budget in ``world``: one for
+        every run, for the rung by name, or for its level."""
+        by = self.budgets.get(world_kind(world), {})
+        return self.student_steps is not None or spec.name in by or spec.level in by
+
     def budget(self, spec: TaskSpec, world: str) -> int:
         """A student's budget in transitions on a rung in a world."""
         if self.student_steps is not None:
@@ -96,7 +102,7 @@ class Suite:
         kind = world_kind(world)
         if spec.name in self.budgets.get(kind, {}):
             return self.budgets[kind][spec.name]
-        if spec.level not in self.budgets.get(kind, {}):
+        if not self.has_budget(spec, world):
             raise ValueError(f"suite {self.name!r} has no {kind} budget for {spec.name}'s level {spec.level!r} "
                              f"(tags: {', '.join(spec.tags) or 'none'}); budgets: {self.budgets}. Give every run the "
                              "same budget (--steps N, Suite.student_steps) or tag the task with a level the suite has")

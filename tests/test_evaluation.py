@@ -2,6 +2,8 @@
 trained run's model evaluated by it gives the run's own last evaluation, episode for
 episode; plain callables and torch modules are taken; bad input is refused in one line."""
 
+import dataclasses
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -89,3 +91,13 @@ def test_a_module_is_evaluated_in_eval_mode_and_left_as_it_was():
 def test_a_rung_of_another_suite_names_the_suites_it_is_in():
     with pytest.raises(ValueError, match=r"DiamondMine in Grid10 is not a rung of the 'standard' suite.*'hard'"):
         craftsuite.evaluate(lambda obs: 0, "CraftSuite/DiamondMine-Grid10-v0", step=1000)
+
+
+def test_a_suite_with_a_fault_of_its_own_is_refused_with_that_fault(monkeypatch):
+    # a suite that does run the rung, but whose learner regime is misspelt: its own sentence,
+    # not "not a rung of the suite"
+    broken = dataclasses.replace(SUITES["standard"], name="broken", regime="n-step-wid")
+    monkeypatch.setitem(SUITES, "broken", broken)
+    with pytest.raises(ValueError, match=r"n-step-wid.*did you mean n-step-wide") as refused:
+        craftsuite.evaluate(lambda obs: 0, "CraftSuite/Reach-Grid10-v0", suite="broken", episodes=1)
+    assert "not a rung" not in str(refused.value)

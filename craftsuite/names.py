@@ -27,9 +27,12 @@ class UnknownName(KeyError, ValueError):
 
 def closest(name: object, known: Iterable[str]) -> list[str]:
     """The known names a misspelling of ``name`` most likely meant (case aside; difflib's
-    3 best above its 0.6 similarity), best first."""
-    by_lower = {k.lower(): k for k in known}
-    return [by_lower[k] for k in difflib.get_close_matches(str(name).lower(), by_lower)]
+    3 best above its 0.6 similarity), best first; known names that differ only in case are
+    each named."""
+    by_lower: dict[str, list[str]] = {}
+    for k in known:
+        by_lower.setdefault(k.lower(), []).append(k)
+    return [k for lower in difflib.get_close_matches(str(name).lower(), by_lower) for k in by_lower[lower]]
 
 
 def suggested(name: object, known: Iterable[str]) -> str:

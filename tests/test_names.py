@@ -50,6 +50,7 @@ def test_a_misspelt_setting_or_keyword_gets_its_suggestion_too():
 def test_closest_ignores_case_and_keeps_the_known_spelling():
     assert closest("toolhome", ["ToolHome", "Reach"]) == ["ToolHome"]
     assert closest("qqqq", ["ToolHome", "Reach"]) == []
+    assert closest("toolhme", ["ToolHome", "toolhome", "Reach"]) == ["ToolHome", "toolhome"]  # neither hides the other
 
 
 @pytest.mark.parametrize("look_up, start", [

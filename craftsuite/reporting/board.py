@@ -63,6 +63,13 @@ def finite_mean(values) -> float:
     return float(x.mean()) if len(x) else -math.inf
 
 
+def unread_reason(err: Exception) -> str:
+    """Why a record was not read, from the error that stopped it: CraftSuite's own errors
+    say it in their sentence (``unknown task 'X' (did you mean ...)``), Python's keep their
+    class (a ``KeyError``'s message is the missing key alone)."""
+    return str(err) if type(err).__module__.startswith("craftsuite.") else f"{type(err).__name__}: {err}"
+
+
 def world_of(config: dict) -> tuple[str, dict]:
     """A student's world as its ``config.json`` records it: the world's name and the
     keywords that change it (a fixed grid instance, a frame skip, a board size)."""
@@ -331,7 +338,7 @@ def build(students_root, *more, apart=None, keep=None) -> Board:
             board.unreadable.append(str(err))
             continue
         except (ValueError, KeyError, TypeError) as err:  # a record that does not read as a run's
-            board.unreadable.append(f"{run / 'config.json'}: {type(err).__name__}: {err}")
+            board.unreadable.append(f"{run / 'config.json'}: {unread_reason(err)}")
             continue
         setting = {k: v for k, v in run_settings(config).items() if k != "seed"}
         # a regime's runs are never variants of another's: each regime is a board of its own (of_regime)

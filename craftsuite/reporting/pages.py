@@ -36,6 +36,7 @@ from .board import (
     distilled_against_scratch,
     finite_mean,
     rung_order,
+    unread_reason,
     verdict,
 )
 from .coverage import Coverage, coverage, coverage_markdown
@@ -839,7 +840,7 @@ def teachers_markdown(root: Path) -> list[str]:
                          f"| {result['steps']:,} / {result['updates']:,} | {result['success']:.2f} "
                          f"| {'yes' if result['reached_target'] else 'no'} ({config['target_success']:.0%}) |"))
         except (RunError, OSError, ValueError, KeyError, TypeError) as err:
-            problems.append(f"- not read: {run} ({type(err).__name__}: {err})")
+            problems.append(f"- not read: {run} ({unread_reason(err)})")
     if not rows and not problems:
         return []
     return ["Teachers (product DQN on the 7x7 grid, trained until their target greedy success over 50 episodes or "

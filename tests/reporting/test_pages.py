@@ -140,9 +140,16 @@ def test_a_results_page_lists_its_teachers_and_names_a_damaged_one(tmp_path):
     torn = tmp_path / "teachers" / "teacher-Reach-Grid7-s0-def"
     torn.mkdir()
     (torn / "config.json").write_text("{torn")
+    stray = tmp_path / "teachers" / "teacher-GoldMine-Grid7-s1-fed"  # a config without its target
+    stray.mkdir()
+    (stray / "config.json").write_text(json.dumps({"task": "GoldMine", "layout_seed": 1}))
+    (stray / "result.json").write_text((good / "result.json").read_text())
     text = "\n".join(teachers_markdown(tmp_path / "teachers"))
     assert "| GoldMine | `CraftSuite/GoldMine-Grid7-v0` | fixed (0) | 55,000 / 53,999 | 1.00 | yes (90%) |" in text
-    assert f"- not read: {torn} (RunError: {torn / 'config.json'} is not valid JSON" in text
+    # CraftSuite's own errors say what went wrong in their sentence, without their class's name;
+    # Python's keep it (a KeyError's message is the key alone)
+    assert f"- not read: {torn} ({torn / 'config.json'} is not valid JSON" in text
+    assert f"- not read: {stray} (KeyError: 'target_success')" in text
     assert teachers_markdown(tmp_path / "nowhere") == []
 
 

@@ -23,7 +23,9 @@ marked ``self_reported``: CraftSuite did not train them, and says so wherever it
     env.finish(agent.act, updates=agent.updates)
 
 A step past the budget is refused: a library that collects in rollouts (SB3's PPO, say) stops
-at it through a callback that returns ``not env.done``.
+at it through a callback that returns ``not env.done``. An evaluation called late is recorded
+at its scheduled step (its seeds are that step's), and ``finish`` warns of any, and of any
+skipped: a late one plays a policy that trained on more transitions than its step says.
 """
 
 from __future__ import annotations
@@ -165,6 +167,7 @@ class Recorder(gym.Wrapper):
         _RECORDING.add(self.path.resolve())
         self.transitions = 0
         self.evaluated: list[int] = []  # the steps evaluated so far
+        self.late: list[int] = []  # for each evaluation made after its step, the transitions it was late by
         self._episode = None  # (return, length) of the episode being played
         self._pending: list[dict] = []
         self._reached = Reached(resolve_task(self.config.task).automaton, 1, self.config.task)
@@ -248,6 +251,8 @@ class Recorder(gym.Wrapper):
                                                     "episodes": self.config.eval_episodes,
                                                     "length": round(result.mean_length, 2)}])
         self.evaluated.append(step)
+        if self.transitions > step:
+            self.late.append(self.transitions - step)
         return result
 
     def finish(self, policy, updates: int) -> Path:
@@ -275,6 +280,11 @@ class Recorder(gym.Wrapper):
             warnings.warn(f"{self.path}: {len(skipped)} of the suite's {len(self.scheduled)} evaluations were not made "
                           f"(the first at step {skipped[0]:,}): the leaderboard reads this run's AUC as not measured; "
                           "call evaluate(policy) whenever evaluation_due says so", stacklevel=2)
+        if self.late:  # recorded at their steps, of a policy that had trained longer: the curve reads early
+            warnings.warn(f"{self.path}: {len(self.late)} of the suite's {len(self.scheduled)} evaluations were made "
+                          f"after their step (by up to {max(self.late):,} transitions): each is recorded at its "
+                          "step, of a policy that had trained on more; call evaluate(policy) as soon as "
+                          "evaluation_due says so", stacklevel=2)
         self._flush()
         self.run.write_result({"kind": "student", "env_id": self.config.env_id, "method": self.config.method,
                                "task": self.config.task, "seed": self.config.seed, "steps": self.transitions,

@@ -59,10 +59,25 @@ def test_an_evaluation_called_late_is_the_latest_step_reached(tmp_path):
             env.reset()
     assert env.evaluation_due
     env.evaluate(lambda obs: 0)
-    assert env.evaluated == [2 * every] and not env.evaluation_due
+    assert env.evaluated == [2 * every] and not env.evaluation_due and env.late == [5]
     with pytest.raises(RuntimeError, match="no evaluation is due"):
         env.evaluate(lambda obs: 0)
     env.close()
+
+
+def test_finishing_a_run_with_late_evaluations_says_so(tmp_path):
+    env = craftsuite.Recorder(ENV, tmp_path, method="my-tardy", steps=1_000)
+    env.reset(seed=0)
+    while not env.done:
+        _, _, terminated, truncated, _ = env.step(0)
+        if terminated or truncated:
+            env.reset()
+        if env.evaluation_due and (env.transitions % 50 == 3 or env.transitions == 1_000):  # 3 late, but the last
+            env.evaluate(lambda obs: 0)
+    assert env.late == [3] * 19
+    with pytest.warns(UserWarning, match=r"19 of the suite's 20 evaluations were made after their step \(by up to 3 "
+                                         r"transitions\): each is recorded at its step"):
+        env.finish(lambda obs: 0, updates=0)
 
 
 @pytest.mark.parametrize("method, message", [

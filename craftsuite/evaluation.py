@@ -58,7 +58,10 @@ def protocol(env: str, suite: str = "standard", step: int | None = None):
         raise ValueError(f"{task} in {world} is not a rung of the {suite!r} suite, whose protocol (budget, "
                          f"evaluations) an evaluation follows: give suite= one of "
                          + ", ".join(repr(name) for name in theirs or sorted(SUITES)))
-    config = chosen.student_config(spec, world, scratch(world))
+    try:
+        config = chosen.student_config(spec, world, scratch(world))
+    except ValueError as err:  # a setting of the suite's own (its regime, say): not one the caller gave
+        raise ValueError(f"suite {suite!r}: {err}") from None
     return config, config.steps if step is None else step
 
 

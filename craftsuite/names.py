@@ -26,12 +26,14 @@ class UnknownName(KeyError, ValueError):
 
 
 def closest(name: object, known: Iterable[str]) -> list[str]:
-    """The known names a misspelling of ``name`` most likely meant (case aside; difflib's
-    3 best above its 0.6 similarity), best first; known names that differ only in case are
-    each named."""
+    """The known names a misspelling of ``name`` most likely meant, best first: the known
+    spellings of difflib's 3 best above its 0.6 similarity, case aside (so two known names
+    that differ only in case are both named)."""
     by_lower: dict[str, list[str]] = {}
     for k in known:
-        by_lower.setdefault(k.lower(), []).append(k)
+        spellings = by_lower.setdefault(k.lower(), [])
+        if k not in spellings:
+            spellings.append(k)
     return [k for lower in difflib.get_close_matches(str(name).lower(), by_lower) for k in by_lower[lower]]
 
 

@@ -283,8 +283,8 @@ class Recorder(gym.Wrapper):
         if self.late:  # recorded at their steps, of a policy that had trained longer: the curve reads early
             warnings.warn(f"{self.path}: {len(self.late)} of the suite's {len(self.scheduled)} evaluations were made "
                           f"after their step (by up to {max(self.late):,} transitions): each is recorded at its "
-                          "step, of a policy that had trained on more; call evaluate(policy) as soon as "
-                          "evaluation_due says so", stacklevel=2)
+                          "step though its policy had trained on more, so the curve credits learning too early; "
+                          "check evaluation_due after every step and call evaluate(policy) then", stacklevel=2)
         self._flush()
         self.run.write_result({"kind": "student", "env_id": self.config.env_id, "method": self.config.method,
                                "task": self.config.task, "seed": self.config.seed, "steps": self.transitions,

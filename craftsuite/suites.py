@@ -96,17 +96,17 @@ class Suite:
         return self.student_steps is not None or spec.name in by or spec.level in by
 
     def budget(self, spec: TaskSpec, world: str) -> int:
-        """A student's budget in transitions on a rung in a world."""
-        if self.student_steps is not None:
-            return self.student_steps
+        """A student's budget in transitions on a rung in a world: the one for every run, else
+        the rung's own, else its level's."""
         kind = world_kind(world)
-        if spec.name in self.budgets.get(kind, {}):
-            return self.budgets[kind][spec.name]
         if not self.has_budget(spec, world):
             raise ValueError(f"suite {self.name!r} has no {kind} budget for {spec.name}'s level {spec.level!r} "
                              f"(tags: {', '.join(spec.tags) or 'none'}); budgets: {self.budgets}. Give every run the "
                              "same budget (--steps N, Suite.student_steps) or tag the task with a level the suite has")
-        return self.budgets[kind][spec.level]
+        if self.student_steps is not None:
+            return self.student_steps
+        by = self.budgets[kind]
+        return by[spec.name] if spec.name in by else by[spec.level]
 
     def seeds_for(self, spec: TaskSpec, world: str) -> int:
         """The seeds of a rung's cells in a world."""

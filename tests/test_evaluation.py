@@ -98,6 +98,7 @@ def test_a_suite_with_a_fault_of_its_own_is_refused_with_that_fault(monkeypatch)
     # not "not a rung of the suite"
     broken = dataclasses.replace(SUITES["standard"], name="broken", regime="n-step-wid")
     monkeypatch.setitem(SUITES, "broken", broken)
-    with pytest.raises(ValueError, match=r"n-step-wid.*did you mean n-step-wide") as refused:
+    with pytest.raises(ValueError, match=r"^suite 'broken': unknown learner regime 'n-step-wid' \(did you mean "
+                                         r"n-step-wide") as refused:
         craftsuite.evaluate(lambda obs: 0, "CraftSuite/Reach-Grid10-v0", suite="broken", episodes=1)
     assert "not a rung" not in str(refused.value)

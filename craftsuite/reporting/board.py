@@ -64,10 +64,11 @@ def finite_mean(values) -> float:
 
 
 def unread_reason(err: Exception) -> str:
-    """Why a record was not read, from the error that stopped it: CraftSuite's own errors
-    say it in their sentence (``unknown task 'X' (did you mean ...)``), Python's keep their
-    class (a ``KeyError``'s message is the missing key alone)."""
-    return str(err) if type(err).__module__.startswith("craftsuite.") else f"{type(err).__name__}: {err}"
+    """Why a record was not read, from the error that stopped it: its sentence
+    (``automaton_state must be true, false or null, got 'yes'``), after the class's name
+    only where the sentence alone would not say what went wrong: Python's own ``KeyError``
+    (its message is the missing key) and ``TypeError``."""
+    return f"{type(err).__name__}: {err}" if type(err) in (KeyError, TypeError) else str(err)
 
 
 def world_of(config: dict) -> tuple[str, dict]:

@@ -68,6 +68,18 @@ def test_a_task_only_one_method_ran_stays_out_of_the_aggregate_and_says_so(runs)
     assert "| td3-dynamic | 2 |" in md.split("## Across tasks")[1]
 
 
+def test_a_record_not_read_is_named_by_its_sentence_and_a_bare_key_by_its_class(tmp_path):
+    root = tmp_path / "students"
+    fake_run(root, "td3", 0, [(1000, 1.0)], [(995, 1.0)])
+    wrong = fake_run(root, "td3", 1, [(1000, 1.0)], [(995, 1.0)], automaton_state="yes")
+    nowhere = fake_run(root, "td3", 2, [(1000, 1.0)], [(995, 1.0)], world="Grid")
+    board = build(root)
+    assert sorted(board.unreadable) == sorted([
+        f"{wrong / 'config.json'}: automaton_state must be true, false or null, got 'yes'",
+        f"{nowhere / 'config.json'}: unknown world 'Grid': use Cont (MuJoCo), Kinematic or Grid<size>, e.g. Grid10"])
+    assert [e.seeds for e in board.entries] == [[0]]
+
+
 def test_aggregates_pool_tasks_with_stratified_intervals_and_a_probability_of_improvement(tmp_path):
     root = tmp_path / "students"
     for task in ("Reach", "BlindCraftsman"):

@@ -6,6 +6,8 @@ In a wheel, ``tasks/`` and ``assets/`` are shipped as ``craftsuite/_data/{tasks,
 
 from __future__ import annotations
 
+import hashlib
+import os
 from pathlib import Path
 
 _PACKAGE = Path(__file__).resolve().parent
@@ -30,3 +32,33 @@ def tasks_dir() -> Path:
 
 def assets_dir() -> Path:
     return data_dir("assets")
+
+
+def cache_dir(kind: str) -> Path:
+    """Where CraftSuite keeps what it computed and can compute again (``kind``: "automata",
+    "references"): $CRAFTSUITE_CACHE_DIR/kind, else the XDG cache's craftsuite/kind."""
+    root = os.environ.get("CRAFTSUITE_CACHE_DIR")
+    if root:
+        return Path(root) / kind
+    xdg = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(xdg) / "craftsuite" / kind
+
+
+def files_digest(roots) -> str:
+    """The sha256 of every file under ``roots`` (folders), by its path below its root and its
+    bytes; Python's compiled ``__pycache__`` is left out (it follows the sources)."""
+    h = hashlib.sha256()
+    for root in roots:
+        root = Path(root)
+        for path in sorted(p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts):
+            name = path.relative_to(root).as_posix()
+            h.update(f"{root.name}/{name}\0{path.stat().st_size}\0".encode())
+            h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def code_digest() -> str:
+    """A digest of the package's code and data (craftsuite/, tasks/, assets/): a result
+    computed from them alone is the same while it is."""
+    roots = [_PACKAGE] + [data_dir(name) for name in DATA_DIRS if not (_PACKAGE / "_data" / name).is_dir()]
+    return files_digest(roots)

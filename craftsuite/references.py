@@ -8,10 +8,18 @@ automaton's state, the task's progress). Both play the registered ids as users g
 on episode seeds 0, 1, ...
 
 ``craftsuite tasks --markdown docs/tasks.md`` writes the page; nothing in it is typed by hand.
+The references depend on the code alone, the archive's figures on the page do not: the
+references are kept in the cache (``paths.cache_dir("references")``), keyed by a digest of the
+package's code and data and the versions of the libraries that simulate, so that the page
+rebuilt after runs land plays its thousands of episodes again only when the code changed.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
+import json
+import logging
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,6 +27,12 @@ import gymnasium as gym
 import numpy as np
 
 POLICIES = ("scripted", "random")
+# the libraries whose versions can change a reference (the simulation and its random numbers)
+SIMULATING = ("gymnasium", "mujoco", "numpy")
+# bump when the cache file's layout changes: old entries then miss
+CACHE_FORMAT = 1
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -61,6 +75,64 @@ def reference(env_id: str, policy: str, episodes: int = 100, seed: int = 0) -> R
                      edges / episodes, broken / episodes)
 
 
+def references(env_ids, episodes: int = 100, progress: bool = True) -> dict[tuple[str, str], Reference]:
+    """Every policy's reference (``POLICIES``) on each of ``env_ids``, keyed by (id, policy):
+    from the cache where this code, data and the ``SIMULATING`` libraries computed them
+    before, else played (and kept there; a cache that cannot be read or written is passed by
+    with a warning)."""
+    from .files import atomic_write
+    from .paths import cache_dir
+    from .progress import progress_iter
+
+    env_ids = list(env_ids)
+    path = cache_dir("references") / f"{_cache_key(env_ids, episodes)}.json"
+    cached = _load(path, {(env_id, policy) for env_id in env_ids for policy in POLICIES})
+    if cached is not None:
+        return cached
+    refs = {}
+    for env_id in progress_iter(env_ids, "references", "id", enabled=progress):
+        for policy in POLICIES:
+            refs[env_id, policy] = reference(env_id, policy, episodes)
+    try:
+        atomic_write(path, json.dumps([dataclasses.asdict(r) for r in refs.values()]))
+    except OSError as err:  # a read-only home must not stop anyone from writing the page
+        log.warning("could not write the references cache %s (%s)", path, err)
+    return refs
+
+
+def _cache_key(env_ids: list[str], episodes: int) -> str:
+    """What the references hang on: the code and data, the libraries, and each id's
+    registration and task spec (a task registered from Python is in no file)."""
+    from importlib.metadata import version
+
+    from .ids import parse_id
+    from .paths import code_digest
+    from .task_registry import tasks
+
+    def registration(env_id):
+        spec = gym.spec(env_id)
+        return {"kwargs": spec.kwargs, "max_steps": spec.max_episode_steps,
+                "task": tasks()[parse_id(env_id)[0]].to_data()}
+
+    what = {"format": CACHE_FORMAT, "code": code_digest(), "episodes": episodes,
+            "ids": {env_id: registration(env_id) for env_id in env_ids},
+            "libraries": {name: version(name) for name in SIMULATING}}
+    return hashlib.sha256(json.dumps(what).encode()).hexdigest()[:32]  # key order kept: a spec's is its bit order
+
+
+def _load(path: Path, keys: set) -> dict[tuple[str, str], Reference] | None:
+    try:
+        refs = {(r.env_id, r.policy): r for r in (Reference(**row) for row in json.loads(path.read_text()))}
+        if set(refs) != keys:
+            raise ValueError(f"it holds {len(refs)} references, not the {len(keys)} asked for")
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError, TypeError) as err:  # torn, or not this layout
+        log.warning("ignoring unreadable references cache %s (%s); playing the episodes again", path, err)
+        return None
+    return refs
+
+
 def _ids_of(name: str) -> list[str]:
     """A task's ids: the grids by size, then the MuJoCo world, then the kinematic one."""
     from .ids import CONT_WORLDS, grid_size, parse_id
@@ -97,16 +169,12 @@ def tasks_page(episodes: int = 100, progress: bool = True, results="results") ->
     """The tasks page in Markdown: the ladder's rungs, easiest first, with their references
     and, where the results archive (``results``; None: none) holds it, TD3 from scratch's
     success in MuJoCo."""
-    from .progress import progress_iter
     from .task_registry import ladder
 
     specs = ladder()
-    ids = [(spec, env_id) for spec in specs for env_id in _ids_of(spec.name)]
+    ids = [env_id for spec in specs for env_id in _ids_of(spec.name)]
     periods = ", ".join(sorted({f"{s.continuous.control_period:g} s" for s in specs}))
-    refs = {}
-    for _spec, env_id in progress_iter(ids, "references", "id", enabled=progress):
-        for policy in POLICIES:
-            refs[env_id, policy] = reference(env_id, policy, episodes)
+    refs = references(ids, episodes, progress)
     lines = [
         "# Tasks",
         "",
@@ -162,7 +230,7 @@ def tasks_page(episodes: int = 100, progress: bool = True, results="results") ->
             lines.append(f"| `{env_id}` | {limit} | {s.success:.2f} | {s.steps:.1f} | {r.success:.2f} | "
                          f"{r.automaton_steps:.2f} | {r.violations:.2f} |")
     # no wall time here: the page is the same wherever and whenever it is regenerated
-    lines += ["", f"*{len(ids)} ids, {2 * len(ids) * episodes:,} episodes.*", ""]
+    lines += ["", f"*{len(ids)} ids, {len(POLICIES) * len(ids) * episodes:,} episodes.*", ""]
     return "\n".join(lines)
 
 

@@ -7,13 +7,13 @@ from __future__ import annotations
 
 import hashlib
 import logging
-import os
 import re
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
+from .. import paths
 from ..files import atomic_path
 from ..names import unknown_name
 from .dfa import MAX_PROPOSITIONS, Automaton, minimize
@@ -28,12 +28,8 @@ _NAME = re.compile(r"[a-z_][a-z0-9_]*\Z")
 
 
 def cache_dir() -> Path:
-    """Where compiled automata are cached: $CRAFTSUITE_CACHE_DIR, else the XDG cache."""
-    root = os.environ.get("CRAFTSUITE_CACHE_DIR")
-    if root:
-        return Path(root) / "automata"
-    xdg = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(xdg) / "craftsuite" / "automata"
+    """Where compiled automata are cached: $CRAFTSUITE_CACHE_DIR/automata, else the XDG cache's."""
+    return paths.cache_dir("automata")
 
 
 def _check(formula: str, propositions) -> tuple[tuple[str, ...], tuple]:

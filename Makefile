@@ -30,7 +30,8 @@ test-slow: $(STAMP)
 	$(PY) -m pytest -q -m slow --nbmake tests notebooks
 
 # The pages generated from data: the tasks page from the specs and the results archive (its
-# scripted and random references played again only when the code changed: craftsuite.references),
+# scripted and random references cached, played again only when the package, a spec or a
+# simulating library changed: craftsuite.references),
 # the record format's page from its table (craftsuite.record_format),
 # the results and reproduction pages from the archive (results/)
 docs: $(STAMP)

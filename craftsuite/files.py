@@ -62,7 +62,7 @@ def atomic_path(path) -> Iterator[Path]:
     ``path`` is left as it was, the temporary file is removed, and so are the folders made
     for it while they are empty (a writer that makes the same new folder at the same moment
     may find it gone: no caller writes into a new folder from two processes but the
-    automaton cache, which takes a failed write as a miss)."""
+    caches, automata's and references', which take a failed write as a miss)."""
     path = Path(path)
     made = missing_folders(path.parent)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -1,4 +1,5 @@
-"""Where CraftSuite's data lives: the one place that knows the repo and wheel layouts.
+"""Where CraftSuite's data lives: the one place that knows the repo and wheel layouts, the
+cache's folder, and which files make up the package (``code_digest``).
 
 In a wheel, ``tasks/`` and ``assets/`` are shipped as ``craftsuite/_data/{tasks,assets}``
 (hatchling force-include); in a source checkout they sit at the top of the repo.

@@ -10,8 +10,10 @@ on episode seeds 0, 1, ...
 ``craftsuite tasks --markdown docs/tasks.md`` writes the page; nothing in it is typed by hand.
 The references depend on the code alone, the archive's figures on the page do not: the
 references are kept in the cache (``paths.cache_dir("references")``), keyed by a digest of the
-package's code and data and the versions of the libraries that simulate, so that the page
-rebuilt after runs land plays its thousands of episodes again only when the code changed.
+package's code and data, the ids' registrations and specs and the versions of the libraries
+that simulate, so that the page rebuilt after runs land plays its thousands of episodes again
+only when one of those changed (any change to the package's code counts; delete the cache's
+``references/`` folder to play them again regardless).
 """
 
 from __future__ import annotations
@@ -27,8 +29,8 @@ import gymnasium as gym
 import numpy as np
 
 POLICIES = ("scripted", "random")
-# the libraries whose versions can change a reference (the simulation and its random numbers)
-SIMULATING = ("gymnasium", "mujoco", "numpy")
+# the libraries whose versions can change a reference (the scenes, the simulation, its random numbers)
+SIMULATING = ("gymnasium", "dm-control", "mujoco", "numpy")
 # bump when the cache file's layout changes: old entries then miss
 CACHE_FORMAT = 1
 
@@ -77,57 +79,75 @@ def reference(env_id: str, policy: str, episodes: int = 100, seed: int = 0) -> R
 
 def references(env_ids, episodes: int = 100, progress: bool = True) -> dict[tuple[str, str], Reference]:
     """Every policy's reference (``POLICIES``) on each of ``env_ids``, keyed by (id, policy):
-    from the cache where this code, data and the ``SIMULATING`` libraries computed them
-    before, else played (and kept there; a cache that cannot be read or written is passed by
-    with a warning)."""
+    from the cache where the same code, data, specs and libraries computed them before, else
+    played (and kept there, unless the code on disk changed while they played). A cache that
+    cannot be read or written is passed by with a warning; an id whose registration has no
+    JSON form (a callable entry point) is played every time."""
     from .files import atomic_write
     from .paths import cache_dir
     from .progress import progress_iter
 
     env_ids = list(env_ids)
-    path = cache_dir("references") / f"{_cache_key(env_ids, episodes)}.json"
-    cached = _load(path, {(env_id, policy) for env_id in env_ids for policy in POLICIES})
+    key = _cache_key(env_ids, episodes)
+    path = None if key is None else cache_dir("references") / f"{key}.json"
+    cached = None if path is None else _load(path, env_ids, episodes)
     if cached is not None:
         return cached
     refs = {}
     for env_id in progress_iter(env_ids, "references", "id", enabled=progress):
         for policy in POLICIES:
             refs[env_id, policy] = reference(env_id, policy, episodes)
-    try:
-        atomic_write(path, json.dumps([dataclasses.asdict(r) for r in refs.values()]))
-    except OSError as err:  # a read-only home must not stop anyone from writing the page
-        log.warning("could not write the references cache %s (%s)", path, err)
+    if path is not None and _cache_key(env_ids, episodes) == key:
+        rows = [{k: None if isinstance(v, float) and np.isnan(v) else v for k, v in dataclasses.asdict(r).items()}
+                for r in refs.values()]  # NaN as null: strict JSON
+        try:
+            atomic_write(path, json.dumps(rows))
+        except OSError as err:  # a read-only home must not stop anyone from writing the page
+            log.warning("could not write the references cache %s (%s)", path, err)
     return refs
 
 
-def _cache_key(env_ids: list[str], episodes: int) -> str:
-    """What the references hang on: the code and data, the libraries, and each id's
-    registration and task spec (a task registered from Python is in no file)."""
+def _cache_key(env_ids: list[str], episodes: int) -> str | None:
+    """What the references hang on: the package's code and data, the simulating libraries and
+    the platform, and each id's registration and task spec (a task registered from Python is
+    in no file); None where a registration has no JSON form."""
+    import platform
     from importlib.metadata import version
 
     from .ids import parse_id
     from .paths import code_digest
     from .task_registry import tasks
 
-    def registration(env_id):
-        spec = gym.spec(env_id)
-        return {"kwargs": spec.kwargs, "max_steps": spec.max_episode_steps,
-                "task": tasks()[parse_id(env_id)[0]].to_data()}
-
-    what = {"format": CACHE_FORMAT, "code": code_digest(), "episodes": episodes,
-            "ids": {env_id: registration(env_id) for env_id in env_ids},
-            "libraries": {name: version(name) for name in SIMULATING}}
-    return hashlib.sha256(json.dumps(what).encode()).hexdigest()[:32]  # key order kept: a spec's is its bit order
-
-
-def _load(path: Path, keys: set) -> dict[tuple[str, str], Reference] | None:
     try:
-        refs = {(r.env_id, r.policy): r for r in (Reference(**row) for row in json.loads(path.read_text()))}
-        if set(refs) != keys:
-            raise ValueError(f"it holds {len(refs)} references, not the {len(keys)} asked for")
-    except FileNotFoundError:
+        registrations = {env_id: gym.spec(env_id).to_json() for env_id in env_ids}
+    except (TypeError, ValueError):  # gymnasium's refusal of a callable entry point
         return None
-    except (OSError, ValueError, TypeError) as err:  # torn, or not this layout
+    what = {"format": CACHE_FORMAT, "code": code_digest(), "episodes": episodes, "ids": registrations,
+            "tasks": {env_id: tasks()[parse_id(env_id)[0]].digest() for env_id in env_ids},
+            "libraries": {name: version(name) for name in SIMULATING},
+            "platform": [platform.python_version(), platform.machine()]}
+    return hashlib.sha256(json.dumps(what, sort_keys=True).encode()).hexdigest()[:32]
+
+
+_NUMBERS = ("success", "steps", "automaton_steps", "violations")
+
+
+def _load(path: Path, env_ids: list[str], episodes: int) -> dict[tuple[str, str], Reference] | None:
+    """The cached references at ``path``, checked to be those asked for; None: not cached."""
+    try:
+        refs = {}
+        for row in json.loads(path.read_text()):
+            r = Reference(**{**row, **{k: float("nan") for k in _NUMBERS if row.get(k, 0) is None}})
+            if r.episodes != episodes or not all(isinstance(getattr(r, k), (int, float)) for k in _NUMBERS):
+                raise ValueError(f"its row for {r.env_id} ({r.policy}) is not a reference of {episodes} episodes")
+            refs[r.env_id, r.policy] = r
+        asked = {(env_id, policy) for env_id in env_ids for policy in POLICIES}
+        if set(refs) != asked:
+            missing, extra = sorted(asked - set(refs)), sorted(set(refs) - asked)
+            raise ValueError(f"it lacks {missing[:2]}" if missing else f"it holds {extra[:2]}, not asked for")
+    except (FileNotFoundError, NotADirectoryError):  # not cached (or no cache folder can be made)
+        return None
+    except (OSError, ValueError, TypeError, AttributeError) as err:  # torn, or not this layout
         log.warning("ignoring unreadable references cache %s (%s); playing the episodes again", path, err)
         return None
     return refs

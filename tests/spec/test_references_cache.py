@@ -2,7 +2,6 @@
 
 import json
 import logging
-from pathlib import Path
 
 import pytest
 
@@ -43,7 +42,7 @@ def test_references_are_played_once_then_read_from_the_cache(played, tmp_path):
     assert len(_cache_files(tmp_path)) == 1
 
 
-@pytest.mark.parametrize("change", ["code", "episodes", "ids", "task", "library"])
+@pytest.mark.parametrize("change", ["code", "episodes", "ids", "task", "registration", "library"])
 def test_a_change_to_what_references_hang_on_plays_them_again(played, tmp_path, monkeypatch, change):
     references(IDS, episodes=3, progress=False)
     ids, episodes = IDS, 3
@@ -57,13 +56,17 @@ def test_a_change_to_what_references_hang_on_plays_them_again(played, tmp_path, 
         from craftsuite import task_registry
 
         specs = dict(task_registry.tasks())
-        reach = specs["Reach"]
-        monkeypatch.setattr(task_registry, "tasks", lambda: {**specs, "Reach": _Respecified(reach)})
+        monkeypatch.setattr(task_registry, "tasks", lambda: {**specs, "Reach": _Respecified(specs["Reach"])})
+    elif change == "registration":  # the id registered again with another episode limit
+        import gymnasium as gym
+
+        spec = gym.spec(IDS[0])
+        monkeypatch.setattr(spec, "max_episode_steps", spec.max_episode_steps + 1)
     else:
         from importlib import metadata
 
         real = metadata.version
-        monkeypatch.setattr(metadata, "version", lambda name: "0.0-other" if name == "mujoco" else real(name))
+        monkeypatch.setattr(metadata, "version", lambda name: "0.0-other" if name == "dm-control" else real(name))
     before = len(played)
     references(ids, episodes=episodes, progress=False)
     assert len(played) == before + len(ids) * len(POLICIES)
@@ -74,13 +77,22 @@ class _Respecified:
     def __init__(self, spec):
         self.spec = spec
 
-    def to_data(self):
-        data = self.spec.to_data()
-        data["continuous"] = {**data["continuous"], "max_steps": data["continuous"]["max_steps"] + 1}
-        return data
+    def digest(self):
+        return "another " + self.spec.digest()
 
 
-@pytest.mark.parametrize("text", ["{torn", "[]", '[{"env_id": "x"}]', "not json at all"])
+def test_references_played_while_the_code_changed_are_not_kept(played, tmp_path, monkeypatch):
+    versions = iter(["the code as play began", "the code as play ended"])
+    monkeypatch.setattr(paths, "code_digest", lambda: next(versions))
+    assert len(references(IDS, episodes=3, progress=False)) == len(IDS) * len(POLICIES)
+    assert _cache_files(tmp_path) == []
+
+
+WRONG_TYPES = ('[{"env_id": "CraftSuite/Reach-Grid7-v0", "policy": "random", "episodes": 3, "success": "x", '
+               '"steps": 1.0, "automaton_steps": 1.0, "violations": 0.0}]')
+
+
+@pytest.mark.parametrize("text", ["{torn", "[]", '[{"env_id": "x"}]', "[1]", WRONG_TYPES])
 def test_an_unreadable_cache_file_is_passed_by_with_a_warning_and_rewritten(played, tmp_path, caplog, text):
     references(IDS, episodes=3, progress=False)
     (path,) = _cache_files(tmp_path)
@@ -119,8 +131,17 @@ def test_files_digest_follows_names_and_bytes_but_not_compiled_python(tmp_path):
     assert files_digest([root]) != before
 
 
-def test_the_code_digest_covers_the_package_its_tasks_and_its_assets():
-    import craftsuite
-
-    package = Path(craftsuite.__file__).parent
-    assert paths.code_digest() == files_digest([package, paths.tasks_dir(), paths.assets_dir()])
+@pytest.mark.parametrize("layout", ["checkout", "wheel"])
+def test_the_code_digest_follows_the_package_its_tasks_and_its_assets(tmp_path, monkeypatch, layout):
+    package = tmp_path / "craftsuite"
+    data = package / "_data" if layout == "wheel" else tmp_path  # where tasks/ and assets/ sit
+    for folder, name in ((package, "env.py"), (data / "tasks", "reach.toml"), (data / "assets", "scene.xml")):
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / name).write_text("v1")
+    monkeypatch.setattr(paths, "_PACKAGE", package)
+    before = paths.code_digest()
+    for changed in (package / "env.py", data / "tasks" / "reach.toml", data / "assets" / "scene.xml"):
+        changed.write_text("v2")
+        assert paths.code_digest() != before, changed
+        changed.write_text("v1")
+    assert paths.code_digest() == before

@@ -6,6 +6,7 @@ One directory per suite, shaped as a transfer output, so that every reader of ru
 it as one::
 
     results/<suite>/suite.json, provenance.json      the suite as last run; every session
+                                                      (of those that kept runs here)
     results/<suite>/teachers/<run name>/              config.json, result.json, evals.csv,
                                                       episodes.csv.gz, table.npz
     results/<suite>/students/<run name>/              config.json, result.json, evals.csv,
@@ -212,12 +213,13 @@ def restore(archive: Path, out: Path, names: dict[str, set[str]], log=print) -> 
 
 
 def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict | None = None,
-             log=print) -> dict[str, int]:
-    """Archive the finished runs of ``out`` named in ``names`` (kind -> run names), the
-    suite as run (``suite.json``) and every session that ran into ``out`` (merged into the
-    archive's ``provenance.json`` by session id). A run that cannot be kept (a record whose
-    success cannot be re-read) is named through ``log``; the others are kept all the same.
-    Returns how many of each kind were kept."""
+             log=print, record: bool | None = None) -> dict[str, int]:
+    """Archive the finished runs of ``out`` named in ``names`` (kind -> run names), then, if
+    ``record`` (by default: where this call kept a run), the suite as run (``suite.json``)
+    and every session that ran into ``out`` (merged into the archive's ``provenance.json``
+    by session id): a call that keeps nothing new leaves the archive as it was. A run that
+    cannot be kept (a record whose success cannot be re-read) is named through ``log``; the
+    others are kept all the same. Returns how many of each kind were kept."""
     from .provenance import merge, read
 
     out, archive = Path(out), Path(archive)
@@ -234,6 +236,8 @@ def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict |
                     continue
                 count += 1
         kept[kind] = count
+    if not (any(kept.values()) if record is None else record):
+        return kept
     if suite is not None:
         atomic_write(archive / "suite.json", json.dumps(suite, indent=2) + "\n")
     sessions = read(out)
@@ -409,5 +413,5 @@ def add(source: Source, archive: Path) -> dict[str, int]:
                 keep(run, archive, kind)
                 kept[kind] += 1
     if any(kept.values()):
-        keep_all(source.path, archive, {}, suite=source.suite)  # the sessions that made them, and the suite
+        keep_all(source.path, archive, {}, suite=source.suite, record=True)  # their sessions and suite
     return kept

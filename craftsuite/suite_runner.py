@@ -381,9 +381,15 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         pool.close(abort=True)
         raise
 
+    # whether this session has kept a run in the archive: one that keeps none (its runs all
+    # reused) leaves the archive's suite.json and provenance.json as they were
+    archived_any = False
+
     def keep_finished(kind: str, paths: list[Path]) -> None:  # each population as it finishes
+        nonlocal archived_any
         try:
-            keep_all(out, kept, {kind: {p.name for p in paths}}, suite=dataclasses.asdict(suite), log=log)
+            archived_any |= any(keep_all(out, kept, {kind: {p.name for p in paths}}, suite=dataclasses.asdict(suite),
+                                         log=log).values())
         except Exception as err:  # the runs train on; the end of the session tries again
             log(f"results archive {kept}: not updated ({type(err).__name__}: {err})")
 
@@ -408,7 +414,8 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     finally:  # what finished is kept, whatever stopped the rest (each population was, as it finished)
         if kept is not None:
             try:  # (the session is on record in out since it started)
-                keep_all(out, kept, names, suite=dataclasses.asdict(suite), log=log)  # as run: pages read its settings
+                archived_any |= any(keep_all(out, kept, names, suite=dataclasses.asdict(suite), log=log,
+                                             record=archived_any or None).values())  # as run: pages read its settings
             except Exception as err:  # never in place of what stopped the runs
                 log(f"results archive {kept}: not updated ({type(err).__name__}: {err})")
     board = build(out / "students")
@@ -421,7 +428,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         movie = _best_student_video(students, out, log)
     record_session(out, session, time.perf_counter() - clock)
     if kept is not None:
-        keep_all(out, kept, {})  # the runs are kept already: this session's duration
+        keep_all(out, kept, {}, record=archived_any)  # the runs are kept already: this session's duration
         log(f"results archive {kept}: {archive_size(kept) / 1e6:.1f} MB")
     return TransferResult(out, {task: out / "teachers" / t.run_name() for task, t in teachers.items()},
                           students, board_md, plots, movie)

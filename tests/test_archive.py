@@ -237,12 +237,17 @@ def test_a_transfer_on_the_sb3_engine_reuses_the_finished_runs_its_archive_holds
         _finished_record(store / "students", c, {"kind": "student", "steps": c.steps, "task": c.task,
                                                  "method": c.method, "seed": c.seed, "model": "model.zip"})
     assert all(reason is None for reason in map(archive.check_record, (store / "students").iterdir()))
+    (store / "suite.json").write_text('{"name": "quick", "as": "last run"}\n')
+    (store / "provenance.json").write_text('[{"id": "earlier", "command": "craftsuite transfer", "seconds": 1.0}]\n')
+    before = {name: (store / name).read_bytes() for name in ("suite.json", "provenance.json")}
     said = []
     result = suite_runner.transfer(suite, tmp_path / "out", video=False, progress=False, log=said.append,
                                    archive=tmp_path / "results")
     assert f"results archive {store}: 2 of 2 student runs and 1 of 1 teachers copied from it (not trained again)" \
         in said
     assert pools[0].jobs == ["_teacher_job"]  # the teacher's reuse goes through the pool; nothing trains
+    # nothing kept: the archive's record of the suite as last run, and of its sessions, stays as it was
+    assert {name: (store / name).read_bytes() for name in before} == before
     assert sorted(p.name for p in result.students) == sorted(c.run_name() for c in students)
     for run in result.students:
         assert json.loads((run / "result.json").read_text()) == json.loads(

@@ -447,6 +447,13 @@ def _transfer(args) -> int:
         notes.append(f"({'rungs, worlds or methods' if beyond else 'settings'} beyond the suite's: no results archive "
                      "unless --archive DIR is given)")
 
+    if args.dry_run:
+        from .suite_runner import plan
+
+        for line in [*plan(suite, out, archive=archive, device=args.device).lines(), *notes]:
+            print(line)
+        return 0
+
     def log(line: str) -> None:
         print(line)
         while notes:
@@ -773,6 +780,9 @@ def build_parser() -> argparse.ArgumentParser:
                    "where the populations at once (--workers) would hold more than the memory available")
     p.add_argument("--ray", metavar="ADDRESS", help="run the students on Ray ('local' starts one here)")
     p.add_argument("--no-video", action="store_true", help="skip the rollout video of the best student")
+    p.add_argument("--dry-run", action="store_true", help="say what it would train (per cell: the seeds finished "
+                   "in --out or the results archive, which are reused, and the transitions left) and stop: its "
+                   "input checked, nothing trained or written, no leaderboard")
     p.add_argument("--time-limit", type=_positive_float, metavar="MINUTES",
                    help="stop training after this many minutes (a campaign's part, a machine held for a while): the "
                    "runs still training are stopped and resume from their checkpoints when the same command runs "

@@ -337,7 +337,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     from .archive import keep_all, restore
     from .archive import size as archive_size
     from .completion import reread_in_place
-    from .provenance import read, record_session, start_session
+    from .provenance import record_session, start_session
     from .reporting.board import build
     from .reporting.pages import write_leaderboard
     from .reporting.plots import plot_curves
@@ -347,15 +347,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     session, clock = start_session(command), time.perf_counter()
     deadline = None if time_limit is None else time.monotonic() + time_limit
     out = Path(out)
-    configs = suite.student_configs(out / "teachers")
-    teachers = suite.teachers()
-    check_budgets(configs, teachers)
-    kept = _check_places(out, archive, suite.name)
-    _check_out_suite(out, suite.name)
-    _check_students(configs, device, teachers.values())  # fail before any training
-    read(out)  # a damaged provenance record, too
-    _counting_acceptance([out / "students" / c.run_name() for c in configs])  # none unfinished
-    _refuse_sb3_not_kept(out, kept, configs, teachers.values())  # nothing written for a run it would not train
+    configs, teachers, kept = _checked(suite, out, archive, device)
     # the pool, and a Ray cluster with it, before anything is written: one out of reach leaves no output behind
     pool = WorkerPool(len(cells(configs, members)) + len(teachers), workers, ray)
     log(f"suite {suite.name}: {suite.description}")  # (its input checked: a refused transfer says only why)
@@ -455,6 +447,79 @@ def _counting_acceptance(runs: list[Path]) -> list[Path]:
             reread_logs(run, config)  # decidable, or named now
             found.append(run)
     return found
+
+
+def _checked(suite: Suite, out: Path, archive, device: str | None):
+    """``transfer``'s input checked before anything is written (each refusal one line naming
+    the fix): its student configs, its teachers, and the suite's place in the archive (None:
+    no archive)."""
+    from .provenance import read
+
+    configs = suite.student_configs(out / "teachers")
+    teachers = suite.teachers()
+    check_budgets(configs, teachers)
+    kept = _check_places(out, archive, suite.name)
+    _check_out_suite(out, suite.name)
+    _check_students(configs, device, teachers.values())  # fail before any training
+    read(out)  # a damaged provenance record, too
+    _counting_acceptance([out / "students" / c.run_name() for c in configs])  # none unfinished
+    _refuse_sb3_not_kept(out, kept, configs, teachers.values())  # nothing written for a run it would not train
+    return configs, teachers, kept
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What a transfer would train (``plan``): per cell, its seeds finished already (in the
+    output directory or the archive: reused) and asked, and the transitions left to train;
+    the teachers likewise, by count."""
+
+    suite: Suite
+    cells: dict  # (world, task, method) -> [seeds finished, seeds asked, transitions to train]
+    teachers: tuple[int, int]  # finished, asked
+
+    @property
+    def left(self) -> int:
+        return sum(todo for _, _, todo in self.cells.values())
+
+    def lines(self) -> list[str]:
+        """The plan in words: a line per cell, then the totals."""
+        out = [f"suite {self.suite.name} ({self.suite.regime} learner regime), a dry run: nothing is trained or "
+               "written"]
+        for (world, task, method), (done, asked, todo) in self.cells.items():
+            out.append(f"  {world} {task} {method}: {done} of {asked} seeds finished (reused)"
+                       + (f", {asked - done} to train, {todo / 1e6:,.2f}M transitions" if todo else ""))
+        runs = sum(asked - done for done, asked, _ in self.cells.values())
+        asked = sum(asked for _, asked, _ in self.cells.values())
+        out.append(f"students: {runs} of {asked} runs to train, {self.left / 1e6:,.2f}M transitions; teachers: "
+                   f"{self.teachers[1] - self.teachers[0]} of {self.teachers[1]} to train")
+        return out
+
+
+def plan(suite: Suite, out, *, archive=None, device: str | None = None) -> Plan:
+    """What ``transfer`` with these arguments would do, with nothing trained or written: its
+    input checked as ``transfer`` checks it (the same refusals), then each run it asks for
+    found finished in ``out`` or in the archive (reused) or not (to train)."""
+    from .archive import check_record
+
+    out = Path(out)
+    configs, teachers, kept = _checked(suite, out, archive, device)
+
+    def finished(kind: str, name: str) -> bool:
+        if (out / kind / name / "result.json").is_file():
+            return True
+        held = None if kept is None else kept / kind / name
+        return held is not None and (held / "result.json").is_file() and check_record(held) is None
+
+    cells: dict[tuple[str, str, str], list[int]] = {}
+    for c in configs:
+        cell = cells.setdefault((c.world, c.task, c.method), [0, 0, 0])
+        cell[1] += 1
+        if finished("students", c.run_name()):
+            cell[0] += 1
+        else:
+            cell[2] += c.steps
+    done = sum(finished("teachers", t.run_name()) for t in teachers.values())
+    return Plan(suite, cells, (done, len(teachers)))
 
 
 # where else a finished sb3 run can come from: ``--engine sb3`` alone turns the default archive off

@@ -412,3 +412,45 @@ def test_a_leaderboard_drawn_over_an_archive_directory_leaves_git_clean(tmp_path
         records = ["suite.json", "provenance.json", "looks.json", "students/run/evals.csv",
                    "students/run/episodes.csv.gz", "teachers/run/table.npz"]
         assert [r for r in records if ignored(f"{archive_dir}/{r}")] == []
+
+
+def _snapshot(root):
+    return {p.relative_to(root).as_posix(): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def test_a_dry_run_counts_the_runs_it_would_reuse_and_train_and_writes_nothing(tmp_path):
+    from craftsuite.suite_runner import plan
+
+    suite = dataclasses.replace(SUITES["standard"], tags=(), tasks=("Reach",), worlds=("Cont",),
+                                methods=("td3", "td3-static"), seeds=3)
+    configs = suite.student_configs(tmp_path / "out" / "teachers")
+    store, out = tmp_path / "results" / "standard", tmp_path / "out"
+    by = {(c.method, c.seed): c for c in configs}
+    for method, seed, root in (("td3", 0, store), ("td3", 1, out), ("td3-static", 2, store)):
+        c = by[method, seed]
+        _finished_record(root / "students", c, {"kind": "student", "steps": c.steps, "task": c.task,
+                                                "method": c.method, "seed": c.seed, "model": "model.zip"})
+    (out / "students" / by["td3", 2].run_name()).mkdir()  # begun, not finished: still to train
+    before = _snapshot(tmp_path)
+    found = plan(suite, out, archive=tmp_path / "results")
+    steps = configs[0].steps
+    assert found.cells == {("Cont", "Reach", "td3"): [2, 3, steps], ("Cont", "Reach", "td3-static"): [1, 3, 2 * steps]}
+    assert found.left == 3 * steps and found.teachers == (0, 0)
+    assert found.lines()[-1] == (f"students: 3 of 6 runs to train, {3 * steps / 1e6:,.2f}M transitions; "
+                                 "teachers: 0 of 0 to train")
+    assert _snapshot(tmp_path) == before  # nothing written: no suite.json, provenance, restored run
+
+
+def test_the_transfer_command_dry_run_says_what_it_would_train_and_refuses_what_transfer_refuses(tmp_path, capsys):
+    out = tmp_path / "out"
+    args = ["transfer", "--suite", "standard", "--tasks", "Reach", "--worlds", "Cont", "--methods", "td3",
+            "--seeds", "2", "--archive", str(tmp_path / "results"), "--out", str(out), "--dry-run"]
+    assert main(args) == 0
+    said = capsys.readouterr().out
+    assert "a dry run: nothing is trained or written" in said and "Cont Reach td3: 0 of 2 seeds finished" in said
+    assert "leaderboard" not in said
+    assert not out.exists() and not (tmp_path / "results").exists()
+    out.mkdir()
+    (out / "suite.json").write_text(json.dumps({"name": "hard"}))  # another suite's runs: transfer refuses it
+    assert main(args) == 2
+    assert "holds runs of the hard suite" in capsys.readouterr().err

@@ -213,13 +213,13 @@ def restore(archive: Path, out: Path, names: dict[str, set[str]], log=print) -> 
 
 
 def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict | None = None,
-             log=print, record: bool | None = None) -> dict[str, int]:
-    """Archive the finished runs of ``out`` named in ``names`` (kind -> run names), then, if
-    ``record`` (by default: where this call kept a run), the suite as run (``suite.json``)
-    and every session that ran into ``out`` (merged into the archive's ``provenance.json``
-    by session id): a call that keeps nothing new leaves the archive as it was. A run that
-    cannot be kept (a record whose success cannot be re-read) is named through ``log``; the
-    others are kept all the same. Returns how many of each kind were kept."""
+             log=print, record_always: bool = False) -> dict[str, int]:
+    """Archive the finished runs of ``out`` named in ``names`` (kind -> run names), then,
+    where this call kept a run (or ``record_always``), the suite as run (``suite.json``) and
+    every session that ran into ``out`` (merged into the archive's ``provenance.json`` by
+    session id): a call that keeps nothing new leaves the archive as it was unless told to
+    record. A run that cannot be kept (a record whose success cannot be re-read) is named
+    through ``log``; the others are kept all the same. Returns how many of each kind were kept."""
     from .provenance import merge, read
 
     out, archive = Path(out), Path(archive)
@@ -236,7 +236,7 @@ def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict |
                     continue
                 count += 1
         kept[kind] = count
-    if not (any(kept.values()) if record is None else record):
+    if not (record_always or any(kept.values())):
         return kept
     if suite is not None:
         atomic_write(archive / "suite.json", json.dumps(suite, indent=2) + "\n")
@@ -413,5 +413,5 @@ def add(source: Source, archive: Path) -> dict[str, int]:
                 keep(run, archive, kind)
                 kept[kind] += 1
     if any(kept.values()):
-        keep_all(source.path, archive, {}, suite=source.suite, record=True)  # their sessions and suite
+        keep_all(source.path, archive, {}, suite=source.suite, record_always=True)  # their sessions and suite
     return kept

@@ -781,8 +781,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--ray", metavar="ADDRESS", help="run the students on Ray ('local' starts one here)")
     p.add_argument("--no-video", action="store_true", help="skip the rollout video of the best student")
     p.add_argument("--dry-run", action="store_true", help="say what it would train (per cell: the seeds finished "
-                   "in --out or the results archive, which are reused, and the transitions left) and stop: its "
-                   "input checked, nothing trained or written, no leaderboard")
+                   "in --out or the results archive, which are reused, and the transitions left) and stop: the "
+                   "suite, settings and directories checked as a run checks them, nothing trained or written")
     p.add_argument("--time-limit", type=_positive_float, metavar="MINUTES",
                    help="stop training after this many minutes (a campaign's part, a machine held for a while): the "
                    "runs still training are stopped and resume from their checkpoints when the same command runs "

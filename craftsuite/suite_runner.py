@@ -373,15 +373,20 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         pool.close(abort=True)
         raise
 
-    # whether this session has kept a run in the archive: one that keeps none (its runs all
-    # reused) leaves the archive's suite.json and provenance.json as they were
-    archived_any = False
+    # Whether the archive records this session (in its provenance.json, with the suite as run):
+    # one with runs to train always is (its time counts, finished runs or not); one that trains
+    # nothing (every run reused) only once it keeps a run (one re-read here), so that checking
+    # a cell leaves the archive as it was.
+    recorded = any(not (out / kind / name / "result.json").is_file() for kind in names for name in names[kind])
+
+    def archive_runs(kept_names: dict[str, set[str]]) -> None:
+        nonlocal recorded
+        now = keep_all(out, kept, kept_names, suite=dataclasses.asdict(suite), log=log, record_always=recorded)
+        recorded = recorded or any(now.values())
 
     def keep_finished(kind: str, paths: list[Path]) -> None:  # each population as it finishes
-        nonlocal archived_any
         try:
-            archived_any |= any(keep_all(out, kept, {kind: {p.name for p in paths}}, suite=dataclasses.asdict(suite),
-                                         log=log).values())
+            archive_runs({kind: {p.name for p in paths}})
         except Exception as err:  # the runs train on; the end of the session tries again
             log(f"results archive {kept}: not updated ({type(err).__name__}: {err})")
 
@@ -406,8 +411,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     finally:  # what finished is kept, whatever stopped the rest (each population was, as it finished)
         if kept is not None:
             try:  # (the session is on record in out since it started)
-                archived_any |= any(keep_all(out, kept, names, suite=dataclasses.asdict(suite), log=log,
-                                             record=archived_any or None).values())  # as run: pages read its settings
+                archive_runs(names)  # with the suite as run: pages read its settings
             except Exception as err:  # never in place of what stopped the runs
                 log(f"results archive {kept}: not updated ({type(err).__name__}: {err})")
     board = build(out / "students")
@@ -420,7 +424,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         movie = _best_student_video(students, out, log)
     record_session(out, session, time.perf_counter() - clock)
     if kept is not None:
-        keep_all(out, kept, {}, record=archived_any)  # the runs are kept already: this session's duration
+        keep_all(out, kept, {}, record_always=recorded)  # the runs are kept already: this session's duration
         log(f"results archive {kept}: {archive_size(kept) / 1e6:.1f} MB")
     return TransferResult(out, {task: out / "teachers" / t.run_name() for task, t in teachers.items()},
                           students, board_md, plots, movie)
@@ -468,58 +472,83 @@ def _checked(suite: Suite, out: Path, archive, device: str | None):
 
 
 @dataclass(frozen=True)
+class CellPlan:
+    """One cell of a ``Plan``: its seeds asked, those finished already (reused), those with a
+    checkpoint to resume from, and the transitions left to train."""
+
+    asked: int
+    finished: int = 0
+    resumed: int = 0
+    left: int = 0
+
+
+@dataclass(frozen=True)
 class Plan:
-    """What a transfer would train (``plan``): per cell, its seeds finished already (in the
-    output directory or the archive: reused) and asked, and the transitions left to train;
-    the teachers likewise, by count."""
+    """What a transfer would train (``plan``): per cell (world, task, method), a ``CellPlan``;
+    the teachers by count; and the archive's records of its runs that it would skip as
+    damaged (each with why: those runs train again)."""
 
     suite: Suite
-    cells: dict  # (world, task, method) -> [seeds finished, seeds asked, transitions to train]
+    cells: dict[tuple[str, str, str], CellPlan]
     teachers: tuple[int, int]  # finished, asked
+    skipped: tuple[str, ...] = ()
 
     @property
     def left(self) -> int:
-        return sum(todo for _, _, todo in self.cells.values())
+        return sum(cell.left for cell in self.cells.values())
 
     def lines(self) -> list[str]:
-        """The plan in words: a line per cell, then the totals."""
+        """The plan in words: the records skipped, a line per cell, then the totals."""
         out = [f"suite {self.suite.name} ({self.suite.regime} learner regime), a dry run: nothing is trained or "
-               "written"]
-        for (world, task, method), (done, asked, todo) in self.cells.items():
-            out.append(f"  {world} {task} {method}: {done} of {asked} seeds finished (reused)"
-                       + (f", {asked - done} to train, {todo / 1e6:,.2f}M transitions" if todo else ""))
-        runs = sum(asked - done for done, asked, _ in self.cells.values())
-        asked = sum(asked for _, asked, _ in self.cells.values())
-        out.append(f"students: {runs} of {asked} runs to train, {self.left / 1e6:,.2f}M transitions; teachers: "
+               "written", *(f"results archive: skipped {reason}" for reason in self.skipped)]
+        for (world, task, method), cell in self.cells.items():
+            todo = cell.asked - cell.finished
+            out.append(f"  {world} {task} {method}: {cell.asked} seeds, {cell.finished} finished (reused)"
+                       + (f", {todo} to train" + (f" ({cell.resumed} from a checkpoint)" if cell.resumed else "")
+                          + f", {cell.left / 1e6:,.2f}M transitions" if todo else ""))
+        to_train = sum(cell.asked - cell.finished for cell in self.cells.values())
+        runs = sum(cell.asked for cell in self.cells.values())
+        out.append(f"students: {to_train} of {runs} runs to train, {self.left / 1e6:,.2f}M transitions; teachers: "
                    f"{self.teachers[1] - self.teachers[0]} of {self.teachers[1]} to train")
         return out
 
 
 def plan(suite: Suite, out, *, archive=None, device: str | None = None) -> Plan:
-    """What ``transfer`` with these arguments would do, with nothing trained or written: its
-    input checked as ``transfer`` checks it (the same refusals), then each run it asks for
-    found finished in ``out`` or in the archive (reused) or not (to train)."""
+    """What ``transfer`` with these arguments would do, with nothing trained or written: the
+    suite, its settings and its places checked as ``transfer`` checks them (the same
+    refusals; not the workers, which only a run starts), then each run it asks for found
+    finished in ``out`` or in the archive (reused), or to train: from its newest checkpoint
+    in ``out`` where it has one (its population resumes from the newest step all its
+    members hold: that step, or an earlier one)."""
     from .archive import check_record
+    from .population.train import saved_steps
 
     out = Path(out)
     configs, teachers, kept = _checked(suite, out, archive, device)
+    skipped = []
 
     def finished(kind: str, name: str) -> bool:
         if (out / kind / name / "result.json").is_file():
             return True
-        held = None if kept is None else kept / kind / name
-        return held is not None and (held / "result.json").is_file() and check_record(held) is None
+        if kept is None or not (kept / kind / name).is_dir():
+            return False
+        reason = check_record(kept / kind / name)
+        if reason is not None:
+            skipped.append(reason)
+        return reason is None
 
-    cells: dict[tuple[str, str, str], list[int]] = {}
+    counts: dict[tuple[str, str, str], list[int]] = {}
     for c in configs:
-        cell = cells.setdefault((c.world, c.task, c.method), [0, 0, 0])
-        cell[1] += 1
+        cell = counts.setdefault((c.world, c.task, c.method), [0, 0, 0, 0])
+        cell[0] += 1
         if finished("students", c.run_name()):
-            cell[0] += 1
-        else:
-            cell[2] += c.steps
+            cell[1] += 1
+            continue
+        step = max(saved_steps(out / "students" / c.run_name()), default=0)
+        cell[2] += step > 0
+        cell[3] += c.steps - step
     done = sum(finished("teachers", t.run_name()) for t in teachers.values())
-    return Plan(suite, cells, (done, len(teachers)))
+    return Plan(suite, {key: CellPlan(*cell) for key, cell in counts.items()}, (done, len(teachers)), tuple(skipped))
 
 
 # where else a finished sb3 run can come from: ``--engine sb3`` alone turns the default archive off

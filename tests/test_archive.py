@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import signal
+from pathlib import Path
 
 import pytest
 
@@ -419,7 +420,9 @@ def _snapshot(root):
 
 
 def test_a_dry_run_counts_the_runs_it_would_reuse_and_train_and_writes_nothing(tmp_path):
-    from craftsuite.suite_runner import plan
+    from craftsuite.archive import check_record
+    from craftsuite.runs import RunDir
+    from craftsuite.suite_runner import CellPlan, plan
 
     suite = dataclasses.replace(SUITES["standard"], tags=(), tasks=("Reach",), worlds=("Cont",),
                                 methods=("td3", "td3-static"), seeds=3)
@@ -430,14 +433,26 @@ def test_a_dry_run_counts_the_runs_it_would_reuse_and_train_and_writes_nothing(t
         c = by[method, seed]
         _finished_record(root / "students", c, {"kind": "student", "steps": c.steps, "task": c.task,
                                                 "method": c.method, "seed": c.seed, "model": "model.zip"})
-    (out / "students" / by["td3", 2].run_name()).mkdir()  # begun, not finished: still to train
+    begun = out / "students" / by["td3", 2].run_name()  # begun, not finished: resumes from its checkpoint
+    saved = begun / RunDir.CHECKPOINTS[0]  # a member's checkpoint as the population engine writes it
+    saved.mkdir(parents=True)
+    (saved / "step.json").write_text(json.dumps({"num_timesteps": 1000}))
+    (saved / "population.pt").write_bytes(b"state")
+    c = by["td3-static", 1]
+    damaged = _finished_record(store / "students", c, {"kind": "student", "steps": c.steps, "task": c.task,
+                                                        "method": c.method, "seed": c.seed, "model": "model.zip"})
+    (damaged / "config.json").write_text("{torn")  # the archive skips it: the run trains again
     before = _snapshot(tmp_path)
     found = plan(suite, out, archive=tmp_path / "results")
     steps = configs[0].steps
-    assert found.cells == {("Cont", "Reach", "td3"): [2, 3, steps], ("Cont", "Reach", "td3-static"): [1, 3, 2 * steps]}
-    assert found.left == 3 * steps and found.teachers == (0, 0)
-    assert found.lines()[-1] == (f"students: 3 of 6 runs to train, {3 * steps / 1e6:,.2f}M transitions; "
-                                 "teachers: 0 of 0 to train")
+    assert found.cells == {("Cont", "Reach", "td3"): CellPlan(asked=3, finished=2, resumed=1, left=steps - 1000),
+                           ("Cont", "Reach", "td3-static"): CellPlan(asked=3, finished=1, left=2 * steps)}
+    assert found.left == 3 * steps - 1000 and found.teachers == (0, 0)
+    lines = found.lines()
+    assert [line for line in lines if damaged.name in line] == [f"results archive: skipped {check_record(damaged)}"]
+    assert "  Cont Reach td3: 3 seeds, 2 finished (reused), 1 to train (1 from a checkpoint)" in lines[-3]
+    assert lines[-1] == (f"students: 3 of 6 runs to train, {(3 * steps - 1000) / 1e6:,.2f}M transitions; "
+                         "teachers: 0 of 0 to train")
     assert _snapshot(tmp_path) == before  # nothing written: no suite.json, provenance, restored run
 
 
@@ -447,10 +462,59 @@ def test_the_transfer_command_dry_run_says_what_it_would_train_and_refuses_what_
             "--seeds", "2", "--archive", str(tmp_path / "results"), "--out", str(out), "--dry-run"]
     assert main(args) == 0
     said = capsys.readouterr().out
-    assert "a dry run: nothing is trained or written" in said and "Cont Reach td3: 0 of 2 seeds finished" in said
+    assert "a dry run: nothing is trained or written" in said and "Cont Reach td3: 2 seeds, 0 finished" in said
     assert "leaderboard" not in said
     assert not out.exists() and not (tmp_path / "results").exists()
     out.mkdir()
     (out / "suite.json").write_text(json.dumps({"name": "hard"}))  # another suite's runs: transfer refuses it
     assert main(args) == 2
-    assert "holds runs of the hard suite" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "holds runs of the hard suite" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_session_stopped_by_its_time_limit_before_any_run_finished_is_on_the_archives_record(tmp_path, monkeypatch):
+    """Its time counts (the results page sums the sessions' wall time) though it kept no run."""
+    import craftsuite.suite_runner as suite_runner
+    from craftsuite.cli import TIME_LIMIT_STATUS
+    from craftsuite.provenance import read
+
+    monkeypatch.setattr(suite_runner, "WorkerPool", _InProcessPool)
+
+    def stopped(configs, root, **kwargs):
+        raise suite_runner.TimeLimitReached("time limit reached with 2 of 2 student runs unfinished")
+
+    monkeypatch.setattr(suite_runner, "run_students", stopped)
+    monkeypatch.chdir(tmp_path)
+    assert main(["transfer", "--suite", "standard", "--worlds", "Grid10", "--tasks", "Reach", "--methods", "dqn",
+                 "--seeds", "2", "--no-video", "--time-limit", "1.5", "--out", "runs"]) == TIME_LIMIT_STATUS
+    [session] = read(tmp_path / "results" / "standard")
+    assert session["seconds"] is not None
+
+
+def test_a_session_whose_record_failed_as_a_population_finished_is_recorded_at_its_end(tmp_path, monkeypatch):
+    import craftsuite.provenance as provenance
+    import craftsuite.suite_runner as suite_runner
+    from craftsuite.provenance import read
+
+    monkeypatch.setattr(suite_runner, "WorkerPool", _InProcessPool)
+    real, failed = provenance.merge, []
+
+    def fails_once(where, sessions):
+        if not failed and "results" in Path(where).parts:  # the archive's, not the output directory's
+            failed.append(where)
+            raise OSError("No space left on device")
+        return real(where, sessions)
+
+    monkeypatch.setattr(provenance, "merge", fails_once)
+
+    def trains_all(configs, root, finished=None, **kwargs):
+        paths = [_finished_record(root, c, {"kind": "student", "steps": c.steps, "task": c.task, "method": c.method,
+                                            "seed": c.seed, "model": "model.zip"}) for c in configs]
+        finished("students", paths)  # its record fails here: the session's end tries again
+        return paths
+
+    monkeypatch.setattr(suite_runner, "run_students", trains_all)
+    monkeypatch.chdir(tmp_path)
+    assert main(["transfer", "--suite", "standard", "--worlds", "Grid10", "--tasks", "Reach", "--methods", "dqn",
+                 "--seeds", "1", "--no-video", "--out", "runs"]) == 0
+    assert failed and [s["seconds"] is not None for s in read(tmp_path / "results" / "standard")] == [True]

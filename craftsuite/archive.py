@@ -6,7 +6,7 @@ One directory per suite, shaped as a transfer output, so that every reader of ru
 it as one::
 
     results/<suite>/suite.json, provenance.json      the suite as last run; every session
-                                                      (of those that kept runs here)
+                                                      (of those that trained or kept runs here)
     results/<suite>/teachers/<run name>/              config.json, result.json, evals.csv,
                                                       episodes.csv.gz, table.npz
     results/<suite>/students/<run name>/              config.json, result.json, evals.csv,

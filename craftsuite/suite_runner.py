@@ -369,19 +369,23 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
             reread_in_place(run)  # (restored ones too)
             log(f"re-read {run.name}: its success counted the automaton's acceptance; now completion")
         _refuse_unfinished_sb3(out, configs, teachers.values())  # in case a restore left one out (a run in use)
+        # Whether the archive records this session (in its provenance.json, with the suite as
+        # run): one with runs to train always is (its time counts, finished runs or not); one
+        # that trains nothing (every run reused) only once it keeps a run (one re-read here, or
+        # one finished in --out that the archive lacks), so that checking a cell leaves the
+        # archive as it was.
+        recorded = any(not (out / kind / name / "result.json").is_file() for kind in names for name in names[kind])
     except BaseException:
         pool.close(abort=True)
         raise
 
-    # Whether the archive records this session (in its provenance.json, with the suite as run):
-    # one with runs to train always is (its time counts, finished runs or not); one that trains
-    # nothing (every run reused) only once it keeps a run (one re-read here), so that checking
-    # a cell leaves the archive as it was.
-    recorded = any(not (out / kind / name / "result.json").is_file() for kind in names for name in names[kind])
-
     def archive_runs(kept_names: dict[str, set[str]]) -> None:
         nonlocal recorded
-        now = keep_all(out, kept, kept_names, suite=dataclasses.asdict(suite), log=log, record_always=recorded)
+        try:
+            now = keep_all(out, kept, kept_names, suite=dataclasses.asdict(suite), log=log, record_always=recorded)
+        except Exception:
+            recorded = True  # it may have kept runs before its record failed: the session's end records it
+            raise
         recorded = recorded or any(now.values())
 
     def keep_finished(kind: str, paths: list[Path]) -> None:  # each population as it finishes
@@ -401,11 +405,13 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         raise
     except BrokenProcessPool as err:  # a local worker died (run_students has stopped the rest already)
         pool.close(abort=True)
+        record_session(out, session, time.perf_counter() - clock)  # this process ran to here: its time counts
         raise WorkerLost(pool.lost) from err
     except BaseException as err:
         pool.close(abort=True)  # (run_students closes it too, but not if it failed before its jobs; twice is harmless)
         how = ray_worker_lost(err)
         if how is not None:  # as a local worker's death: one line, and the same command resumes
+            record_session(out, session, time.perf_counter() - clock)
             raise WorkerLost([], how) from err
         raise
     finally:  # what finished is kept, whatever stopped the rest (each population was, as it finished)
@@ -424,7 +430,8 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         movie = _best_student_video(students, out, log)
     record_session(out, session, time.perf_counter() - clock)
     if kept is not None:
-        keep_all(out, kept, {}, record_always=recorded)  # the runs are kept already: this session's duration
+        # the runs are kept already: this session's duration (and its suite, where a record failed before)
+        keep_all(out, kept, {}, suite=dataclasses.asdict(suite), record_always=recorded)
         log(f"results archive {kept}: {archive_size(kept) / 1e6:.1f} MB")
     return TransferResult(out, {task: out / "teachers" / t.run_name() for task, t in teachers.items()},
                           students, board_md, plots, movie)
@@ -474,7 +481,9 @@ def _checked(suite: Suite, out: Path, archive, device: str | None):
 @dataclass(frozen=True)
 class CellPlan:
     """One cell of a ``Plan``: its seeds asked, those finished already (reused), those with a
-    checkpoint to resume from, and the transitions left to train."""
+    checkpoint to resume from, and the transitions left to train (counted from each run's
+    newest checkpoint; its population resumes from the newest step all its members hold,
+    that or an earlier one: so at least this many)."""
 
     asked: int
     finished: int = 0
@@ -504,11 +513,14 @@ class Plan:
         for (world, task, method), cell in self.cells.items():
             todo = cell.asked - cell.finished
             out.append(f"  {world} {task} {method}: {cell.asked} seeds, {cell.finished} finished (reused)"
-                       + (f", {todo} to train" + (f" ({cell.resumed} from a checkpoint)" if cell.resumed else "")
-                          + f", {cell.left / 1e6:,.2f}M transitions" if todo else ""))
+                       + (f", {todo} to train, " + (f"at least {cell.left / 1e6:,.2f}M transitions ({cell.resumed} "
+                                                    "resume from a checkpoint)" if cell.resumed else
+                                                    f"{cell.left / 1e6:,.2f}M transitions") if todo else ""))
         to_train = sum(cell.asked - cell.finished for cell in self.cells.values())
         runs = sum(cell.asked for cell in self.cells.values())
-        out.append(f"students: {to_train} of {runs} runs to train, {self.left / 1e6:,.2f}M transitions; teachers: "
+        least = "at least " if any(cell.resumed for cell in self.cells.values()) else ""
+        out.append(f"students: {to_train} of {runs} runs to train, {least}{self.left / 1e6:,.2f}M transitions; "
+                   "teachers: "
                    f"{self.teachers[1] - self.teachers[0]} of {self.teachers[1]} to train")
         return out
 

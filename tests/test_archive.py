@@ -321,6 +321,10 @@ def test_a_transfer_whose_worker_was_killed_keeps_what_finished_and_exits_as_a_k
                     "fewer seeds to a population (--members) or populations at once (--workers) use less; the same "
                     "command resumes the unfinished runs from their checkpoints"]
     assert len(list((tmp_path / "results" / "standard" / "students").iterdir())) == 1
+    from craftsuite.provenance import read
+
+    [session] = read(tmp_path / "results" / "standard")  # the time it ran counts, as a stop's does
+    assert session["seconds"] is not None
 
 
 @pytest.mark.parametrize("died, how", [
@@ -450,8 +454,11 @@ def test_a_dry_run_counts_the_runs_it_would_reuse_and_train_and_writes_nothing(t
     assert found.left == 3 * steps - 1000 and found.teachers == (0, 0)
     lines = found.lines()
     assert [line for line in lines if damaged.name in line] == [f"results archive: skipped {check_record(damaged)}"]
-    assert "  Cont Reach td3: 3 seeds, 2 finished (reused), 1 to train (1 from a checkpoint)" in lines[-3]
-    assert lines[-1] == (f"students: 3 of 6 runs to train, {(3 * steps - 1000) / 1e6:,.2f}M transitions; "
+    assert lines[-3] == (f"  Cont Reach td3: 3 seeds, 2 finished (reused), 1 to train, at least "
+                         f"{(steps - 1000) / 1e6:,.2f}M transitions (1 resume from a checkpoint)")
+    assert lines[-2] == f"  Cont Reach td3-static: 3 seeds, 1 finished (reused), 2 to train, {2 * steps / 1e6:,.2f}M " \
+                        "transitions"
+    assert lines[-1] == (f"students: 3 of 6 runs to train, at least {(3 * steps - 1000) / 1e6:,.2f}M transitions; "
                          "teachers: 0 of 0 to train")
     assert _snapshot(tmp_path) == before  # nothing written: no suite.json, provenance, restored run
 
@@ -518,3 +525,36 @@ def test_a_session_whose_record_failed_as_a_population_finished_is_recorded_at_i
     assert main(["transfer", "--suite", "standard", "--worlds", "Grid10", "--tasks", "Reach", "--methods", "dqn",
                  "--seeds", "1", "--no-video", "--out", "runs"]) == 0
     assert failed and [s["seconds"] is not None for s in read(tmp_path / "results" / "standard")] == [True]
+
+
+def test_a_session_that_trains_nothing_but_keeps_a_run_is_recorded_though_its_first_record_failed(tmp_path,
+                                                                                                  monkeypatch):
+    """A run finished in --out that the archive lacks is kept by a session with nothing to
+    train: its record (the session, the suite) is written, at the session's end if it failed before."""
+    import craftsuite.provenance as provenance
+    import craftsuite.suite_runner as suite_runner
+    from craftsuite.provenance import read
+
+    monkeypatch.setattr(suite_runner, "WorkerPool", _InProcessPool)
+    suite = dataclasses.replace(SUITES["standard"], tags=(), tasks=("Reach",), worlds=("Grid10",), methods=("dqn",),
+                                seeds=1)
+    [config] = suite.student_configs(tmp_path / "out" / "teachers")
+    _finished_record(tmp_path / "out" / "students", config, {"kind": "student", "steps": config.steps,
+                                                             "task": config.task, "method": config.method,
+                                                             "seed": config.seed, "model": "model.zip"})
+    real, failed = provenance.merge, []
+
+    def fails_once(where, sessions):
+        if not failed and "results" in Path(where).parts:
+            failed.append(where)
+            raise OSError("No space left on device")
+        return real(where, sessions)
+
+    monkeypatch.setattr(provenance, "merge", fails_once)
+    monkeypatch.setattr(suite_runner, "run_students", lambda configs, root, **kwargs: [root / c.run_name()
+                                                                                       for c in configs])
+    suite_runner.transfer(suite, tmp_path / "out", video=False, progress=False, log=lambda *_: None,
+                          archive=tmp_path / "results")
+    store = tmp_path / "results" / "standard"
+    assert failed and (store / "students" / config.run_name() / "result.json").is_file()
+    assert [s["seconds"] is not None for s in read(store)] == [True] and (store / "suite.json").is_file()

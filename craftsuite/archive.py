@@ -240,7 +240,8 @@ def keep_all(out: Path, archive: Path, names: dict[str, set[str]], suite: dict |
         return kept
     if suite is not None:
         atomic_write(archive / "suite.json", json.dumps(suite, indent=2) + "\n")
-    sessions = read(out)
+    # (a session that reused every run stays off the archive's record, though a later one into out is on it)
+    sessions = [s for s in read(out) if not s.get("reused_only")]
     if sessions:
         merge(archive, sessions)
     return kept

@@ -450,7 +450,8 @@ def _transfer(args) -> int:
     if args.dry_run:
         from .suite_runner import plan
 
-        for line in [*plan(suite, out, archive=archive, device=args.device).lines(), *notes]:
+        suite_line, *rest = plan(suite, out, archive=archive, device=args.device).lines()
+        for line in [suite_line, *notes, *rest]:  # the notes under the suite's line, as a run says them
             print(line)
         return 0
 

@@ -3,6 +3,8 @@
 ``transfer`` takes a session when it starts (``start_session``), records it in
 ``<out>/provenance.json`` at once without a duration, and records its duration when it
 ends: a session that is killed still leaves its command and commit, marked unfinished.
+One that trained and kept nothing (every run it asked for reused) is marked ``reused_only``:
+on record where it ran, never merged into a results archive (``archive.keep_all``).
 The results page (``reporting.pages.write_results_page``) prints the sessions beside the leaderboard.
 """
 

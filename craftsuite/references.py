@@ -10,10 +10,11 @@ on episode seeds 0, 1, ...
 ``craftsuite tasks --markdown docs/tasks.md`` writes the page; nothing in it is typed by hand.
 The references depend on the code alone, the archive's figures on the page do not: the
 references are kept in the cache (``paths.cache_dir("references")``), keyed by a digest of the
-package's code and data, the ids' registrations and specs and the versions of the libraries
-that simulate, so that the page rebuilt after runs land plays its thousands of episodes again
-only when one of those changed (any change to the package's code counts; delete the cache's
-``references/`` folder to play them again regardless).
+package's code and data, the ids' registrations and specs, the episodes, the versions of the
+libraries that simulate and the Python version and CPU architecture, so that the page
+rebuilt after runs land plays its thousands of episodes again only when one of those changed
+(any change to the package's code counts; delete the cache's ``references/`` folder to play
+them again regardless).
 """
 
 from __future__ import annotations

@@ -374,19 +374,19 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         # that trains nothing (every run reused) only once it keeps a run (one re-read here, or
         # one finished in --out that the archive lacks), so that checking a cell leaves the
         # archive as it was.
-        recorded = any(not (out / kind / name / "result.json").is_file() for kind in names for name in names[kind])
+        on_record = any(not (out / kind / name / "result.json").is_file() for kind in names for name in names[kind])
     except BaseException:
         pool.close(abort=True)
         raise
 
     def archive_runs(kept_names: dict[str, set[str]]) -> None:
-        nonlocal recorded
+        nonlocal on_record
         try:
-            now = keep_all(out, kept, kept_names, suite=dataclasses.asdict(suite), log=log, record_always=recorded)
+            now = keep_all(out, kept, kept_names, suite=dataclasses.asdict(suite), log=log, record_always=on_record)
         except Exception:
-            recorded = True  # it may have kept runs before its record failed: the session's end records it
+            on_record = True  # it may have kept runs before its record failed: the session's end records it
             raise
-        recorded = recorded or any(now.values())
+        on_record = on_record or any(now.values())
 
     def keep_finished(kind: str, paths: list[Path]) -> None:  # each population as it finishes
         try:
@@ -428,10 +428,10 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
     movie = None
     if video:
         movie = _best_student_video(students, out, log)
-    record_session(out, session, time.perf_counter() - clock)
+    record_session(out, session if on_record else {**session, "reused_only": True}, time.perf_counter() - clock)
     if kept is not None:
         # the runs are kept already: this session's duration (and its suite, where a record failed before)
-        keep_all(out, kept, {}, suite=dataclasses.asdict(suite), record_always=recorded)
+        keep_all(out, kept, {}, suite=dataclasses.asdict(suite), record_always=on_record)
         log(f"results archive {kept}: {archive_size(kept) / 1e6:.1f} MB")
     return TransferResult(out, {task: out / "teachers" / t.run_name() for task, t in teachers.items()},
                           students, board_md, plots, movie)
@@ -511,17 +511,19 @@ class Plan:
         out = [f"suite {self.suite.name} ({self.suite.regime} learner regime), a dry run: nothing is trained or "
                "written", *(f"results archive: skipped {reason}" for reason in self.skipped)]
         for (world, task, method), cell in self.cells.items():
-            todo = cell.asked - cell.finished
-            out.append(f"  {world} {task} {method}: {cell.asked} seeds, {cell.finished} finished (reused)"
-                       + (f", {todo} to train, " + (f"at least {cell.left / 1e6:,.2f}M transitions ({cell.resumed} "
-                                                    "resume from a checkpoint)" if cell.resumed else
-                                                    f"{cell.left / 1e6:,.2f}M transitions") if todo else ""))
+            line = f"  {world} {task} {method}: {cell.asked} seeds, {cell.finished} finished (reused)"
+            if cell.asked > cell.finished:
+                line += f", {cell.asked - cell.finished} to train, "
+                if cell.resumed:
+                    line += f"at least {cell.left / 1e6:,.2f}M transitions ({cell.resumed} resume from a checkpoint)"
+                else:
+                    line += f"{cell.left / 1e6:,.2f}M transitions"
+            out.append(line)
         to_train = sum(cell.asked - cell.finished for cell in self.cells.values())
         runs = sum(cell.asked for cell in self.cells.values())
         least = "at least " if any(cell.resumed for cell in self.cells.values()) else ""
         out.append(f"students: {to_train} of {runs} runs to train, {least}{self.left / 1e6:,.2f}M transitions; "
-                   "teachers: "
-                   f"{self.teachers[1] - self.teachers[0]} of {self.teachers[1]} to train")
+                   f"teachers: {self.teachers[1] - self.teachers[0]} of {self.teachers[1]} to train")
         return out
 
 
@@ -536,15 +538,15 @@ def plan(suite: Suite, out, *, archive=None, device: str | None = None) -> Plan:
     from .population.train import saved_steps
 
     out = Path(out)
-    configs, teachers, kept = _checked(suite, out, archive, device)
+    configs, teachers, store = _checked(suite, out, archive, device)
     skipped = []
 
     def finished(kind: str, name: str) -> bool:
         if (out / kind / name / "result.json").is_file():
             return True
-        if kept is None or not (kept / kind / name).is_dir():
+        if store is None or not (store / kind / name).is_dir():
             return False
-        reason = check_record(kept / kind / name)
+        reason = check_record(store / kind / name)
         if reason is not None:
             skipped.append(reason)
         return reason is None

@@ -558,3 +558,30 @@ def test_a_session_that_trains_nothing_but_keeps_a_run_is_recorded_though_its_fi
     store = tmp_path / "results" / "standard"
     assert failed and (store / "students" / config.run_name() / "result.json").is_file()
     assert [s["seconds"] is not None for s in read(store)] == [True] and (store / "suite.json").is_file()
+
+
+def test_a_session_that_reused_every_run_stays_off_the_archives_record_when_a_later_one_into_its_out_trains(
+        tmp_path, monkeypatch):
+    import craftsuite.suite_runner as suite_runner
+    from craftsuite.provenance import read
+
+    monkeypatch.setattr(suite_runner, "WorkerPool", _InProcessPool)
+
+    def trains_the_unfinished(configs, root, finished=None, **kwargs):
+        paths = [root / c.run_name() if (root / c.run_name() / "result.json").is_file() else
+                 _finished_record(root, c, {"kind": "student", "steps": c.steps, "task": c.task, "method": c.method,
+                                            "seed": c.seed, "model": "model.zip"}) for c in configs]
+        finished("students", paths)
+        return paths
+
+    monkeypatch.setattr(suite_runner, "run_students", trains_the_unfinished)
+    sessions = []
+    for seeds in (1, 1, 2):  # trains seed 0; reuses it; trains seed 1
+        suite = dataclasses.replace(SUITES["standard"], tags=(), tasks=("Reach",), worlds=("Grid10",),
+                                    methods=("dqn",), seeds=seeds)
+        suite_runner.transfer(suite, tmp_path / "out", video=False, progress=False, log=lambda *_: None,
+                              archive=tmp_path / "results", command=f"transfer --seeds {seeds} ({len(sessions)})")
+        sessions.append(read(tmp_path / "out")[-1])
+    assert [s.get("reused_only", False) for s in sessions] == [False, True, False]
+    assert [s["command"] for s in read(tmp_path / "results" / "standard")] == \
+        [sessions[0]["command"], sessions[2]["command"]]

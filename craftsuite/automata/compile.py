@@ -13,9 +13,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import paths
 from ..files import atomic_path
 from ..names import unknown_name
+from ..paths import cache_dir as cache_folder
 from .dfa import MAX_PROPOSITIONS, Automaton, minimize
 from .ltlf import LTLfSyntaxError, atoms, parse
 from .progression import progress_to_dfa
@@ -29,7 +29,7 @@ _NAME = re.compile(r"[a-z_][a-z0-9_]*\Z")
 
 def cache_dir() -> Path:
     """Where compiled automata are cached: $CRAFTSUITE_CACHE_DIR/automata, else the XDG cache's."""
-    return paths.cache_dir("automata")
+    return cache_folder("automata")
 
 
 def _check(formula: str, propositions) -> tuple[tuple[str, ...], tuple]:

@@ -32,7 +32,7 @@ from .files import atomic_write
 from .ids import file_stem
 from .methods import METHODS, methods_for
 from .progress import progress_bar
-from .runs import RunDir, read_result, teacher_outcome
+from .runs import RunDir, in_use, read_result, teacher_outcome
 from .suites import Suite
 from .task_registry import carried, resolve_task
 from .worker_pool import WorkerPool, ray_worker_lost
@@ -501,6 +501,7 @@ class Plan:
     cells: dict[tuple[str, str, str], CellPlan]
     teachers: tuple[int, int]  # finished, asked
     skipped: tuple[str, ...] = ()
+    busy: tuple[Path, ...] = ()  # unfinished runs in ``out`` that a live process trains now
 
     @property
     def left(self) -> int:
@@ -509,7 +510,9 @@ class Plan:
     def lines(self) -> list[str]:
         """The plan in words: the records skipped, a line per cell, then the totals."""
         out = [f"suite {self.suite.name} ({self.suite.regime} learner regime), a dry run: nothing is trained or "
-               "written", *(f"results archive: skipped {reason}" for reason in self.skipped)]
+               "written", *(f"results archive: skipped {reason}" for reason in self.skipped),
+               *(f"{run} is in use by a live run: nothing is restored into it, and a transfer started now "
+                 "stops at it; wait for that run to end" for run in self.busy)]
         for (world, task, method), cell in self.cells.items():
             line = f"  {world} {task} {method}: {cell.asked} seeds, {cell.finished} finished (reused)"
             if cell.asked > cell.finished:
@@ -533,17 +536,22 @@ def plan(suite: Suite, out, *, archive=None, device: str | None = None) -> Plan:
     refusals; not the workers, which only a run starts), then each run it asks for found
     finished in ``out`` or in the archive (reused), or to train: from its newest checkpoint
     in ``out`` where it has one (its population resumes from the newest step all its
-    members hold: that step, or an earlier one)."""
+    members hold: that step, or an earlier one). A run that a live process trains in ``out``
+    is named (``Plan.busy``): ``archive.restore`` leaves it alone and a transfer could not
+    take it."""
     from .archive import check_record
     from .population.train import saved_steps
 
     out = Path(out)
     configs, teachers, store = _checked(suite, out, archive, device)
-    skipped = []
+    skipped, busy = [], []
 
     def finished(kind: str, name: str) -> bool:
         if (out / kind / name / "result.json").is_file():
             return True
+        if in_use(out / kind / name):
+            busy.append(out / kind / name)
+            return False
         if store is None or not (store / kind / name).is_dir():
             return False
         reason = check_record(store / kind / name)
@@ -562,7 +570,8 @@ def plan(suite: Suite, out, *, archive=None, device: str | None = None) -> Plan:
         cell[2] += step > 0
         cell[3] += c.steps - step
     done = sum(finished("teachers", t.run_name()) for t in teachers.values())
-    return Plan(suite, {key: CellPlan(*cell) for key, cell in counts.items()}, (done, len(teachers)), tuple(skipped))
+    return Plan(suite, {key: CellPlan(*cell) for key, cell in counts.items()}, (done, len(teachers)), tuple(skipped),
+                tuple(busy))
 
 
 # where else a finished sb3 run can come from: ``--engine sb3`` alone turns the default archive off

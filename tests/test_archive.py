@@ -463,6 +463,29 @@ def test_a_dry_run_counts_the_runs_it_would_reuse_and_train_and_writes_nothing(t
     assert _snapshot(tmp_path) == before  # nothing written: no suite.json, provenance, restored run
 
 
+def test_a_dry_run_names_a_run_a_live_process_trains_and_does_not_count_it_reused(tmp_path):
+    """``archive.restore`` leaves a run in use alone, and a transfer could not take its lock:
+    its archived record is not what a transfer now would reuse."""
+    from craftsuite.runs import RunDir
+    from craftsuite.suite_runner import CellPlan, plan
+
+    suite = dataclasses.replace(SUITES["standard"], tags=(), tasks=("Reach",), worlds=("Cont",),
+                                methods=("td3",), seeds=2)
+    configs = suite.student_configs(tmp_path / "out" / "teachers")
+    store, out = tmp_path / "results" / "standard", tmp_path / "out"
+    for c in configs:
+        _finished_record(store / "students", c, {"kind": "student", "steps": c.steps, "task": c.task,
+                                                 "method": c.method, "seed": c.seed, "model": "model.zip"})
+    live = out / "students" / configs[1].run_name()
+    with RunDir(live, configs[1]):  # a live run's lock, as a training process holds it
+        found = plan(suite, out, archive=tmp_path / "results")
+    assert found.cells == {("Cont", "Reach", "td3"): CellPlan(asked=2, finished=1, left=configs[1].steps)}
+    assert found.busy == (live,)
+    assert [line for line in found.lines() if str(live) in line] == [
+        f"{live} is in use by a live run: nothing is restored into it, and a transfer started now stops at it; "
+        "wait for that run to end"]
+
+
 def test_the_transfer_command_dry_run_says_what_it_would_train_and_refuses_what_transfer_refuses(tmp_path, capsys):
     out = tmp_path / "out"
     args = ["transfer", "--suite", "standard", "--tasks", "Reach", "--worlds", "Cont", "--methods", "td3",

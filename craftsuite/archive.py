@@ -189,24 +189,27 @@ def keep(run: Path, archive: Path, kind: str) -> Path:
 def restore(archive: Path, out: Path, names: dict[str, set[str]], log=print) -> dict[str, int]:
     """Copy into ``out/<kind>/`` the archived runs named in ``names`` (kind -> run names)
     that ``out`` does not hold finished: a run there is finished, so it is reused and not
-    trained again. Unusable archived runs are named through ``log`` and skipped. Returns how
+    trained again. An unusable archived record of a run it would copy is named through
+    ``log`` and skipped (that run trains anew); the archive's other records are not read (a
+    suite's archive holds thousands, and a transfer of one cell asks for a few). Returns how
     many of each kind were restored."""
     restored = {}
     for kind in KINDS:
-        runs, skipped = archived(archive, kind)
-        for reason in skipped:
-            log(f"results archive: skipped {reason}")
         count = 0
-        for name in sorted(names.get(kind, set()) & set(runs)):
-            dest = Path(out) / kind / name
-            if (dest / "result.json").exists():
+        for name in sorted(names.get(kind, set())):
+            source, dest = Path(archive) / kind / name, Path(out) / kind / name
+            if not source.is_dir() or (dest / "result.json").exists():
                 continue
-            if dest.exists():  # an unfinished run of the same settings: the archive's finished one wins,
-                if in_use(dest):  # unless it is training now
-                    log(f"results archive: {dest} is in use by a live run; its archived record is not restored")
-                    continue
+            if dest.exists() and in_use(dest):  # an unfinished run of the same settings, training now
+                log(f"results archive: {dest} is in use by a live run; its archived record is not restored")
+                continue
+            reason = check_record(source)
+            if reason is not None:
+                log(f"results archive: skipped {reason}")
+                continue
+            if dest.exists():  # unfinished: the archive's finished run of the same settings wins
                 shutil.rmtree(dest)
-            shutil.copytree(runs[name], dest)
+            shutil.copytree(source, dest)
             count += 1
         restored[kind] = count
     return restored

@@ -590,15 +590,12 @@ def _refuse_sb3_not_kept(out: Path, kept: Path | None, configs: list[StudentConf
     """Refuse, before anything is written, a run of the sb3 engine finished neither in
     ``out`` nor in the archive ``kept`` (None: none), whose usable runs ``archive.restore``
     copies into ``out``: that engine's runs are reused, never trained."""
-    from .archive import archived
+    from .archive import check_record
     from .training import SB3_REFUSED
 
-    missing = _sb3_runs(out, configs, teachers)
-    if not missing:  # (an archive is read only when it must be: a large one takes a while)
-        return
-    held = {kind: set(archived(kept, kind)[0]) if kept is not None else set() for kind in ("teachers", "students")}
-    for kind, config in missing:
-        if config.run_name() not in held[kind]:
+    for kind, config in _sb3_runs(out, configs, teachers):
+        record = None if kept is None else kept / kind / config.run_name()
+        if record is None or not record.is_dir() or check_record(record) is not None:
             raise ValueError(SB3_REFUSED.format(name=config.run_name(), also=ARCHIVE_FIX))
 
 

@@ -186,31 +186,50 @@ def keep(run: Path, archive: Path, kind: str) -> Path:
     return final
 
 
+def reuse(archive: Path | None, out: Path, kind: str, name: str) -> tuple[str, str | None]:
+    """How a transfer into ``out`` reuses the run ``name`` of ``kind`` (``teachers``,
+    ``students``) it asks for, with the archive at ``archive`` (None: none), and why where a
+    record is refused: ``("finished", None)``, ``out`` holds it finished; ``("busy", None)``, a
+    live process trains it in ``out`` (nothing is restored into it, and a transfer started
+    now stops at its lock); ``("archived", None)``, the archive's record is usable (``restore``
+    copies it); ``("skipped", why)``, the archive's record is not (the run trains anew);
+    ``("absent", None)``, neither holds it (it trains). ``restore`` and the dry run both
+    decide by it."""
+    run = Path(out) / kind / name
+    if (run / "result.json").is_file():
+        return "finished", None
+    if in_use(run):
+        return "busy", None
+    record = None if archive is None else Path(archive) / kind / name
+    if record is None or not record.is_dir():
+        return "absent", None
+    why = check_record(record)
+    return ("archived", None) if why is None else ("skipped", why)
+
+
 def restore(archive: Path, out: Path, names: dict[str, set[str]], log=print) -> dict[str, int]:
     """Copy into ``out/<kind>/`` the archived runs named in ``names`` (kind -> run names)
     that ``out`` does not hold finished: a run there is finished, so it is reused and not
-    trained again. An unusable archived record of a run it would copy is named through
-    ``log`` and skipped (that run trains anew); the archive's other records are not read (a
-    suite's archive holds thousands, and a transfer of one cell asks for a few). Returns how
-    many of each kind were restored."""
+    trained again (``reuse`` decides each). An unusable archived record of a run it would
+    copy is named through ``log`` and skipped (that run trains anew), as is a run a live
+    process trains in ``out``; the archive's other records are not read (a suite's archive
+    holds thousands, and a transfer of one cell asks for a few). Returns how many of each
+    kind were restored."""
     restored = {}
     for kind in KINDS:
         count = 0
         for name in sorted(names.get(kind, set())):
-            source, dest = Path(archive) / kind / name, Path(out) / kind / name
-            if not source.is_dir() or (dest / "result.json").exists():
-                continue
-            if dest.exists() and in_use(dest):  # an unfinished run of the same settings, training now
-                log(f"results archive: {dest} is in use by a live run; its archived record is not restored")
-                continue
-            reason = check_record(source)
-            if reason is not None:
-                log(f"results archive: skipped {reason}")
-                continue
-            if dest.exists():  # unfinished: the archive's finished run of the same settings wins
-                shutil.rmtree(dest)
-            shutil.copytree(source, dest)
-            count += 1
+            found, why = reuse(archive, out, kind, name)
+            dest = Path(out) / kind / name
+            if found == "busy":
+                log(f"results archive: {dest} is in use by a live run: nothing is restored into it")
+            elif found == "skipped":
+                log(f"results archive: skipped {why}")
+            elif found == "archived":
+                if dest.exists():  # unfinished: the archive's finished run of the same settings wins
+                    shutil.rmtree(dest)
+                shutil.copytree(Path(archive) / kind / name, dest)
+                count += 1
         restored[kind] = count
     return restored
 

@@ -32,7 +32,7 @@ from .files import atomic_write
 from .ids import file_stem
 from .methods import METHODS, methods_for
 from .progress import progress_bar
-from .runs import RunDir, in_use, read_result, teacher_outcome
+from .runs import RunDir, read_result, teacher_outcome
 from .suites import Suite
 from .task_registry import carried, resolve_task
 from .worker_pool import WorkerPool, ray_worker_lost
@@ -539,7 +539,7 @@ def plan(suite: Suite, out, *, archive=None, device: str | None = None) -> Plan:
     members hold: that step, or an earlier one). A run that a live process trains in ``out``
     is named (``Plan.busy``): ``archive.restore`` leaves it alone and a transfer could not
     take it."""
-    from .archive import check_record
+    from .archive import reuse
     from .population.train import saved_steps
 
     out = Path(out)
@@ -547,17 +547,12 @@ def plan(suite: Suite, out, *, archive=None, device: str | None = None) -> Plan:
     skipped, busy = [], []
 
     def finished(kind: str, name: str) -> bool:
-        if (out / kind / name / "result.json").is_file():
-            return True
-        if in_use(out / kind / name):
+        found, why = reuse(store, out, kind, name)
+        if found == "busy":
             busy.append(out / kind / name)
-            return False
-        if store is None or not (store / kind / name).is_dir():
-            return False
-        reason = check_record(store / kind / name)
-        if reason is not None:
-            skipped.append(reason)
-        return reason is None
+        elif found == "skipped":
+            skipped.append(why)
+        return found in ("finished", "archived")
 
     counts: dict[tuple[str, str, str], list[int]] = {}
     for c in configs:

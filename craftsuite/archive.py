@@ -192,9 +192,11 @@ def reuse(archive: Path | None, out: Path, kind: str, name: str) -> tuple[str, s
     record is refused: ``("finished", None)``, ``out`` holds it finished; ``("busy", None)``, a
     live process trains it in ``out`` (nothing is restored into it, and a transfer started
     now stops at its lock); ``("archived", None)``, the archive's record is usable (``restore``
-    copies it); ``("skipped", why)``, the archive's record is not (the run trains anew);
-    ``("absent", None)``, neither holds it (it trains). ``restore`` and the dry run both
-    decide by it."""
+    copies it); ``("skipped", why)``, the archive's record is not; ``("absent", None)``, the
+    archive has none. (Skipped or absent, the run trains, resuming from its checkpoint in
+    ``out`` where it has one.) ``restore`` and the dry run both decide by it. Telling a
+    busy run takes its lock for an instant (``runs.in_use``): a run starting in that
+    instant is refused as in use, as it would be beside any live run."""
     run = Path(out) / kind / name
     if (run / "result.json").is_file():
         return "finished", None
@@ -211,8 +213,8 @@ def restore(archive: Path, out: Path, names: dict[str, set[str]], log=print) -> 
     """Copy into ``out/<kind>/`` the archived runs named in ``names`` (kind -> run names)
     that ``out`` does not hold finished: a run there is finished, so it is reused and not
     trained again (``reuse`` decides each). An unusable archived record of a run it would
-    copy is named through ``log`` and skipped (that run trains anew), as is a run a live
-    process trains in ``out``; the archive's other records are not read (a suite's archive
+    copy is named through ``log`` and skipped (that run trains), as is a run a live process
+    trains in ``out``; the archive's other records are not read (a suite's archive
     holds thousands, and a transfer of one cell asks for a few). Returns how many of each
     kind were restored."""
     restored = {}
@@ -221,6 +223,8 @@ def restore(archive: Path, out: Path, names: dict[str, set[str]], log=print) -> 
         for name in sorted(names.get(kind, set())):
             found, why = reuse(archive, out, kind, name)
             dest = Path(out) / kind / name
+            if found == "archived" and in_use(dest):  # a run took it while its record was read
+                found = "busy"
             if found == "busy":
                 log(f"results archive: {dest} is in use by a live run: nothing is restored into it")
             elif found == "skipped":

@@ -494,8 +494,9 @@ class CellPlan:
 @dataclass(frozen=True)
 class Plan:
     """What a transfer would train (``plan``): per cell (world, task, method), a ``CellPlan``;
-    the teachers by count; and the archive's records of its runs that it would skip as
-    damaged (each with why: those runs train again)."""
+    the teachers by count; the archive's records of its runs that it would skip as damaged
+    (each with why: those runs train again); and its runs that a live process trains in
+    ``out`` now (a transfer started now would stop at them)."""
 
     suite: Suite
     cells: dict[tuple[str, str, str], CellPlan]
@@ -508,7 +509,8 @@ class Plan:
         return sum(cell.left for cell in self.cells.values())
 
     def lines(self) -> list[str]:
-        """The plan in words: the records skipped, a line per cell, then the totals."""
+        """The plan in words: the records skipped, the runs busy, a line per cell, then the
+        totals."""
         out = [f"suite {self.suite.name} ({self.suite.regime} learner regime), a dry run: nothing is trained or "
                "written", *(f"results archive: skipped {reason}" for reason in self.skipped),
                *(f"{run} is in use by a live run: nothing is restored into it, and a transfer started now "

@@ -587,12 +587,11 @@ def _refuse_sb3_not_kept(out: Path, kept: Path | None, configs: list[StudentConf
     """Refuse, before anything is written, a run of the sb3 engine finished neither in
     ``out`` nor in the archive ``kept`` (None: none), whose usable runs ``archive.restore``
     copies into ``out``: that engine's runs are reused, never trained."""
-    from .archive import check_record
+    from .archive import reuse
     from .training import SB3_REFUSED
 
     for kind, config in _sb3_runs(out, configs, teachers):
-        record = None if kept is None else kept / kind / config.run_name()
-        if record is None or not record.is_dir() or check_record(record) is not None:
+        if reuse(kept, out, kind, config.run_name())[0] != "archived":
             raise ValueError(SB3_REFUSED.format(name=config.run_name(), also=ARCHIVE_FIX))
 
 

@@ -209,16 +209,26 @@ def probability_of_improvement(x_per_task: list, y_per_task: list, level: float 
     return Estimate(float(statistic(*samples)), float(low), float(high))
 
 
+# Where counting a batch of resamples' pairs is faster than ranking them: measured on 2 busy
+# cores, 2,000 resamples, 20 runs a side 3.3 ms against 9.5 ms, even at 40 a side (11-12 ms),
+# 150 a side 0.33 s against 0.14 s
+COUNTED_PAIRS = 40 * 40
+
+
 def p_greater(x, y, axis: int = -1) -> np.ndarray:
     """P(X > Y) + P(X = Y) / 2 over every pair of a run of ``x`` and a run of ``y`` along
-    ``axis`` (the Mann-Whitney U over n x m): from the midranks of both together, U = (the
-    ranks of x summed) - n(n+1)/2, in n log n per resample where counting the pairs takes n x m
-    (2,000 resamples of 150 seeds a side: 0.05 s against 2.8 s). The ranks are multiples of
-    a half and their sums exact, so U / nm is the pair count's own float."""
-    from scipy.stats import rankdata
-
+    ``axis`` (the Mann-Whitney U over n x m). Up to ``COUNTED_PAIRS`` pairs it counts them;
+    beyond, from the midranks of both together, U = (the ranks of x summed) - n(n+1)/2, in
+    n log n per resample where counting takes n x m. Both are exact (counts, and ranks that
+    are multiples of a half), so U / nm is the same float either way."""
     x, y = np.moveaxis(np.asarray(x), axis, -1), np.moveaxis(np.asarray(y), axis, -1)
     n, m = x.shape[-1], y.shape[-1]
+    if n * m <= COUNTED_PAIRS:
+        pairs_x, pairs_y = x[..., :, None], y[..., None, :]
+        above, tied = (pairs_x > pairs_y).sum(axis=(-2, -1)), (pairs_x == pairs_y).sum(axis=(-2, -1))
+        return (above + tied / 2) / (n * m)
+    from scipy.stats import rankdata
+
     ranks = rankdata(np.concatenate((x, y), axis=-1), axis=-1)
     return (ranks[..., :n].sum(axis=-1) - n * (n + 1) / 2) / (n * m)
 

@@ -132,10 +132,11 @@ def test_an_interval_read_at_a_higher_level_keeps_as_many_resamples_beyond_each_
 
 
 def test_the_probability_of_improvement_from_ranks_is_the_count_over_every_pair():
-    """The midrank form of P(X > Y) + P(X = Y) / 2 gives the count over every n x m pair to the
-    bit, with ties (success comes in twentieths), unequal sides and a batch of resamples."""
+    """P(X > Y) + P(X = Y) / 2, counted or (beyond COUNTED_PAIRS) from midranks, gives the count
+    over every n x m pair to the bit, with ties (success comes in twentieths), unequal sides and a
+    batch of resamples."""
     rng = np.random.default_rng(5)
-    for n, m in ((5, 5), (10, 20), (150, 150), (3, 1)):
+    for n, m in ((5, 5), (10, 20), (150, 150), (3, 1), (40, 40), (40, 41)):  # counted, then ranked beyond 40 x 40
         x, y = rng.integers(0, 21, (40, n)) / 20, rng.integers(0, 21, (40, m)) / 20
         pairs = ((x[:, :, None] > y[:, None, :]) + 0.5 * (x[:, :, None] == y[:, None, :])).mean(axis=(1, 2))
         assert np.array_equal(stats.p_greater(x, y), pairs)

@@ -494,22 +494,29 @@ def _log_rows(path, fields: tuple[str, ...], required: bool) -> tuple[list[str] 
     not ``required``, or an empty one when no ``fields`` are asked for)."""
     import gzip
     import io
+    import zlib
 
     path = Path(path)
     packed = path.with_name(path.name + ".gz")
     # the whole file at once: a log of 50,000 lines parses in about 0.6 of the time it takes
     # through gzip's and the text layer's small reads
-    if path.exists():
-        data = path.read_bytes()
-    elif packed.exists():
-        data = gzip.decompress(packed.read_bytes())
-    elif required:
-        raise FileNotFoundError(f"{path} is missing")
-    else:
-        return None, []
-    reader = csv.reader(io.TextIOWrapper(io.BytesIO(data), newline=""))  # (open()'s own decoding)
-    header = next(reader, None)
-    rows = [row for row in reader if row]
+    try:
+        if path.exists():
+            data = path.read_bytes()
+        elif packed.exists():
+            data = gzip.decompress(packed.read_bytes())
+        elif required:
+            raise FileNotFoundError(f"{path} is missing")
+        else:
+            return None, []
+        reader = csv.reader(io.TextIOWrapper(io.BytesIO(data), newline=""))  # (open()'s own decoding)
+        header = next(reader, None)
+        rows = [row for row in reader if row]
+    # neither is an OSError or a ValueError, the damage a log's readers name (reading_log)
+    except zlib.error as err:
+        raise ValueError(f"its compressed bytes are damaged ({err})") from None
+    except csv.Error as err:
+        raise ValueError(f"it does not parse as CSV ({err})") from None
     if fields:
         _check_log(header, rows, fields)
     return header, rows

@@ -109,6 +109,22 @@ def test_read_columns_holds_the_rows_read_csv_reads(tmp_path):
         read_columns(tmp_path / "missing.csv", ("step",), required=True)
 
 
+def test_a_log_whose_gzip_stream_or_csv_is_damaged_is_named_as_a_damaged_record(tmp_path):
+    """zlib's and csv's own errors are neither OSError nor ValueError: read through
+    read_log_columns they come out as the RunError that names the file, as a torn .gz does."""
+    import gzip
+
+    from craftsuite.runs import RunError, read_log_columns
+
+    packed = gzip.compress(("step,return\n" + "".join(f"{i},{i % 7}\n" for i in range(5000))).encode())
+    (tmp_path / "e.csv.gz").write_bytes(packed[:20] + b"\xff" * 8 + packed[28:])  # the deflate stream broken
+    with pytest.raises(RunError, match=r"e\.csv does not read as a run's log .*compressed bytes are damaged"):
+        read_log_columns(tmp_path / "e.csv", ("step",))
+    (tmp_path / "f.csv").write_text("step,return\n" + "x" * 200_000 + ",1\n")  # beyond csv's field limit
+    with pytest.raises(RunError, match=r"f\.csv does not read as a run's log .*does not parse as CSV"):
+        read_log_columns(tmp_path / "f.csv", ("step",))
+
+
 def test_atomic_write_leaves_no_temporary_files(tmp_path):
     atomic_write(tmp_path / "a.json", "{}")
     atomic_write(tmp_path / "a.json", "[]")

@@ -220,7 +220,9 @@ def p_greater(x, y, axis: int = -1) -> np.ndarray:
     ``axis`` (the Mann-Whitney U over n x m). Up to ``COUNTED_PAIRS`` pairs it counts them;
     beyond, from the midranks of both together, U = (the ranks of x summed) - n(n+1)/2, in
     n log n per resample where counting takes n x m. Both are exact (counts, and ranks that
-    are multiples of a half), so U / nm is the same float either way."""
+    are multiples of a half), so U / nm is the same float either way. Finite values only (a
+    NaN would be ranked, but counted as neither above nor tied): ``probability_of_improvement``
+    answers NaN before it asks."""
     x, y = np.moveaxis(np.asarray(x), axis, -1), np.moveaxis(np.asarray(y), axis, -1)
     n, m = x.shape[-1], y.shape[-1]
     if n * m <= COUNTED_PAIRS:

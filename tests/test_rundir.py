@@ -117,7 +117,9 @@ def test_a_log_whose_gzip_stream_or_csv_is_damaged_is_named_as_a_damaged_record(
     from craftsuite.runs import RunError, read_log_columns
 
     packed = gzip.compress(("step,return\n" + "".join(f"{i},{i % 7}\n" for i in range(5000))).encode())
-    (tmp_path / "e.csv.gz").write_bytes(packed[:20] + b"\xff" * 8 + packed[28:])  # the deflate stream broken
+    # the deflate stream's first block given the reserved block type (bits 1-2 of its first byte,
+    # after gzip's 10-byte header): zlib's "invalid block type", whatever zlib compressed it
+    (tmp_path / "e.csv.gz").write_bytes(packed[:10] + bytes([packed[10] | 0b110]) + packed[11:])
     with pytest.raises(RunError, match=r"e\.csv does not read as a run's log .*compressed bytes are damaged"):
         read_log_columns(tmp_path / "e.csv", ("step",))
     (tmp_path / "f.csv").write_text("step,return\n" + "x" * 200_000 + ",1\n")  # beyond csv's field limit

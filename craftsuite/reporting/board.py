@@ -44,6 +44,7 @@ from ..progress import progress_bar
 from ..record_format import RecordError, breaks_format, check_config, check_episodes, check_evals, check_result
 from ..record_format import required as required_columns
 from ..runs import RunError, evaluation_steps, flatten, read_config, read_log_columns, read_result, run_settings
+from .obstacles import tally
 
 # metrics with a mean and an interval per task and method; a rate lies in [0, 1]
 METRICS = {"success": (0.0, 1.0), "return": (-math.inf, math.inf), "train_success": (0.0, 1.0),
@@ -118,11 +119,12 @@ def finishing_session(config: dict) -> dict:
 @dataclass(frozen=True)
 class Curves:
     """A run's learning curves as its logs give them, kept by ``run_metrics`` (which reads
-    the logs anyway) for whoever draws them: a page of thousands of runs then reads each
-    log once."""
+    the logs anyway) for whoever draws them, and what its episodes reached for the obstacle
+    tables: a page of thousands of runs then reads each log once."""
 
     episodes: np.ndarray  # (k, 3) per training episode: the step it ended at, its return, completed (0/1)
     evals: np.ndarray  # (j, 2) per evaluation: its step, greedy success
+    reached: dict = field(default_factory=dict)  # its episodes' seen and states cells (obstacles.tally)
 
 
 def run_metrics(run: Path) -> dict | None:
@@ -183,7 +185,7 @@ def run_metrics(run: Path) -> dict | None:
         # mean decisions of the last evaluation's episodes
         "length": float(lengths[-1] or "nan") if lengths else float("nan"),
         "finished_by": finishing_session(config),
-        "curves": Curves(episodes, evals),
+        "curves": Curves(episodes, evals, tally(raw_episodes)),
     }
 
 

@@ -5,11 +5,13 @@ For a task no method learns, a success curve is flat at 0 and says nothing; what
 episodes reached does: the propositions that ever held, the automaton states visited, and
 the furthest of them, the visited state fewest automaton edges from acceptance.
 ``episode_progress`` reads one run, ``pool`` the seeds of one method (the results page
-shows one line per method).
+shows one line per method). A reader of many logs keeps each run's ``tally`` (a few dozen
+pairs of cells for its thousands of episodes) and reads no log twice.
 """
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -108,9 +110,11 @@ def _edge_name(automaton, source: int, target: int) -> str:
     return automaton.guard(source, target, sink_free=True)
 
 
-def episode_progress(run) -> Progress | None:
+def episode_progress(run, tallied: tuple[np.ndarray, dict[tuple[str, str], int]] | None = None) -> Progress | None:
     """What the training episodes of the run at ``run`` reached; None for a record made before
     ``episodes.csv`` had its ``seen`` and ``states`` columns (no episode carries them).
+    ``tallied``: its episodes' completions (0/1) and its log's ``tally``, as a reader of the log
+    kept them (the log is then read only to name a cell at fault); by default the log is read here.
 
     Raises:
         RunError: a record that does not read (the file named), of a task unknown here or of
@@ -121,17 +125,53 @@ def episode_progress(run) -> Progress | None:
     budget = _budget(run, config)
     spec = _spec(run, config)
     path = run / "episodes.csv"  # (or the archive's episodes.csv.gz: read_columns reads either)
-    log, completed = _read_episodes(path)
+    log = None
+    if tallied is None:
+        log, completed = _read_episodes(path)
+        tallied = completed, tally(log)
+    try:  # each distinct pair of cells read once, as many times over as episodes logged it
+        return _summarized(spec, budget, tallied[0], *_untally(tallied[1]))
+    except ValueError:
+        pass  # a cell that is no mask, or bits the task has not: read again in the log's order, to name its line
+    if log is None:
+        log, _ = _read_episodes(path)
+    completed = tallied[0]
     with reading_log(path):  # (a mask that does not read: the file named)
         seen, seen_given = _masks(log, "seen", len(completed))
         states, states_given = _masks(log, "states", len(completed))
-    marked = seen_given & states_given
-    if len(completed) and not marked.any():
-        return None
     try:
-        return summarize(spec.automaton, spec.name, budget, completed, seen, states, marked)
+        return _summarized(spec, budget, completed, seen, states, seen_given & states_given)
     except ValueError as err:
         raise RunError(f"{path}: {err}: the record was made with another automaton") from None
+
+
+def _summarized(spec, budget: int, completed, seen, states, marked) -> Progress | None:
+    """``summarize`` of a run's episodes; None where no episode carries its masks."""
+    if len(completed) and not marked.any():
+        return None
+    return summarize(spec.automaton, spec.name, budget, completed, seen, states, marked)
+
+
+def tally(log: dict) -> dict[tuple[str, str], int]:
+    """A log's (``read_columns``) ``seen`` and ``states`` cells, each pair of one row counted:
+    what ``Progress`` reads of them, a run's thousands of episodes in a few dozen pairs ("" for a
+    cell a row lacks, an empty one or a log without the column)."""
+    n = len(next(iter(log.values()), ()))
+    return dict(Counter(zip(log.get("seen") or ("",) * n, log.get("states") or ("",) * n)))
+
+
+def _untally(pairs: dict[tuple[str, str], int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A ``tally``'s masks as ``seen``, ``states`` and ``marked`` arrays, one entry an episode
+    (in no log's order: a cell at fault is named by the index of its pair, not its line).
+
+    Raises:
+        ValueError: a cell that is no mask.
+    """
+    cells = {"seen": tuple(s for s, _ in pairs), "states": tuple(q for _, q in pairs)}
+    counts = np.fromiter(pairs.values(), dtype=np.int64, count=len(pairs))
+    seen, seen_given = _masks(cells, "seen", len(pairs))
+    states, states_given = _masks(cells, "states", len(pairs))
+    return np.repeat(seen, counts), np.repeat(states, counts), np.repeat(seen_given & states_given, counts)
 
 
 def _masks(log: dict, name: str, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -290,14 +330,17 @@ def pool(progress: list[Progress]) -> Progress:
                      first.depth)
 
 
-def method_progress(runs) -> Progress | None:
+def method_progress(runs, tallied=None) -> Progress | None:
     """The pooled ``Progress`` of one method's seeds (run directories or archived records),
-    over those whose records carry the columns; None where none does.
+    over those whose records carry the columns; None where none does. ``tallied``: per run,
+    as ``episode_progress`` takes it.
 
     Raises:
         RunError: as ``episode_progress``, for any of them.
     """
-    found = [p for p in (episode_progress(run) for run in runs) if p is not None]
+    runs = list(runs)
+    tallied = [None] * len(runs) if tallied is None else list(tallied)
+    found = [p for p in (episode_progress(run, t) for run, t in zip(runs, tallied, strict=True)) if p is not None]
     return pool(found) if found else None
 
 

@@ -271,7 +271,7 @@ def obstacles_markdown(rows: list[Entry]) -> list[str]:
     found, unread = [], []
     for e in ranked(rows):
         try:
-            progress = method_progress(e.runs)
+            progress = method_progress(e.runs, [(c.episodes[:, 2], c.reached) for c in e.curves])
             per_100k = (progress.completed_per_100k if progress is not None
                         else float(np.mean([completed_per_100k(run) for run in e.runs])))
         except (RunError, OSError, ValueError) as err:

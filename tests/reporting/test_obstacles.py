@@ -129,6 +129,37 @@ def test_the_seeds_of_a_method_pool(tmp_path):
         pool([episode_progress(a), episode_progress(_run(tmp_path, task="FirstWood", rows=REACH))])
 
 
+def test_a_board_keeps_each_runs_tally_and_the_obstacles_read_no_log_again(tmp_path):
+    from craftsuite.reporting.board import build
+
+    # one run with a resumed session's unmarked rows, one with every row marked, one old record
+    runs = [_run(tmp_path, rows=[r[:4] for r in REACH[:2]] + REACH[2:]),
+            _run(tmp_path, rows=REACH + [(995, -20.0, 5, 0, 0, 0b01)] * 3, seed=1),
+            _run(tmp_path, rows=[r[:4] for r in REACH], fields=EPISODE_CORE, seed=2)]
+    (entry,) = build(tmp_path).entries
+    tallied = [(c.episodes[:, 2], c.reached) for c in entry.curves]
+    assert entry.curves[1].reached == {("0", "1"): 5, ("1", "3"): 2}  # seven episodes in two pairs
+    expected = [episode_progress(run) for run in entry.runs]
+    assert expected[2] is None and expected[0].marked == 2
+    for run in runs:
+        (run / "episodes.csv").unlink()  # the board's tally alone: the log is not read again
+    assert [episode_progress(run, t) for run, t in zip(entry.runs, tallied)] == expected
+    assert method_progress(entry.runs, tallied) == pool(expected[:2])
+
+
+def test_a_tallied_cell_at_fault_is_named_by_its_line_in_the_log(tmp_path):
+    from craftsuite.reporting.board import build
+
+    _run(tmp_path, rows=REACH + [(995, -20.0, 5, 0, 0, "1\x00")])
+    _run(tmp_path, rows=REACH + [(995, -20.0, 5, 0, 0b10, 0b01)], seed=1)  # Reach has one proposition
+    garbled, wrong = build(tmp_path).entries[0].curves
+    run_garbled, run_wrong = build(tmp_path).entries[0].runs
+    with pytest.raises(RunError, match=r"line 6: states '1\\x00' is not an integer"):
+        episode_progress(run_garbled, (garbled.episodes[:, 2], garbled.reached))
+    with pytest.raises(RunError, match=r"episode 5 \(line 6: seen 2, states 1\) .*another automaton"):
+        episode_progress(run_wrong, (wrong.episodes[:, 2], wrong.reached))
+
+
 def test_bad_records_are_named(tmp_path):
     wrong = _run(tmp_path, rows=[(300, -20.0, 200, 0, 0b10, 0b01)])  # Reach has one proposition
     with pytest.raises(RunError, match=r"episodes.csv: episode 1 .*another automaton"):

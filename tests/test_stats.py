@@ -131,16 +131,21 @@ def test_an_interval_read_at_a_higher_level_keeps_as_many_resamples_beyond_each_
         stats.resamples(1.0)
 
 
-def test_the_probability_of_improvement_from_ranks_is_the_count_over_every_pair():
-    """P(X > Y) + P(X = Y) / 2, counted or (beyond COUNTED_PAIRS) from midranks, gives the count
-    over every n x m pair to the bit, with ties (success comes in twentieths), unequal sides and a
-    batch of resamples."""
+def test_the_probability_of_improvement_from_places_is_the_count_over_every_pair():
+    """P(X > Y) + P(X = Y) / 2 from each value's place among the distinct values gives the
+    count over every n x m pair to the bit, with ties (success comes in twentieths), distinct
+    floats, unequal sides and a batch of resamples; and the probability of improvement's point
+    is that count over its tasks' places."""
     rng = np.random.default_rng(5)
-    for n, m in ((5, 5), (10, 20), (150, 150), (3, 1), (40, 40), (40, 41)):  # counted, then ranked beyond 40 x 40
-        x, y = rng.integers(0, 21, (40, n)) / 20, rng.integers(0, 21, (40, m)) / 20
-        pairs = ((x[:, :, None] > y[:, None, :]) + 0.5 * (x[:, :, None] == y[:, None, :])).mean(axis=(1, 2))
-        assert np.array_equal(stats.p_greater(x, y), pairs)
-        assert np.array_equal(stats.p_greater(x.T, y.T, axis=0), pairs)
+    for n, m in ((5, 5), (10, 20), (150, 150), (3, 1), (40, 41)):
+        for x, y in ((rng.integers(0, 21, (40, n)) / 20, rng.integers(0, 21, (40, m)) / 20),
+                     (rng.uniform(size=(40, n)), rng.uniform(size=(40, m)))):
+            pairs = ((x[:, :, None] > y[:, None, :]) + 0.5 * (x[:, :, None] == y[:, None, :])).mean(axis=(1, 2))
+            assert np.array_equal(stats.p_greater(x, y), pairs)
+            assert np.array_equal(stats.p_greater(x.T, y.T, axis=0), pairs)
+            if min(n, m) >= 2:  # (a bootstrap resamples 2 runs a side at least)
+                improvement = stats.probability_of_improvement([x[0], x[1]], [y[0], y[1]])
+                assert improvement.value == pytest.approx(pairs[:2].mean())
     assert stats.p_greater([1.0, 1.0], [0.0, 1.0]) == 0.75
     # a run with no value in the metric has no place in the order: no probability, as no difference
     e = stats.probability_of_improvement([np.array([1.0, math.nan, 0.5])], [np.array([0.0, 1.0, 0.5])])

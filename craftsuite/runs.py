@@ -243,7 +243,7 @@ def in_use(run) -> bool:
     lock = Path(run) / ".lock"
     if not lock.exists():
         return False
-    fd = os.open(lock, os.O_RDWR)
+    fd = _open_lock(lock, os.O_RDONLY)  # (flock takes a read-only descriptor: another user's lock may be read-only here)
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
@@ -251,6 +251,16 @@ def in_use(run) -> bool:
     finally:
         os.close(fd)  # (closing drops a lock taken here)
     return False
+
+
+def _open_lock(lock: Path, flags: int) -> int:
+    """A run's ``.lock`` opened; one this user may not open (another user's run) a RunError
+    naming it, for the CLI and for code that calls the archive or a trainer alike."""
+    try:
+        return os.open(lock, flags)
+    except PermissionError as err:
+        raise RunError(f"{lock} cannot be opened here ({err.strerror}): the run belongs to another user; "
+                       "run this as the user who trained it, or copy the run to a directory of your own") from None
 
 
 class RunDir:
@@ -321,10 +331,10 @@ class RunDir:
         # An advisory lock held on an open file: the kernel drops it when its owner dies, so a
         # killed run's directory is free again at once, and two live runs can never both hold it.
         try:
-            self._fd = os.open(self._lock, os.O_CREAT | os.O_RDWR)
+            self._fd = _open_lock(self._lock, os.O_CREAT | os.O_RDWR)
         except FileNotFoundError:  # a run that failed at once removed the directory meanwhile
             self.path.mkdir(parents=True, exist_ok=True)
-            self._fd = os.open(self._lock, os.O_CREAT | os.O_RDWR)
+            self._fd = _open_lock(self._lock, os.O_CREAT | os.O_RDWR)
         try:
             fcntl.flock(self._fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:

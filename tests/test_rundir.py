@@ -39,6 +39,28 @@ def test_a_dead_owners_lock_is_taken_over(tmp_path):
         assert (run.path / ".lock").read_text().endswith(str(os.getpid()))
 
 
+def test_another_users_lock_is_named_not_raised_as_a_permission_error(tmp_path, monkeypatch):
+    import craftsuite.runs
+    from craftsuite.runs import in_use
+
+    with RunDir(tmp_path / "r", StudentConfig(steps=10)):
+        pass
+    real_open = os.open
+
+    def other_users(path, flags, *args):  # (the tests run as root, whom no file mode refuses)
+        if str(path).endswith(".lock"):
+            raise PermissionError(13, "Permission denied", str(path))
+        return real_open(path, flags, *args)
+
+    monkeypatch.setattr(craftsuite.runs.os, "open", other_users)
+    for call in (lambda: in_use(tmp_path / "r"), lambda: RunDir(tmp_path / "r", StudentConfig(steps=10)).__enter__()):
+        with pytest.raises(RunError, match=r"r/.lock cannot be opened here \(Permission denied\): the run belongs "
+                                           "to another user; run this as the user who trained it"):
+            call()
+    monkeypatch.undo()
+    assert not in_use(tmp_path / "r")  # the lock a read-only descriptor tells
+
+
 def test_a_directory_of_another_config_is_refused_and_kept(tmp_path):
     with RunDir(tmp_path / "r", StudentConfig(steps=10)) as run:
         run.append("episodes.csv", EPISODE_FIELDS, [{"step": 5, "return": 1.0, "length": 5, "success": 1}])

@@ -232,10 +232,15 @@ def summarize(automaton, task: str, budget: int, completed, seen, states, marked
     of a resumed run; the shares count the marked episodes alone; default: every one).
 
     Raises:
-        ValueError: a marked episode with bits the automaton has no proposition or state for.
+        ValueError: a marked episode with bits the automaton has no proposition or state for, or
+            arrays of different lengths (one entry an episode in each).
     """
     completed, seen, states = (np.asarray(x, dtype=np.int64) for x in (completed, seen, states))
     marked = np.ones(len(completed), dtype=bool) if marked is None else np.asarray(marked, dtype=bool)
+    lengths = {"completed": len(completed), "seen": len(seen), "states": len(states), "marked": len(marked)}
+    if len(set(lengths.values())) > 1:
+        raise ValueError("summarize() takes one entry an episode in each array, got "
+                         + ", ".join(f"{name} {n}" for name, n in lengths.items()))
     n_props, n_states = len(automaton.propositions), automaton.n_states
     far = distances(automaton)
     seen, states = seen[marked], states[marked]

@@ -75,6 +75,8 @@ def test_furthest_is_the_visited_state_closest_to_acceptance():
     assert partly.state_share == pytest.approx({0: 1.0, 1: 1.0, 2: 0.0, 3: 0.0, 4: 0.0})
     with pytest.raises(ValueError, match=r"episode 3 \(line 4: seen -9223372036854775808"):
         summarize_rows(automaton, "hand-made", 1_000, [(0, None, None), (0, 0b01, 0b00011), (0, -2**63, 0b1)])
+    with pytest.raises(ValueError, match="one entry an episode in each array, got completed 2, seen 2, states 1"):
+        summarize(automaton, "hand-made", 1_000, [0, 1], [0b01, 0b11], [0b00011])
 
 
 def _run(root, task="Reach", world="Grid10", budget=1_000, rows=(), fields=EPISODE_FIELDS, seed=0, **config):

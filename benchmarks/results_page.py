@@ -10,8 +10,9 @@ runs in a fresh process, as a user runs it; its row gives the wall time, the CPU
 of ``--repeat``. The reference is the same command with the package as it was at
 ``--reference`` (its ``craftsuite/``, ``tasks/`` and ``assets/`` read from git) over the
 same archives, so both read the same records; the default reference is the last commit
-before the page read each run's logs once and counted the probability of improvement
-from midranks. "Same page" says whether the two builds wrote the same text, and if not
+before the obstacle tables took what each run's episodes reached from the board's own
+reading of its log and the probability of improvement counted its resamples' pairs from
+histograms of places. "Same page" says whether the two builds wrote the same text, and if not
 how many lines of today's page differ (the reference's wording may differ where the
 page's has changed since). ARCHIVE paths are relative to the current directory.
 
@@ -37,7 +38,7 @@ from _page import ROOT, Report, add_page_argument, at_reference  # benchmarks/ i
 from craftsuite.archive import archived
 from craftsuite.paths import DATA_DIRS
 
-REFERENCE = "81fd8777"
+REFERENCE = "6d42ccb1"
 ARCHIVES = ("results/standard", "results/hard")
 TARGET_CPU_S = 120.0
 PAGE_NAME = "results.md"

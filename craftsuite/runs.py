@@ -243,10 +243,13 @@ def in_use(run) -> bool:
     lock = Path(run) / ".lock"
     if not lock.exists():
         return False
-    fd = _open_lock(lock, os.O_RDONLY)  # (flock takes a read-only descriptor: another user's lock may be read-only here)
+    # read-only (another user's lock may allow no more), so a shared lock: it conflicts with the
+    # owner's exclusive one all the same, and NFS, which takes flock as fcntl, needs a descriptor
+    # open for writing for an exclusive lock alone
+    fd = _open_lock(lock, os.O_RDONLY)
     try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
         return True
     finally:
         os.close(fd)  # (closing drops a lock taken here)

@@ -224,6 +224,8 @@ def p_greater(x, y, axis: int = -1) -> np.ndarray:
     would take a place above every value): ``probability_of_improvement`` answers NaN before
     it asks."""
     x, y = np.moveaxis(np.asarray(x, dtype=float), axis, -1), np.moveaxis(np.asarray(y, dtype=float), axis, -1)
+    batch = np.broadcast_shapes(x.shape[:-1], y.shape[:-1])  # (e.g. a batch of resamples against one sample)
+    x, y = np.broadcast_to(x, batch + x.shape[-1:]), np.broadcast_to(y, batch + y.shape[-1:])
     both = np.concatenate((x, y), axis=-1)
     order = np.argsort(both, axis=-1)
     ordered = np.take_along_axis(both, order, axis=-1)

@@ -58,7 +58,16 @@ def test_another_users_lock_is_named_not_raised_as_a_permission_error(tmp_path, 
                                            "to another user; run this as the user who trained it"):
             call()
     monkeypatch.undo()
-    assert not in_use(tmp_path / "r")  # the lock a read-only descriptor tells
+
+    def read_only(path, flags, *args):  # a lock this user may read, not write
+        if str(path).endswith(".lock") and flags & (os.O_WRONLY | os.O_RDWR):
+            raise PermissionError(13, "Permission denied", str(path))
+        return real_open(path, flags, *args)
+
+    with RunDir(tmp_path / "r", StudentConfig(steps=10)):  # its owner holds it
+        monkeypatch.setattr(craftsuite.runs.os, "open", read_only)
+        assert in_use(tmp_path / "r")
+    assert not in_use(tmp_path / "r")  # released: a read-only descriptor tells that too
 
 
 def test_a_directory_of_another_config_is_refused_and_kept(tmp_path):

@@ -145,7 +145,11 @@ def test_the_probability_of_improvement_from_places_is_the_count_over_every_pair
             assert np.array_equal(stats.p_greater(x.T, y.T, axis=0), pairs)
             if min(n, m) >= 2:  # (a bootstrap resamples 2 runs a side at least)
                 improvement = stats.probability_of_improvement([x[0], x[1]], [y[0], y[1]])
-                assert improvement.value == pytest.approx(pairs[:2].mean())
+                assert improvement.value == np.mean(pairs[:2])
+    # a batch against one sample broadcasts, as counting the pairs would
+    x, y = rng.integers(0, 21, (7, 6)) / 20, rng.integers(0, 21, 9) / 20
+    pairs = ((x[:, :, None] > y[None, None, :]) + 0.5 * (x[:, :, None] == y[None, None, :])).mean(axis=(1, 2))
+    assert np.array_equal(stats.p_greater(x, y), pairs)
     assert stats.p_greater([1.0, 1.0], [0.0, 1.0]) == 0.75
     # a run with no value in the metric has no place in the order: no probability, as no difference
     e = stats.probability_of_improvement([np.array([1.0, math.nan, 0.5])], [np.array([0.0, 1.0, 0.5])])

@@ -133,9 +133,12 @@ def episode_progress(run, tallied: tuple[np.ndarray, dict[tuple[str, str], int]]
         return _summarized(spec, budget, tallied[0], *_untally(tallied[1]))
     except ValueError:
         pass  # a cell that is no mask, or bits the task has not: read again in the log's order, to name its line
-    if log is None:
-        log, _ = _read_episodes(path)
     completed = tallied[0]
+    if log is None:
+        log, now = _read_episodes(path)
+        if len(now) != len(completed):  # (rewritten, or swapped for another record, since it was tallied)
+            raise RunError(f"{path} holds {len(now):,} episodes where it held {len(completed):,} when it was read: "
+                           "it changed since; read its runs again")
     with reading_log(path):  # (a mask that does not read: the file named)
         seen, seen_given = _masks(log, "seen", len(completed))
         states, states_given = _masks(log, "states", len(completed))

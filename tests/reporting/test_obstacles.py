@@ -153,12 +153,17 @@ def test_a_tallied_cell_at_fault_is_named_by_its_line_in_the_log(tmp_path):
     from craftsuite.reporting.board import build
 
     _run(tmp_path, rows=REACH + [(995, -20.0, 5, 0, 0, "1\x00")])
-    _run(tmp_path, rows=REACH + [(995, -20.0, 5, 0, 0b10, 0b01)], seed=1)  # Reach has one proposition
-    garbled, wrong = build(tmp_path).entries[0].curves
-    run_garbled, run_wrong = build(tmp_path).entries[0].runs
+    # Reach has one proposition; the tally's order would make the wrong row its 5th episode
+    _run(tmp_path, rows=REACH[:3] + [(900, -20.0, 5, 0, 0b10, 0b01)] + REACH[3:], seed=1)
+    (entry,) = build(tmp_path).entries
+    (garbled, wrong), (run_garbled, run_wrong) = entry.curves, entry.runs
     with pytest.raises(RunError, match=r"line 6: states '1\\x00' is not an integer"):
         episode_progress(run_garbled, (garbled.episodes[:, 2], garbled.reached))
-    with pytest.raises(RunError, match=r"episode 5 \(line 6: seen 2, states 1\) .*another automaton"):
+    with pytest.raises(RunError, match=r"episode 4 \(line 5: seen 2, states 1\) .*another automaton"):
+        episode_progress(run_wrong, (wrong.episodes[:, 2], wrong.reached))
+    # a log rewritten since the board read it is not read as the episodes it tallied
+    (run_wrong / "episodes.csv").unlink()
+    with pytest.raises(RunError, match=r"episodes.csv holds 0 episodes where it held 5 when it was read"):
         episode_progress(run_wrong, (wrong.episodes[:, 2], wrong.reached))
 
 

@@ -240,13 +240,13 @@ def eval_seed(step: int) -> int:
 
 def in_use(run) -> bool:
     """Whether a live process holds the run directory's lock (``RunDir``)."""
-    lock = Path(run) / ".lock"
-    if not lock.exists():
-        return False
     # read-only (another user's lock may allow no more), so a shared lock: it conflicts with the
     # owner's exclusive one all the same, and NFS, which takes flock as fcntl, needs a descriptor
     # open for writing for an exclusive lock alone
-    fd = _open_lock(lock, os.O_RDONLY)
+    try:  # (opened at once: a directory this user may not search is named, as a lock it may not read)
+        fd = _open_lock(Path(run) / ".lock", os.O_RDONLY)
+    except (FileNotFoundError, NotADirectoryError):  # no lock, or no run directory: nothing holds it
+        return False
     try:
         fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
     except BlockingIOError:

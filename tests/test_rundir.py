@@ -68,6 +68,7 @@ def test_another_users_lock_is_named_not_raised_as_a_permission_error(tmp_path, 
         monkeypatch.setattr(craftsuite.runs.os, "open", read_only)
         assert in_use(tmp_path / "r")
     assert not in_use(tmp_path / "r")  # released: a read-only descriptor tells that too
+    assert not in_use(tmp_path / "none") and not in_use(tmp_path / "r" / "config.json")  # no run, a file
 
 
 def test_a_directory_of_another_config_is_refused_and_kept(tmp_path):

@@ -47,6 +47,7 @@ import json
 import os
 import shutil
 import socket
+import stat
 from pathlib import Path
 
 from .files import atomic_write, missing_folders, remove_empty
@@ -258,12 +259,21 @@ def in_use(run) -> bool:
 
 def _open_lock(lock: Path, flags: int) -> int:
     """A run's ``.lock`` opened; one this user may not open (another user's run) a RunError
-    naming it, for the CLI and for code that calls the archive or a trainer alike."""
+    naming it, for the CLI and for code that calls the archive or a trainer alike; so is a
+    directory in its place (read-only, Linux opens one: the same answer whatever the flags)."""
     try:
-        return os.open(lock, flags)
+        fd = os.open(lock, flags)
     except PermissionError as err:
         raise RunError(f"{lock} cannot be opened here ({err.strerror}): the run belongs to another user; "
                        "run this as the user who trained it, or copy the run to a directory of your own") from None
+    except IsADirectoryError:
+        fd = None
+    if fd is None or stat.S_ISDIR(os.fstat(fd).st_mode):
+        if fd is not None:
+            os.close(fd)
+        raise RunError(f"{lock} is a directory where a run keeps its lock file; "
+                       "remove it (rmdir, which refuses one that holds files) and run again")
+    return fd
 
 
 class RunDir:

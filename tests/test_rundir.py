@@ -71,6 +71,17 @@ def test_another_users_lock_is_named_not_raised_as_a_permission_error(tmp_path, 
     assert not in_use(tmp_path / "none") and not in_use(tmp_path / "r" / "config.json")  # no run, a file
 
 
+def test_a_directory_in_the_locks_place_is_named_and_kept(tmp_path):
+    from craftsuite.runs import in_use
+
+    (tmp_path / "r" / ".lock").mkdir(parents=True)
+    (tmp_path / "r" / ".lock" / "kept").write_text("x")
+    for call in (lambda: in_use(tmp_path / "r"), lambda: RunDir(tmp_path / "r", StudentConfig(steps=10)).__enter__()):
+        with pytest.raises(RunError, match=r"r/.lock is a directory where a run keeps its lock file; remove it"):
+            call()
+    assert sorted(p.name for p in (tmp_path / "r").rglob("*")) == [".lock", "kept"]  # nothing written, nothing lost
+
+
 def test_a_directory_of_another_config_is_refused_and_kept(tmp_path):
     with RunDir(tmp_path / "r", StudentConfig(steps=10)) as run:
         run.append("episodes.csv", EPISODE_FIELDS, [{"step": 5, "return": 1.0, "length": 5, "success": 1}])

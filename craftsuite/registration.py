@@ -33,9 +33,12 @@ _WHY_NOT = {"Grid": {side: "the grid world draws every cell {tile} pixels a side
 # keywords of a world's entry point that a run sets itself, refused in a run's flags (--env)
 # with who sets them; the others' listings leave them out
 _PRODUCT = "whether the automaton state is observed is the run's to say (its method; video's --product)"
+# the command renders where it shows something: a run trains unrendered, a video asks for frames
+_RENDER = "the command sets it (runs train unrendered; craftsuite video renders its frames itself)"
 _RUN_OWNS = {"Grid": {"product": _PRODUCT, "size": "the world (Grid7, Grid10) fixes the grid's size",
-                      "layout_seed": "a run's layout seed is its own setting (--layout-seed)"},
-             CONT: {"product": _PRODUCT}, KINEMATIC_WORLD: {"product": _PRODUCT}}
+                      "layout_seed": "a run's layout seed is its own setting (--layout-seed)", "render_mode": _RENDER},
+             CONT: {"product": _PRODUCT, "render_mode": _RENDER},
+             KINEMATIC_WORLD: {"product": _PRODUCT, "render_mode": _RENDER}}
 
 
 def world_keywords(world: str) -> tuple[str, ...]:

@@ -615,12 +615,17 @@ def _check_students(configs: list[StudentConfig], device: str | None = None, tea
 
     if any(c.engine == "population" for c in [*configs, *teachers]):
         from .population import check_supported
+        from .population.envs import make_envs
         from .population.train import check_device
 
         check_device(device or "cpu")
         for c in [*configs, *teachers]:
             if c.engine == "population":
                 check_supported(c.method, c.effective()["hyperparameters"])
+        # the engine's own vector world, which refuses some keywords the single env takes (render_mode)
+        for env_id, env_kwargs in {(c.env_id, json.dumps(c.env_kwargs, sort_keys=True))
+                                   for c in configs if c.engine == "population"}:
+            make_envs(env_id, 1, json.loads(env_kwargs), product=False).close()
 
     kinds = {(c.env_id, c.world, c.n_envs, json.dumps(c.env_kwargs, sort_keys=True),
               json.dumps(c.hyperparameters, sort_keys=True)) for c in configs}

@@ -55,7 +55,7 @@ def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
 
 @pytest.mark.parametrize("command,message", [
     (["student", "BlindCraftsman", "--method", "td3", "--env", '{"frame_skp": 10}'],
-     "--env: unknown keyword 'frame_skp' (did you mean frame_skip?) for the MuJoCo world; it accepts render_mode, "
+     "--env: unknown keyword 'frame_skp' (did you mean frame_skip?) for the MuJoCo world; it accepts "
      "width, height, frame_skip, status_panel, max_episode_steps"),
     (["student", "BlindCraftsman", "--method", "dqn", "--world", "Grid7", "--env", '{"width": 480}'],
      "--env: width: the grid world draws every cell 32 pixels a side"),
@@ -65,6 +65,11 @@ def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
      "--hyper: learning_rate must be above 0 (default 0.0005), got -1"),
     (["transfer", "--dqn-hyper", '{"batch_size": -1}'], "--dqn-hyper: batch_size must be at least 1"),
     (["transfer", "--env", '{"layout_seed": 1}'], "--env: unknown keyword 'layout_seed' for the MuJoCo world"),
+    # the engine's vector world does not render: refused at the flag, not once the archive has the session
+    (["transfer", "--env", '{"render_mode": "rgb_array"}'], "--env: render_mode: the command sets it (runs train "
+     "unrendered; craftsuite video renders its frames itself); leave it out of --env"),
+    (["student", "FirstTool", "--method", "td3", "--env", '{"render_mode": "human"}'], "--env: render_mode: the "
+     "command sets it"),
     # a method of the other kind of world: DQN's first in the list, the world Cont by default
     (["student", "FirstTool", "--method", "dqn"],
      "method 'dqn' runs in the Grid worlds, not in Cont; give a Grid world (e.g. Grid10), or one of Cont's methods: "
@@ -298,6 +303,24 @@ def test_transfer_refuses_a_device_the_machine_lacks(tmp_path, capsys, monkeypat
     monkeypatch.setattr(torch.cuda, "device_count", lambda: 1)
     assert _refused(tmp_path, capsys, *base, "--device", "cuda:3") == (
         "--device cuda:3: this machine has 1 CUDA GPU(s), cuda:0 to cuda:0; use one of them, or --device cuda")
+
+
+def test_a_world_setting_the_engine_refuses_is_refused_before_the_archive_changes(tmp_path):
+    """A suite whose students' world the engine cannot build (from Python, where no flag is
+    checked) is refused before the output or the archive's records change."""
+    import craftsuite.suite_runner as suite_runner
+    from craftsuite.suites import SUITES
+
+    archive = tmp_path / "results" / "quick"
+    archive.mkdir(parents=True)
+    (archive / "suite.json").write_text("{}\n")  # the archive's record of the suite, kept as it is
+    suite = dataclasses.replace(SUITES["quick"], tasks=("Reach",), seeds=1, student_steps=2_000,
+                                cont_world_kwargs={"render_mode": "rgb_array"})
+    with pytest.raises(ValueError, match="render_mode='rgb_array': the vectorized MuJoCo world does not render"):
+        suite_runner.transfer(suite, tmp_path / "out", archive=tmp_path / "results", video=False, progress=False)
+    assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*")) == [
+        "results", "results/quick", "results/quick/suite.json"]
+    assert (archive / "suite.json").read_text() == "{}\n"
 
 
 def test_transfer_refuses_a_file_where_its_directories_must_be(tmp_path, capsys):

@@ -219,7 +219,10 @@ def test_env_keywords_the_run_sets_itself_are_refused_by_name(tmp_path, capsys):
         in capsys.readouterr().err
     assert main([*grid, "--env", '{"sze": 10}']) == 2
     err = capsys.readouterr().err
-    assert "unknown keyword 'sze' for the grid world; it accepts render_mode" in err and "size" not in err.split(";")[1]
+    assert "unknown keyword 'sze' for the grid world; it accepts " in err and "size" not in err.split(";")[1]
+    assert "render_mode" not in err  # (the command's: below)
+    assert main([*grid, "--env", '{"render_mode": "rgb_array"}']) == 2
+    assert "--env: render_mode: the command sets it" in capsys.readouterr().err
     assert main(["student", "Reach", "--env", '{"product": true}', "--out", str(out)]) == 2
     assert "--env: product: whether the automaton state is observed" in capsys.readouterr().err
     assert not out.exists()

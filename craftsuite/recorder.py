@@ -117,8 +117,49 @@ def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "stand
     return RecordedConfig(task=suite_config.task, method=method, world=suite_config.world, seed=seed,
                           steps=steps, eval_every=eval_every,
                           eval_episodes=suite_config.eval_episodes, suite=suite, library=library,
-                          settings=dict(settings or {}), commit=commit, layout_seed=suite_config.layout_seed,
+                          settings=recorded_settings(settings), commit=commit, layout_seed=suite_config.layout_seed,
                           world_kwargs=dict(suite_config.world_kwargs))
+
+
+def recorded_settings(settings) -> dict:
+    """The learner's settings as ``config.json`` keeps them: a dict of JSON's values (numpy's
+    scalars as the numbers they hold). Anything else (a class, a function, a NaN) is named by
+    its key, with what to record instead: the record is JSON, and its key hashes it.
+
+    Raises:
+        ValueError: settings that are not a dict of JSON values, naming the first key at fault.
+    """
+    if settings is None:
+        return {}
+    if not isinstance(settings, dict):
+        raise ValueError(f"settings must be a dict of the learner's settings, e.g. {{'learning_rate': 3e-4}}, "
+                         f"got {type(settings).__name__} {settings!r:.60}")
+
+    def plain(value, where: str):
+        if isinstance(value, np.floating):  # np.float32(0.99): the number as numpy prints it, 0.99
+            value = float(str(value))
+        elif isinstance(value, np.generic):  # np.int64(256), np.bool_: the value it holds
+            value = value.item()
+        if value is None or isinstance(value, (bool, int, str)):
+            return value
+        if isinstance(value, float):
+            if not np.isfinite(value):
+                raise ValueError(f"settings {where} holds {value}, not a finite number, which JSON cannot hold; "
+                                 f"record it as a string ({str(value)!r}) or leave it out")
+            return value
+        if isinstance(value, (list, tuple)):
+            return [plain(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        if isinstance(value, dict):
+            if not all(isinstance(k, str) for k in value):
+                raise ValueError(f"settings {where}: its keys must be strings, got {sorted(map(repr, value))}")
+            return {k: plain(v, f"{where}[{k!r}]") for k, v in value.items()}
+        name = getattr(value, "__qualname__", None) or type(value).__name__
+        raise ValueError(f"settings {where} holds {name} (a {type(value).__name__}), which a JSON record cannot "
+                         f"hold; record it as a string, e.g. {name!r}")
+
+    if not all(isinstance(k, str) for k in settings):
+        raise ValueError(f"settings: its keys must be strings (the settings' names), got {sorted(map(repr, settings))}")
+    return {k: plain(v, repr(k)) for k, v in settings.items()}
 
 
 _RECORDING: set[Path] = set()  # the runs being recorded in this process

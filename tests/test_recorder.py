@@ -90,6 +90,25 @@ def test_a_method_named_as_craftsuites_own_is_refused(tmp_path, method, message)
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize("settings, message", [
+    ({"policy_kwargs": {"activation_fn": np.tanh}}, r"settings 'policy_kwargs'\['activation_fn'\] holds tanh \(a "
+     r"ufunc\), which a JSON record cannot hold; record it as a string, e.g. 'tanh'"),
+    ({"lr": float("nan")}, "settings 'lr' holds nan, not a finite number, which JSON cannot hold; record it as "
+     "a string"),
+    ("lr=1", "settings must be a dict of the learner's settings"),
+    ({1: 2}, "settings: its keys must be strings"),
+])
+def test_settings_a_json_record_cannot_hold_are_named_by_key(tmp_path, settings, message):
+    with pytest.raises(ValueError, match=message):
+        craftsuite.Recorder(ENV, tmp_path / "out", method="my-sac", settings=settings)
+    assert not (tmp_path / "out").exists()
+
+
+def test_numpy_numbers_are_recorded_as_the_numbers_they_print():
+    config = recorded_config(ENV, "my-sac", settings={"gamma": np.float32(0.99), "net": (np.int64(64), 64)})
+    assert config.settings == {"gamma": 0.99, "net": [64, 64]}
+
+
 def test_finishing_before_the_budget_is_refused_and_a_second_recording_too(tmp_path):
     env = craftsuite.Recorder(ENV, tmp_path, method="my-short")
     env.reset(seed=0)

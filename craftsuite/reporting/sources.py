@@ -96,10 +96,25 @@ def read_runs(path, *, transfer: bool = False, suite_cells: bool = False, keep=N
     if required and not board.entries and not (board.apart and board.apart.entries):
         raise ValueError(f"no finished student runs{only} under {students}"
                          + (f" ({unfinished} unfinished)" if unfinished else "")
-                         + "".join(f"; not read: {reason}" for reason in board.unreadable))
+                         + "".join(f"; not read: {reason}" for reason in board.unreadable)
+                         + _runs_elsewhere(path))
     if keep is None:  # a narrowed board holds some of the cells looks.json names: the whole directory checks it
         looks.check([*board.entries, *(board.apart.entries if board.apart else [])])
     return RunsDirectory(path, students, board, suite, read(path))
+
+
+def _runs_elsewhere(path: Path) -> str:
+    """Where the runs are, for a path given a level too low (one run's own directory) or too
+    high (a results archive, whose suites each hold a runs directory): the path to give
+    instead, or nothing."""
+    if (path / "config.json").is_file():
+        holder = path.parent.parent if path.parent.name in ("students", "teachers") else path.parent
+        return f"; it is one run's directory: give the directory of runs that holds it ({holder})"
+    inner = sorted(p for p in path.iterdir() if (p / "students").is_dir())
+    if inner:
+        return (f"; its folders hold runs: give one or more of them ({' '.join(map(str, inner[:4]))}"
+                + (", ..." if len(inner) > 4 else "") + ")")
+    return ""
 
 
 def suite_json(path: Path) -> dict:

@@ -36,6 +36,23 @@ def test_a_directory_holding_only_a_damaged_run_names_the_file_not_just_no_runs(
     assert (run / "result.json").read_text() == "{torn"  # nothing on disk is touched
 
 
+def test_a_path_a_level_off_names_the_runs_directory_to_give(tmp_path, capsys):
+    """An archive given for one of its suites, or one run's directory for the runs around
+    it: no runs there, and the line says where they are."""
+    run = fake_run(tmp_path / "results" / "standard" / "students", "td3", 0, [(1000, 1.0)], [(995, 1.0)])
+    (tmp_path / "results" / "hard" / "students").mkdir(parents=True)
+    for given, where in ((tmp_path / "results", f"; its folders hold runs: give one or more of them "
+                                                f"({tmp_path}/results/hard {tmp_path}/results/standard)"),
+                         (run, f"; it is one run's directory: give the directory of runs that holds it "
+                               f"({tmp_path}/results/standard)")):
+        with pytest.raises(ValueError, match="no finished student runs under ") as refused:
+            read_runs(given)
+        assert str(refused.value).endswith(where)
+    with pytest.raises(ValueError) as refused:
+        read_runs(tmp_path / "results" / "hard")
+    assert str(refused.value) == f"no finished student runs under {tmp_path}/results/hard/students"
+
+
 def test_sessions_read_to_the_day_or_to_the_minute():
     session = {"command": "craftsuite transfer quick", "started": "2026-01-02T03:04:05+00:00", "commit": None,
                "machine": "Linux", "seconds": 90.0}

@@ -6,6 +6,7 @@ hashes into its run key. This module imports no torch, so checking settings stay
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from types import MappingProxyType
 
@@ -164,6 +165,8 @@ def check_hyperparameters(algorithm: str, overrides: Mapping | None, source: str
         shown = f"default {example!r}" if name in defaults else f"e.g. {example!r}"
         if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
             raise HyperparameterError(f"{source}: {name} must be {text} ({shown}), got {value!r}")
+        if isinstance(value, float) and not math.isfinite(value):  # (JSON's Infinity, 1e400, NaN: Python's too)
+            raise HyperparameterError(f"{source}: {name} must be a finite number ({shown}), got {value!r}")
         bound = _out_of_range(name, value)
         if bound:
             raise HyperparameterError(f"{source}: {name} must be {bound} ({shown}), got {value!r}")

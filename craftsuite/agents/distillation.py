@@ -122,6 +122,12 @@ class AutomatonQTable:
         if q.ndim != 2 or q.shape != counts.shape:
             raise DistillationError(f"{where}: q {q.shape} and counts {counts.shape} must be one matrix shape "
                                     "(automaton states x labels)")
+        broken = np.argwhere(~np.isfinite(q))
+        if len(broken):  # a student would train towards it, and fail only as NaN actions much later
+            w, sigma = broken[0]
+            raise DistillationError(f"{where}: its values are not all finite ({len(broken)} of {q.size}, the first "
+                                    f"{q[w, sigma]} at automaton state {w}, label {sigma}); its teacher diverged or "
+                                    "the file was edited: train and distil the teacher again")
         try:
             table = cls(q=q, counts=counts, fingerprint=meta["fingerprint"],
                         propositions=tuple(meta["propositions"]), kind=meta["kind"])

@@ -81,6 +81,12 @@ def test_save_load_and_clear_errors(tmp_path):
         AutomatonQTable.load(path)
     with pytest.raises(FileNotFoundError):
         AutomatonQTable.load(tmp_path / "missing.npz")
+    diverged = table({(0, SWORD): 0.5, (1, SHIELD): np.nan, (2, SWORD): np.inf})
+    path = diverged.save(tmp_path / "diverged.npz")
+    with pytest.raises(DistillationError, match=r"diverged.npz is not a CraftSuite distilled table: its values "
+                                                r"are not all finite \(2 of \d+, the first nan at automaton state 1, "
+                                                r"label 2\)"):
+        AutomatonQTable.load(path, TOY)
 
 
 def test_describe_lists_edges():

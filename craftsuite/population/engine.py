@@ -34,6 +34,10 @@ class EngineError(ValueError):
     """A run the population engine cannot train (a setting or method it does not support)."""
 
 
+class Diverged(ValueError):
+    """A member whose actor no longer gives finite actions: its updates diverged."""
+
+
 # Settings the engine reads; any other override of a run's algorithm is refused by name
 # (it would be silently ignored otherwise).
 _READ = {
@@ -207,8 +211,15 @@ class Population:
                 return random
             greedy = self.learner.act(obs)
             return np.where(self.rng.random((K, n)) < self.exploration_rate(), random, greedy)
-        actions = self.rng.uniform(-1, 1, size=(K, n, self.act_dim)).astype(np.float32) if warm \
-            else self.learner.act(obs)
+        if warm:
+            actions = self.rng.uniform(-1, 1, size=(K, n, self.act_dim)).astype(np.float32)
+        else:
+            actions = self.learner.act(obs)
+            broken = np.flatnonzero(~np.isfinite(actions).all(axis=(1, 2)))
+            if broken.size:  # named here: the world would refuse NaN thrust, naming neither seed nor cause
+                raise Diverged(f"{self.method} seed {self.seeds[broken[0]]}: its actor's actions are not finite "
+                               f"after {self.num_timesteps:,} transitions, so its learning diverged; run it with a "
+                               "smaller learning_rate (or other settings that shrink its updates)")
         for k, noise in enumerate(self.noises):
             if noise is not None:
                 actions[k] = np.clip(actions[k] + np.asarray(noise()).reshape(n, self.act_dim), -1, 1)

@@ -191,10 +191,17 @@ def _scripted(args) -> int:
 
 
 def _video(args) -> int:
+    from .files import file_to_write
     from .ids import is_id, parse_id
+    from .rendering.video import check_video_path
     from .rollouts import record_video
     from .task_registry import resolve_task
 
+    file_to_write(args.out, "--out", "rollout.mp4")  # where it writes, before a minute of rollouts
+    try:
+        check_video_path(args.out)
+    except ValueError as err:
+        raise ValueError(f"--out {err}") from None
     if is_id(args.target):
         if args.world is not None:
             raise ValueError(f"--world picks the world of a task; {args.target} is an id, which names its own")

@@ -201,6 +201,19 @@ def test_video_takes_a_task_or_a_spec_file_in_a_world(spec_file, tmp_path, capsy
     assert not (tmp_path / "w.mp4").exists()
 
 
+def test_where_a_video_goes_is_checked_as_every_command_checks_a_file(tmp_path, capsys):
+    (tmp_path / "afile").write_text("kept\n")
+    for out, message in ((tmp_path / "afile" / "v.mp4", f"--out {tmp_path / 'afile' / 'v.mp4'}: {tmp_path / 'afile'} "
+                          "is a file, not a directory; give a path whose every folder is a directory"),
+                         (tmp_path, f"--out {tmp_path} is a directory, not a file: give the file to write, e.g. "
+                          f"{tmp_path / 'rollout.mp4'}"),
+                         (tmp_path / "v.avi", f"--out {tmp_path / 'v.avi'}: a video is written as MP4; give a file "
+                          f"name ending in .mp4, e.g. {tmp_path / 'v.mp4'}")):
+        assert main(["video", "Reach", "--out", str(out)]) == 2
+        assert capsys.readouterr().err == f"craftsuite video: error: {message}\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"] and (tmp_path / "afile").read_text() == "kept\n"
+
+
 def test_an_id_given_as_a_task_is_named_as_an_id(tmp_path, capsys):
     out = tmp_path / "runs"
     assert main(["student", "CraftSuite/BlindCraftsman-Cont-v0", "--out", str(out)]) == 2

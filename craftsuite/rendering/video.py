@@ -26,14 +26,25 @@ def even_frame(frame: np.ndarray) -> np.ndarray:
     return frame
 
 
+def check_video_path(path) -> Path:
+    """``path`` as a video's file: MP4, by its name (``VideoWriter``'s one format).
+
+    Raises:
+        ValueError: a name not ending in .mp4, with one that does.
+    """
+    path = Path(path)
+    if path.suffix.lower() != ".mp4":
+        raise ValueError(f"{path}: a video is written as MP4; give a file name ending in .mp4, e.g. "
+                         f"{path.with_suffix('.mp4') if path.name else path / 'rollout.mp4'}")
+    return path
+
+
 class VideoWriter:
     """Write RGB frames to ``path``; the size is taken from the first frame (padded to even
     sides), and every later frame must have the same size."""
 
     def __init__(self, path, fps: float):
-        self.path = Path(path)
-        if self.path.suffix.lower() != ".mp4":
-            raise ValueError(f"video path must end in .mp4, got {self.path.name!r}")
+        self.path = check_video_path(path)
         if not fps > 0:
             raise ValueError(f"fps must be positive, got {fps!r}")
         self.path.parent.mkdir(parents=True, exist_ok=True)  # a folder that cannot be made fails before any frame

@@ -66,7 +66,8 @@ def test_odd_frames_are_padded_with_their_edge_not_scaled():
 
 
 def test_bad_input_is_named_and_nothing_is_written(tmp_path):
-    with pytest.raises(ValueError, match="must end in .mp4"):
+    with pytest.raises(ValueError, match=r"clip.avi: a video is written as MP4; give a file name ending in .mp4, "
+                                         r"e.g. .*clip.mp4"):
         VideoWriter(tmp_path / "clip.avi", fps=4)
     with pytest.raises(ValueError, match="fps must be positive"):
         VideoWriter(tmp_path / "clip.mp4", fps=0)

@@ -219,7 +219,7 @@ def _video(args) -> int:
     return 0
 
 
-def _json_object(text: str | None, flag: str = "--hyper") -> dict:
+def _json_object(text: str | None, flag: str = "--hyper", example: str = '{"learning_rate": 1e-4}') -> dict:
     if not text:
         return {}
     try:
@@ -227,7 +227,7 @@ def _json_object(text: str | None, flag: str = "--hyper") -> dict:
     except json.JSONDecodeError as err:
         raise ValueError(f"{flag} is not JSON ({err}): {text!r}") from None
     if not isinstance(value, dict):
-        raise ValueError(f"{flag} must be a JSON object, e.g. '{{\"learning_rate\": 1e-4}}', not {text!r}")
+        raise ValueError(f"{flag} must be a JSON object, e.g. '{example}', not {text!r}")
     return value
 
 
@@ -235,7 +235,7 @@ def _world_kwargs(text: str | None, world: str, flag: str = "--env") -> dict:
     """``flag``'s JSON, gymnasium.make keywords checked against ``world``'s before anything runs."""
     from .registration import check_world_kwargs
 
-    value = _json_object(text, flag)
+    value = _json_object(text, flag, '{"max_episode_steps": 500}')  # (a keyword of every world)
     check_world_kwargs(world, value, flag)
     return value
 

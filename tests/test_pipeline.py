@@ -57,7 +57,7 @@ def test_cli_errors_name_the_problem(tmp_path, capsys):
     assert main(["student", "BlindCraftsman", "--method", "td3", "--hyper", "{oops", "--out", str(tmp_path)]) == 2
     assert "--hyper is not JSON" in capsys.readouterr().err
     assert main(["student", "BlindCraftsman", "--method", "td3", "--env", "[10]", "--out", str(tmp_path)]) == 2
-    assert "--env must be a JSON object" in capsys.readouterr().err
+    assert "--env must be a JSON object, e.g. '{\"max_episode_steps\": 500}', not '[10]'" in capsys.readouterr().err
     assert main(["transfer", "--suite", "huge", "--out", str(tmp_path)]) == 2
     assert "unknown suite 'huge'" in capsys.readouterr().err
     assert main(["leaderboard", str(tmp_path / "nothing")]) == 2

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 
 from .ids import WORLD_KINDS
-from .names import unknown_name
+from .names import UnknownName, unknown_name
 
 # the algorithm family of each world kind: DQN needs discrete moves, TD3 continuous thrust
 ALGORITHMS = MappingProxyType({"dqn": "Grid", "td3": "Cont"})
@@ -214,12 +214,20 @@ def resolve_method(text: str) -> str:
 
     module, sep, name = text.rpartition(":")
     if sep:
+        if not module or not name:
+            raise ValueError(f"method {text!r}: a method of your own is named module:row (e.g. my_rows:my-td3), "
+                             "both parts given")
         try:
             importlib.import_module(module)
         except ImportError as err:
             raise ValueError(f"method {text!r}: module {module!r} cannot be imported ({err}); put it on the "
                              "Python path (PYTHONPATH) or install its package") from None
-    check_methods([name])
+    try:
+        check_methods([name])
+    except UnknownName as err:
+        if sep:  # imported, and its import registered no such row
+            raise UnknownName(f"{err}; module {module!r} was imported and registers no row {name!r}") from None
+        raise
     return name
 
 

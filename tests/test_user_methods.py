@@ -126,8 +126,12 @@ def test_a_bad_row_is_refused_by_name(row, message):
 def test_a_module_that_is_not_there_or_registers_no_such_row_is_named(user_module, capsys):
     with pytest.raises(ValueError, match="module 'no_such_module' cannot be imported"):
         resolve_method("no_such_module:x")
-    with pytest.raises(KeyError, match=r"^unknown method 'dqn-other'.*; methods: dqn, "):
+    with pytest.raises(KeyError, match=rf"^unknown method 'dqn-other'.*; methods: dqn, .*; module '{user_module}' "
+                                       r"was imported and registers no row 'dqn-other'$"):
         resolve_method(f"{user_module}:dqn-other")
+    for text in (":row", f"{user_module}:", ":"):
+        with pytest.raises(ValueError, match=f"method '{text}': a method of your own is named module:row"):
+            resolve_method(text)
     assert main(["student", "Reach", "--method", "no_such_module:x"]) == 2
     assert "module 'no_such_module' cannot be imported" in capsys.readouterr().err
 

@@ -123,13 +123,15 @@ def _automaton(args) -> int:
     from .files import file_to_write
     from .task_registry import resolve_task
 
-    if args.out:
-        image_format(args.out)
+    if args.out is None and not args.describe:
+        raise ValueError("give --out FILE to draw the automaton, --describe to print its states and edges, or both")
+    if args.out is not None:
         file_to_write(args.out, "--out", f"{args.task}.png")
+        image_format(args.out)
     spec = resolve_task(args.task)
     if args.describe:
         print(spec.automaton.describe())
-    if args.out:
+    if args.out is not None:
         path = write_image(spec.automaton, args.out, title=f"{spec.name}: {spec.formula}",
                            show_sink=args.show_sink)
         print(f"wrote {path}")

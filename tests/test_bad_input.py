@@ -144,7 +144,13 @@ def test_where_a_command_writes_is_checked_before_it_computes(tmp_path, capsys):
         ("distill", "FirstTool", "--static", "--out", str(table), "--draw", str(tmp_path / "v.jpg")):
             f"cannot draw to '{tmp_path / 'v.jpg'}': use a .png, .svg, .pdf or .dot file",
         ("tasks", "--markdown", str(folder)): f"--markdown {folder} is a directory, not a file",
-        ("automaton", "FirstTool", "--out", "."): "cannot draw to '.': use a .png, .svg, .pdf or .dot file",
+        ("automaton", "FirstTool", "--out", "."): "--out . is a directory, not a file: give the file to write, e.g. "
+                                                  "FirstTool.png",
+        ("automaton", "FirstTool"): "give --out FILE to draw the automaton, --describe to print its states and edges",
+        # an empty path is the working directory to Path: never what an empty flag meant
+        ("automaton", "FirstTool", "--out", ""): "--out is empty: give the file to write, e.g. FirstTool.png",
+        ("student", "FirstTool", "--method", "td3", "--out", " "): "--out is empty: give the directory to write in",
+        ("archive", str(folder), "--suite", "standard", "--archive", ""): "--archive is empty: give the directory",
     }
     for command, message in refused.items():
         assert main(list(command)) == 2, command

@@ -70,6 +70,11 @@ def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
      "unrendered; craftsuite video renders its frames itself); leave it out of --env"),
     (["student", "FirstTool", "--method", "td3", "--env", '{"render_mode": "human"}'], "--env: render_mode: the "
      "command sets it"),
+    # gymnasium's own keywords, checked with the world's (its messages name no flag)
+    (["transfer", "--env", '{"max_episode_steps": 0}'], "--env: max_episode_steps must be a positive integer (the "
+     "decisions before an episode is cut short), got 0"),
+    (["student", "Reach", "--env", '{"disable_env_checker": "x"}'], "--env: disable_env_checker must be True or "
+     "False (whether gymnasium skips its env checker), got 'x'"),
     # a method of the other kind of world: DQN's first in the list, the world Cont by default
     (["student", "FirstTool", "--method", "dqn"],
      "method 'dqn' runs in the Grid worlds, not in Cont; give a Grid world (e.g. Grid10), or one of Cont's methods: "

@@ -117,6 +117,9 @@ def _runs_elsewhere(path: Path) -> str:
     return ""
 
 
+_SUITE_FIX = "move it aside (the suite's next transfer into the directory writes it again), or give another directory"
+
+
 def suite_json(path: Path) -> dict:
     """The suite as last run into ``path`` (``suite.json``; empty: none)."""
     if not (path / "suite.json").exists():
@@ -124,10 +127,9 @@ def suite_json(path: Path) -> dict:
     try:
         suite = json.loads((path / "suite.json").read_text())
     except ValueError as err:
-        raise ValueError(f"{path / 'suite.json'} is not valid JSON ({err})") from None
+        raise ValueError(f"{path / 'suite.json'} is not valid JSON ({err}): {_SUITE_FIX}") from None
     if not isinstance(suite, dict):
-        raise ValueError(f"{path / 'suite.json'} is not a suite's record (a JSON object): move it aside, or give "
-                         "another directory")
+        raise ValueError(f"{path / 'suite.json'} is not a suite's record (a JSON object): {_SUITE_FIX}")
     return suite
 
 

@@ -99,3 +99,15 @@ def test_a_leaderboard_narrowed_to_tasks_and_worlds_reads_their_runs_alone(tmp_p
     assert main(["leaderboard", str(mine), str(runs), "--tasks", "FirstTool", "--out", str(tmp_path / "e")]) == 2
     assert capsys.readouterr().err.endswith(f"error: no finished student runs of --tasks FirstTool under {mine}, "
                                             f"{runs}\n")
+
+
+def test_a_damaged_suite_record_is_named_with_what_to_do(tmp_path, capsys):
+    fake_run(tmp_path / "out" / "students", "td3", 0, [(1000, 1.0)], [(995, 1.0)])
+    for text, problem in (("{torn", "is not valid JSON"), ("[1]", "is not a suite's record (a JSON object)")):
+        (tmp_path / "out" / "suite.json").write_text(text)
+        assert main(["leaderboard", str(tmp_path / "out")]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"craftsuite leaderboard: error: {tmp_path / 'out' / 'suite.json'} {problem}")
+        assert err.endswith(": move it aside (the suite's next transfer into the directory writes it again), or give "
+                            "another directory\n") and err.count("\n") == 1
+        assert (tmp_path / "out" / "suite.json").read_text() == text

@@ -284,6 +284,9 @@ def _distill(args) -> int:
         file_to_write(args.draw, "--draw", "values.png")
     if args.static:
         _unread(args, f"with --static the task is SOURCE ({args.source}) and no teacher is read")
+        if (Path(args.source) / "config.json").is_file():  # a run directory: the teacher, not a task
+            raise ValueError(f"{args.source} is a run directory: --static distils a task's automaton alone; give the "
+                             "task's name, or leave out --static to distil this teacher's values")
         spec = resolve_task(_task(args.source))
         table = static_distillation(spec.automaton, completion_reward=spec.completion_reward)
         automaton = spec.automaton
@@ -320,9 +323,17 @@ def _distill(args) -> int:
                 raise FileNotFoundError(f"{source} has no checkpoint (model and replay buffer) yet")
             model, replay = saved / "model.zip", saved / "replay.pkl"
         else:
+            import zipfile
+
             if args.env_id is not None and args.task is not None:
                 raise ValueError(f"--task {args.task} --env-id {args.env_id}: the env id names the teacher's task "
                                  "too; give one of them")
+            if source.suffix == ".npz":  # (a zip too)
+                raise ValueError(f"{source} is a distilled table already: give it to a student (--table), or give "
+                                 "its teacher's run directory to distil it again")
+            if not zipfile.is_zipfile(source):
+                raise ValueError(f"{source} is not a teacher: give a teacher run directory or its model .zip "
+                                 "(dynamic), or a task name with --static")
             env_id, env_kwargs = args.env_id or _registered(args.task or "BlindCraftsman", "Grid7"), {}
             model, replay = source, Path(args.replay) if args.replay else None
         if replay is None or not replay.is_file():

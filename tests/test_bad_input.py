@@ -105,6 +105,9 @@ def test_a_bad_table_fails_before_a_run_directory_exists(tmp_path, capsys):
      "(FirstTool) and the grid's side with --size (e.g. --size 10)"),
     (["distill", "no-such-teacher"], "no teacher at no-such-teacher: give a teacher run directory or its .zip "
                                      "(dynamic), or a task name with --static"),
+    # a file that is no teacher was asked for a replay buffer (--replay), as if it were one
+    (["distill", str(THIS_FILE)], f"{THIS_FILE} is not a teacher: give a teacher run directory or its model .zip "
+                                  "(dynamic), or a task name with --static"),
     # a teacher .zip's flags where SOURCE answers them were ignored
     (["distill", "FirstTool", "--static", "--task", "DungeonQuest"],
      "--task: with --static the task is SOURCE (FirstTool) and no teacher is read; leave it out"),
@@ -129,6 +132,17 @@ def test_distill_refuses_the_flags_a_teacher_run_directory_answers(tmp_path, cap
     err = capsys.readouterr().err
     assert err == (f"craftsuite distill: error: --task, --replay: {teacher} is a teacher run directory: its config "
                    "names the task and env, its checkpoint the replay; leave them out\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [teacher.name]
+    # its directory with --static (a task's automaton alone), its table where the teacher goes
+    assert main(["distill", str(teacher), "--static", "--out", str(tmp_path / "table.npz")]) == 2
+    assert capsys.readouterr().err == (f"craftsuite distill: error: {teacher} is a run directory: --static distils a "
+                                       "task's automaton alone; give the task's name, or leave out --static to "
+                                       "distil this teacher's values\n")
+    (teacher / "table.npz").write_bytes(b"PK\x05\x06" + bytes(18))  # (an empty zip: what an .npz is)
+    assert main(["distill", str(teacher / "table.npz"), "--out", str(tmp_path / "table.npz")]) == 2
+    assert capsys.readouterr().err == (f"craftsuite distill: error: {teacher / 'table.npz'} is a distilled table "
+                                       "already: give it to a student (--table), or give its teacher's run directory "
+                                       "to distil it again\n")
     assert sorted(p.name for p in tmp_path.iterdir()) == [teacher.name]
 
 

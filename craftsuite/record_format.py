@@ -78,6 +78,7 @@ EPISODES = (
           "automaton's i-th proposition); empty in rows written before the column"),
     Field("states", "integer >= 0 or empty", False, "the automaton states it visited, as bits (bit q: state q)"),
 )
+NOTES = {"evals.csv": "One row at least: every run evaluates at its end."}  # rules of a file beyond its columns
 FILES = {"config.json": CONFIG, "result.json": RESULT, "evals.csv": EVALS, "episodes.csv": EPISODES}
 
 
@@ -145,9 +146,11 @@ def check_result(result: dict, config: dict, path) -> None:
 
 
 def check_evals(columns: dict, steps: int, path) -> dict[str, np.ndarray]:
-    """``evals.csv``'s columns (as read: strings, ``runs.read_columns``): steps within the
-    run, success a rate, the means finite where given. Returns the ``step`` and ``success``
+    """``evals.csv``'s columns (as read: strings, ``runs.read_columns``): one row at least,
+    steps within the run, success a rate, the means finite where given. Returns the ``step`` and ``success``
     columns as the floats it read (a reader then converts nothing twice)."""
+    if not len(columns["step"]):
+        raise RecordError(f"{path} holds no evaluation: a finished run's record has one at least (at its end)")
     step = _numbers(columns["step"], "step", path)
     _refuse_first(columns, "step", path, (step != np.floor(step)) | (step < 0) | (step > steps),
                   f"is not a step of the run (0 to {steps:,} transitions)")
@@ -229,7 +232,7 @@ def markdown() -> str:
         kind = "columns" if name.endswith(".csv") else "fields"
         lines += [f"## `{name}`", "", f"| {kind[:-1]} | takes | required | meaning |", "|---|---|---|---|"]
         lines += [f"| `{f.name}` | {f.kind} | {'yes' if f.required else ''} | {f.meaning} |" for f in fields]
-        lines.append("")
+        lines += ["", *([NOTES[name], ""] if name in NOTES else [])]
     lines += ["Format 3 made kinematic success mean completion (format 2 counted the automaton's acceptance: "
               "`craftsuite archive` re-reads such records). `seen` and `states` came within format 3; rows "
               "written before them leave them empty.", ""]

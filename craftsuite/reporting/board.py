@@ -160,8 +160,8 @@ def run_metrics(run: Path) -> dict | None:
     # the curves' arrays (Curves), as the checks above read them
     episodes = np.column_stack([episode_columns[name] for name in ("step", "return", "success")])
     evals = np.column_stack([eval_columns[name] for name in ("step", "success")])
-    success = evals[:, 1]
-    auc = float(success.mean()) if len(evals) else float("nan")
+    success = evals[:, 1]  # (one evaluation at least: check_evals)
+    auc = float(success.mean())
     every, regime = config.get("eval_every"), regime_of(config)
     if regime == SELF_REPORTED and isinstance(every, int) and every > 0:
         # its loop chose when to evaluate: a curve short of the suite's schedule has no comparable area
@@ -177,7 +177,7 @@ def run_metrics(run: Path) -> dict | None:
         "task": config["task"], "world": world, "world_kwargs": world_kwargs, "method": config["method"],
         "regime": regime, "seed": config["seed"], "budget": budget, "steps": result["steps"],
         "updates": result.get("updates"),
-        "success": float(success[-1]) if len(success) else float("nan"),
+        "success": float(success[-1]),
         "return": float(tail[:, 1].mean()) if len(tail) else float("nan"),
         "train_success": float(tail[:, 2].mean()) if len(tail) else float("nan"),
         "auc": auc,
@@ -674,9 +674,6 @@ def aggregates(entries) -> list[Aggregate]:
         cells = {(e.task, e.method): e for e in mine if e.method in methods}
         tasks = sorted({e.task for e in mine}, key=rung_order)
         pairwise = _against_baseline(cells, tasks, methods, scratch_method, finite)
-        blank = sum(len(e.seeds) - len(finite(e, m)) for e in cells.values() for m in AGGREGATED[:1])
-        if blank:
-            left_out.append(f"{blank} run{'s' if blank > 1 else ''} without an evaluation")
         # a method short of runs on a task every method ran is left out; the others keep the task
         common = [t for t in tasks if all((t, m) in cells for m in methods)]
         few = sorted(m for m in methods if any(min(len(finite(cells[(t, m)], metric)) for metric in AGGREGATED) < 2

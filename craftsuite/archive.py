@@ -116,12 +116,14 @@ def _check_evals(evals: Path) -> str | None:
     and the leaderboard could not read it."""
     if not evals.is_file():  # (never kept compressed: the archive keeps this one as it is)
         return f"{evals} is missing: a finished run's record has its evaluations (the last at its end)"
+    from .record_format import RecordError, check_evaluated
+
     try:
-        rows = read_csv(evals, ("step", "success"))
+        check_evaluated(len(read_csv(evals, ("step", "success"))), evals)
+    except RecordError as err:
+        return str(err)
     except (ValueError, OSError) as err:
         return f"{evals} does not read as a run's log ({err}): the record is damaged"
-    if not rows:
-        return f"{evals} holds no evaluation: a finished run's record has one at least (at its end)"
     return None
 
 

@@ -596,6 +596,17 @@ def _leaderboard(args) -> int:
     return 0
 
 
+def _path(text: str) -> str:
+    """A path flag's text: never empty (an empty path is the working directory to Python,
+    which no one typing ``--out ''``, or ``--out "$UNSET"``, meant)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("is empty: give a path")
+    return text
+
+
+_path.__name__ = "path"
+
+
 def _positive(text: str) -> int:
     value = int(text)
     if value < 1:
@@ -685,13 +696,15 @@ def build_parser() -> argparse.ArgumentParser:
     worlds = ", ".join(_known_worlds())
 
     p = command("records", "the run record format (config, result, evaluations, episodes)")
-    p.add_argument("--markdown", metavar="PATH", help="write it as a docs page to PATH, e.g. docs/records.md")
+    p.add_argument("--markdown", type=_path, metavar="PATH",
+                   help="write it as a docs page to PATH, e.g. docs/records.md")
     p.set_defaults(run=_records)
 
     p = command("tasks", "list the tasks (the ladder's rungs, easiest first), formulas, automata, ids")
     p.add_argument("--tag", nargs="+", default=(), help="only the tasks with any of these tags: "
                    + ", ".join(sorted({t for spec in ladder() for t in spec.tags})))
-    p.add_argument("--markdown", metavar="PATH", help="write the tasks page (specs, automata, scripted and random "
+    p.add_argument("--markdown", type=_path, metavar="PATH",
+                   help="write the tasks page (specs, automata, scripted and random "
                    "references) to PATH instead, e.g. docs/tasks.md")
     p.add_argument("--episodes", type=_positive, default=100,
                    help="episodes per id for the references of --markdown (default: 100)")
@@ -699,13 +712,13 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = command("automaton", "draw or print a task's automaton")
     p.add_argument("task", help=task_help)
-    p.add_argument("--out", help="image file (.png, .svg, .pdf or .dot)")
+    p.add_argument("--out", type=_path, help="image file (.png, .svg, .pdf or .dot)")
     p.add_argument("--describe", action="store_true", help="print states and guarded transitions")
     p.add_argument("--show-sink", action="store_true", help="also draw the rejecting sink")
     p.set_defaults(run=_automaton)
 
     p = command("scripted", "roll out the scripted policy on every id; write pictures")
-    p.add_argument("--out", default="out/scripted", help="output directory (default: out/scripted)")
+    p.add_argument("--out", type=_path, default="out/scripted", help="output directory (default: out/scripted)")
     p.add_argument("--task", help=f"only this task (default: all): {task_help}")
     p.add_argument("--episodes", type=_positive, default=10, help="episodes per id (default: 10)")
     p.add_argument("--seed", type=_seed, default=0, help="first seed (default: 0)")
@@ -713,7 +726,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = command("teacher", "train a grid DQN teacher until 90%% greedy success; distil it")
     p.add_argument("task", help=task_help)
-    p.add_argument("--out", default="runs/teachers", help="runs directory (default: runs/teachers)")
+    p.add_argument("--out", type=_path, default="runs/teachers", help="runs directory (default: runs/teachers)")
     p.add_argument("--size", type=int, default=7, help="grid size (default: 7)")
     p.add_argument("--layout-seed", type=int, default=0, help="the fixed grid instance (-1: a new one per episode)")
     p.add_argument("--seed", type=_seed, default=0)
@@ -729,13 +742,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_teacher)
 
     p = command("distill", "distil a teacher (dynamic) or a task's automaton (static) into a table")
-    p.add_argument("source", help="a teacher run directory or teacher .zip (dynamic), or a task name (--static)")
-    p.add_argument("--out", required=True, help="the table to write (.npz)")
+    p.add_argument("source", type=_path,
+                   help="a teacher run directory or teacher .zip (dynamic), or a task name (--static)")
+    p.add_argument("--out", type=_path, required=True, help="the table to write (.npz)")
     p.add_argument("--static", action="store_true", help="value iteration over the automaton alone")
-    p.add_argument("--replay", help="the teacher's replay buffer (.pkl), when SOURCE is a .zip")
+    p.add_argument("--replay", type=_path, help="the teacher's replay buffer (.pkl), when SOURCE is a .zip")
     p.add_argument("--task", help=f"the teacher's task, when SOURCE is a .zip (default: BlindCraftsman): {task_help}")
     p.add_argument("--env-id", help="the teacher's env id (default: CraftSuite/<task>-Grid7-v0)")
-    p.add_argument("--draw", help="also draw the values on the automaton (.png/.svg/.dot; unseen edges dotted)")
+    p.add_argument("--draw", type=_path,
+                   help="also draw the values on the automaton (.png/.svg/.dot; unseen edges dotted)")
     p.set_defaults(run=_distill)
 
     p = command("student", "train one student or baseline run (any method, one seed)")
@@ -745,9 +760,10 @@ def build_parser() -> argparse.ArgumentParser:
                    "row the module registers (craftsuite.methods.register_method)")
     p.add_argument("--world", default="Cont", type=_world,
                    help=f"Cont (MuJoCo), Kinematic or Grid<size>, a world of the task; the known tasks': {worlds}")
-    p.add_argument("--table", help="a teacher's table.npz (craftsuite teacher), for the methods that distil one: "
+    p.add_argument("--table", type=_path,
+                   help="a teacher's table.npz (craftsuite teacher), for the methods that distil one: "
                    + _table_methods())
-    p.add_argument("--out", default="runs/students", help="runs directory (default: runs/students)")
+    p.add_argument("--out", type=_path, default="runs/students", help="runs directory (default: runs/students)")
     p.add_argument("--seed", type=_seed, default=0)
     p.add_argument("--steps", type=_positive, default=20_000, help="the budget in transitions (default: 20000)")
     p.add_argument("--n-envs", type=_positive, default=1,
@@ -768,7 +784,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = command("transfer", "a suite end to end: teacher, distillation, students, leaderboard, video")
     p.add_argument("--suite", default="quick", help="; ".join(f"{n}: {s.description}" for n, s in SUITES.items()))
-    p.add_argument("--out", help="output directory (default: runs/<suite>, so suites never share one)")
+    p.add_argument("--out", type=_path, help="output directory (default: runs/<suite>, so suites never share one)")
     p.add_argument("--tags", nargs="+", help="override the suite's rungs: the tasks with any of these tags: "
                    + ", ".join(sorted({t for spec in ladder() for t in spec.tags})))
     p.add_argument("--tasks", nargs="+", help=f"override the suite's rungs: these tasks (with --tags: and these), "
@@ -808,7 +824,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="stop training after this many minutes (a campaign's part, a machine held for a while): the "
                    "runs still training are stopped and resume from their checkpoints when the same command runs "
                    f"again, the finished ones are kept; exits with status {TIME_LIMIT_STATUS} when it stopped any")
-    p.add_argument("--archive", metavar="DIR", help="the results archive: runs found in DIR/<suite> are not trained "
+    p.add_argument("--archive", type=_path, metavar="DIR",
+                   help="the results archive: runs found in DIR/<suite> are not trained "
                    "again, and every finished run's records are kept there as its population finishes (default: "
                    "results, for the suites that keep their runs: all but quick)")
     p.add_argument("--no-archive", action="store_true", help="neither read nor write a results archive")
@@ -821,20 +838,23 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_transfer)
 
     p = command("archive", "keep finished runs' records in the results archive (results/<suite>)")
-    p.add_argument("runs", nargs="+", help="transfer output directories, or directories of student runs")
+    p.add_argument("runs", type=_path, nargs="+", help="transfer output directories, or directories of student runs")
     p.add_argument("--suite", required=True, help="the suite they are runs of: they are kept in its archive (a run "
                    "of a task, world or method it does not run is skipped, named)")
-    p.add_argument("--archive", default="results", help="the archive (default: results)")
+    p.add_argument("--archive", type=_path, default="results", help="the archive (default: results)")
     p.set_defaults(run=_archive)
 
     p = command("leaderboard", "leaderboard (Markdown, CSV) and learning curves from run directories")
-    p.add_argument("runs", nargs="+", help="a transfer output directory, or a directory of student runs; several "
+    p.add_argument("runs", type=_path, nargs="+",
+                   help="a transfer output directory, or a directory of student runs; several "
                    "are one leaderboard (e.g. your runs from craftsuite.Recorder beside results/standard), or, with "
                    "--page, a section each")
-    p.add_argument("--out", help="where to write (default: RUNS, if one)")
-    p.add_argument("--page", metavar="PATH", help="write a results page (Markdown with provenance, tables, plots) "
+    p.add_argument("--out", type=_path, help="where to write (default: RUNS, if one)")
+    p.add_argument("--page", type=_path, metavar="PATH",
+                   help="write a results page (Markdown with provenance, tables, plots) "
                    "from the RUNS directories to PATH, e.g. docs/results.md")
-    p.add_argument("--reproduction", metavar="PATH", help="write the paper's Figure 5 panels, each beside the "
+    p.add_argument("--reproduction", type=_path, metavar="PATH",
+                   help="write the paper's Figure 5 panels, each beside the "
                    "paper's claim, from one transfer directory (craftsuite transfer --suite paper)")
     p.add_argument("--methods", nargs="+", metavar="MODULE:ROW", help="method rows of your own that runs were "
                    "trained with (as transfer's --methods my_module:my-row): read as the methods they are "
@@ -851,7 +871,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--policy", default="scripted",
                    help="'random', 'scripted' (default) or a stable-baselines3 checkpoint (.zip)")
     p.add_argument("--episodes", type=_positive, default=1, help="episodes to record (default: 1)")
-    p.add_argument("--out", default="rollout.mp4", help="output .mp4 (default: rollout.mp4)")
+    p.add_argument("--out", type=_path, default="rollout.mp4", help="output .mp4 (default: rollout.mp4)")
     p.add_argument("--seed", type=_seed, default=0, help="seed of the first episode (default: 0)")
     p.add_argument("--fps", type=_positive_float, help="frames per second (default: the world's pace, the env's "
                    "render_fps decisions a second; continuous worlds' motion is drawn between decisions)")

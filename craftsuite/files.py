@@ -108,12 +108,6 @@ def _check_writable_dir(path: Path, flag: str, given) -> None:
         raise PermissionError(f"{flag} {given}: {nearest} is not writable here; give a directory you can write in")
 
 
-def _refuse_empty(given, flag: str, wanted: str) -> None:
-    """An empty path (Path('') is the working directory: never what an empty flag meant)."""
-    if isinstance(given, str) and not given.strip():
-        raise ValueError(f"{flag} is empty: give {wanted}")
-
-
 def directory_to_write(path, flag: str) -> Path:
     """``path`` as a directory a command writes into (made later, where missing), checked
     before anything is computed or written; nothing is made here.
@@ -127,7 +121,6 @@ def directory_to_write(path, flag: str) -> Path:
         PermissionError: it, or the folder it would be made in, cannot be written.
     """
     given = path
-    _refuse_empty(given, flag, "the directory to write in")
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise NotADirectoryError(f"{flag} {given} is a file, not a directory: give a directory to write in "
@@ -151,7 +144,6 @@ def file_to_write(path, flag: str, example: str) -> Path:
         PermissionError: the folder it goes in cannot be written.
     """
     given = path
-    _refuse_empty(given, flag, f"the file to write, e.g. {example}")
     path = Path(path)
     if path.is_dir() or str(given).endswith(("/", os.sep)):
         raise IsADirectoryError(f"{flag} {given} {'is' if path.is_dir() else 'names'} a directory, not a file: "

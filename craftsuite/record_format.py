@@ -149,8 +149,7 @@ def check_evals(columns: dict, steps: int, path) -> dict[str, np.ndarray]:
     """``evals.csv``'s columns (as read: strings, ``runs.read_columns``): one row at least,
     steps within the run, success a rate, the means finite where given. Returns the ``step`` and ``success``
     columns as the floats it read (a reader then converts nothing twice)."""
-    if not len(columns["step"]):
-        raise RecordError(f"{path} holds no evaluation: a finished run's record has one at least (at its end)")
+    check_evaluated(len(columns["step"]), path)
     step = _numbers(columns["step"], "step", path)
     _refuse_first(columns, "step", path, (step != np.floor(step)) | (step < 0) | (step > steps),
                   f"is not a step of the run (0 to {steps:,} transitions)")
@@ -161,6 +160,13 @@ def check_evals(columns: dict, steps: int, path) -> dict[str, np.ndarray]:
         given = [i for i, value in enumerate(cells) if value != ""]
         _numbers([cells[i] for i in given], name, path, given)
     return {"step": step, "success": success}
+
+
+def check_evaluated(rows: int, path) -> None:
+    """A RecordError where ``evals.csv`` (at ``path``) holds ``rows`` = 0: a finished run,
+    teacher or student, evaluates at its end."""
+    if not rows:
+        raise RecordError(f"{path} holds no evaluation: a finished run's record has one at least (at its end)")
 
 
 def check_episodes(columns: dict, steps: int, path) -> dict[str, np.ndarray]:

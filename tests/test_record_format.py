@@ -46,6 +46,8 @@ CONFIG = {"task": "Reach", "world": "Cont", "method": "my-sac", "seed": 0, "step
     (lambda: check_result({"kind": "student", "steps": 1000, "seed": 4}, CONFIG, "r.json"),
      "seed 4 is not config.json's \\(0\\): the result of another run"),
     (lambda: check_evals({"step": ("1000",), "success": ("inf",)}, 1000, "e.csv"), "e.csv: line 2: success is inf"),
+    (lambda: check_evals({"step": (), "success": ()}, 1000, "e.csv"),
+     r"e.csv holds no evaluation: a finished run's record has one at least \(at its end\)"),
     (lambda: check_evals({"step": ("500", "500.5"), "success": ("1", "1")}, 1000, "e.csv"),
      "e.csv: line 3: step 500.5 is not a step of the run"),
     (lambda: check_evals({"step": ("500", "1000"), "success": ("0.5", "1.5")}, 1000, "e.csv"),

@@ -67,6 +67,7 @@ TD3_MORE = MappingProxyType(dict(_OFF_POLICY, tau=0.005, policy_delay=OneOf((2, 
 # sample reads its n rows, and past it the return is the episode's rest in all but name
 # (gamma ** 100 = 0.37 at 0.99; an episode lasts 200 to 1,000 steps).
 N_STEPS_MAX = 100
+CAPS = frozenset({"max_grad_norm"})  # settings that cap something: Infinity, refused, would mean no cap
 RANGES = MappingProxyType({
     "learning_rate": (0, None, True), "buffer_size": (1, None, False), "batch_size": (1, None, False),
     "learning_starts": (0, None, False), "gamma": (0, 1, False), "tau": (0, 1, True),
@@ -165,8 +166,10 @@ def check_hyperparameters(algorithm: str, overrides: Mapping | None, source: str
         shown = f"default {example!r}" if name in defaults else f"e.g. {example!r}"
         if not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
             raise HyperparameterError(f"{source}: {name} must be {text} ({shown}), got {value!r}")
-        if isinstance(value, float) and not math.isfinite(value):  # (JSON's Infinity, 1e400, NaN: Python's too)
-            raise HyperparameterError(f"{source}: {name} must be a finite number ({shown}), got {value!r}")
+        # (JSON's Infinity, 1e400, NaN: Python's too; a record holds JSON, which has none of them)
+        if isinstance(value, float) and not math.isfinite(value):
+            uncapped = "; a large one, e.g. 1e9, caps nothing" if name in CAPS else ""
+            raise HyperparameterError(f"{source}: {name} must be a finite number ({shown}{uncapped}), got {value!r}")
         bound = _out_of_range(name, value)
         if bound:
             raise HyperparameterError(f"{source}: {name} must be {bound} ({shown}), got {value!r}")

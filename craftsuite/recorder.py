@@ -31,6 +31,7 @@ skipped: a late one plays a policy that trained on more transitions than its ste
 from __future__ import annotations
 
 import operator
+from collections.abc import Mapping
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -122,16 +123,17 @@ def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "stand
 
 
 def recorded_settings(settings) -> dict:
-    """The learner's settings as ``config.json`` keeps them: a dict of JSON's values (numpy's
-    scalars as the numbers they hold). Anything else (a class, a function, a NaN) is named by
-    its key, with what to record instead: the record is JSON, and its key hashes it.
+    """The learner's settings as ``config.json`` keeps them: a mapping of JSON's values
+    (numpy's scalars as the numbers they hold, integer keys as the strings JSON makes them).
+    Anything else (a class, a function, a NaN) is named by its key, with what to record
+    instead: the record is JSON, and its key hashes it.
 
     Raises:
-        ValueError: settings that are not a dict of JSON values, naming the first key at fault.
+        ValueError: settings that are not a mapping of JSON values, naming the first key at fault.
     """
     if settings is None:
         return {}
-    if not isinstance(settings, dict):
+    if not isinstance(settings, Mapping):
         raise ValueError(f"settings must be a dict of the learner's settings, e.g. {{'learning_rate': 3e-4}}, "
                          f"got {type(settings).__name__} {settings!r:.60}")
 
@@ -149,17 +151,22 @@ def recorded_settings(settings) -> dict:
             return value
         if isinstance(value, (list, tuple)):
             return [plain(v, f"{where}[{i}]") for i, v in enumerate(value)]
-        if isinstance(value, dict):
-            if not all(isinstance(k, str) for k in value):
-                raise ValueError(f"settings {where}: its keys must be strings, got {sorted(map(repr, value))}")
-            return {k: plain(v, f"{where}[{k!r}]") for k, v in value.items()}
-        name = getattr(value, "__qualname__", None) or type(value).__name__
-        raise ValueError(f"settings {where} holds {name} (a {type(value).__name__}), which a JSON record cannot "
-                         f"hold; record it as a string, e.g. {name!r}")
+        if isinstance(value, Mapping):
+            return mapping(value, where)
+        # a class or function by its name; any other object as it prints (a path: its text)
+        named = isinstance(value, type) or callable(value) and hasattr(value, "__qualname__")
+        text = value.__qualname__ if named else str(value)
+        raise ValueError(f"settings {where} holds {text} (a {type(value).__name__}), which a JSON record cannot "
+                         f"hold; record it as a string, e.g. {text!r}")
 
-    if not all(isinstance(k, str) for k in settings):
-        raise ValueError(f"settings: its keys must be strings (the settings' names), got {sorted(map(repr, settings))}")
-    return {k: plain(v, repr(k)) for k, v in settings.items()}
+    def mapping(value: Mapping, where: str) -> dict:
+        odd = [k for k in value if isinstance(k, bool) or not isinstance(k, (str, int))]
+        if odd:
+            raise ValueError(f"{f'settings {where}' if where else 'settings'}: its keys must be names (strings), "
+                             f"got {odd[0]!r}")
+        return {str(k): plain(v, f"{where}[{k!r}]" if where else repr(k)) for k, v in value.items()}
+
+    return mapping(settings, "")
 
 
 _RECORDING: set[Path] = set()  # the runs being recorded in this process

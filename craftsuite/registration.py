@@ -64,14 +64,9 @@ def check_world_kwargs(world: str, kwargs, source: str | None = None) -> None:
         accepted = tuple(k for k in accepted if k not in owns)
     unknown = sorted(set(kwargs) - set(accepted) - {"task"})
     if not unknown:
-        for name, what in (("product", "whether the observation has the automaton state's one-hot"),
-                           ("disable_env_checker", "whether gymnasium skips its env checker")):
-            if not isinstance(kwargs.get(name, False), bool):  # "no" or 0 would pass as a truth value
-                raise ValueError(f"{prefix}{name} must be True or False ({what}), got {kwargs[name]!r}")
-        steps = kwargs.get("max_episode_steps")  # (gymnasium's own message names no flag)
-        if steps is not None and (isinstance(steps, bool) or not isinstance(steps, int) or steps < 1):
-            raise ValueError(f"{prefix}max_episode_steps must be a positive integer (the decisions before an "
-                             f"episode is cut short), got {steps!r}")
+        from .envs.vector import check_world_values
+
+        check_world_values(kwargs, prefix)
         return
     why = [_WHY_NOT.get(kind, {}).get(k) for k in unknown]
     if all(why):

@@ -3,6 +3,7 @@ record format, on the suite's budget and evaluation schedule, marked self-report
 leaderboard reads; bad use is refused in one line and leaves nothing behind."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -96,7 +97,9 @@ def test_a_method_named_as_craftsuites_own_is_refused(tmp_path, method, message)
     ({"lr": float("nan")}, "settings 'lr' holds nan, not a finite number, which JSON cannot hold; record it as "
      "a string"),
     ("lr=1", "settings must be a dict of the learner's settings"),
-    ({1: 2}, "settings: its keys must be strings"),
+    ({(1, 2): 3}, r"settings: its keys must be names \(strings\), got \(1, 2\)"),
+    ({"log": {"dir": Path("runs/x")}}, r"settings 'log'\['dir'\] holds runs/x \(a PosixPath\), which a JSON record "
+     r"cannot hold; record it as a string, e.g. 'runs/x'"),
 ])
 def test_settings_a_json_record_cannot_hold_are_named_by_key(tmp_path, settings, message):
     with pytest.raises(ValueError, match=message):
@@ -104,9 +107,15 @@ def test_settings_a_json_record_cannot_hold_are_named_by_key(tmp_path, settings,
     assert not (tmp_path / "out").exists()
 
 
-def test_numpy_numbers_are_recorded_as_the_numbers_they_print():
-    config = recorded_config(ENV, "my-sac", settings={"gamma": np.float32(0.99), "net": (np.int64(64), 64)})
-    assert config.settings == {"gamma": 0.99, "net": [64, 64]}
+def test_settings_are_recorded_as_json_reads_them_back():
+    """numpy's numbers as the numbers they print, any mapping as a dict, integer keys as the
+    strings JSON makes of them."""
+    from types import MappingProxyType
+
+    settings = MappingProxyType({"gamma": np.float32(0.99), "net": (np.int64(64), 64), "by_state": {3: 0.5}})
+    config = recorded_config(ENV, "my-sac", settings=settings)
+    assert config.settings == {"gamma": 0.99, "net": [64, 64], "by_state": {"3": 0.5}}
+    assert json.loads(json.dumps(config.settings)) == config.settings
 
 
 def test_finishing_before_the_budget_is_refused_and_a_second_recording_too(tmp_path):

@@ -67,10 +67,7 @@ class CraftVectorEnv(VectorEnv):
     def __init__(self, template: gym.Env, num_envs: int, product: bool,
                  max_episode_steps: int | None, autoreset_mode: str | AutoresetMode):
         check_num_envs(num_envs)  # the one check of every vectorization mode (craftsuite.make_vec)
-        if not isinstance(product, bool):
-            raise ValueError(f"product must be True or False, got {product!r}")
-        if max_episode_steps is not None and (not isinstance(max_episode_steps, int) or max_episode_steps < 1):
-            raise ValueError(f"max_episode_steps must be a positive integer or None, got {max_episode_steps!r}")
+        check_world_values({"product": product, "max_episode_steps": max_episode_steps})
         try:
             mode = AutoresetMode(autoreset_mode)
         except ValueError:
@@ -286,6 +283,24 @@ def check_num_envs(num_envs) -> None:
     """Raise a ValueError unless ``num_envs`` is a positive integer (every vectorization mode)."""
     if not isinstance(num_envs, int) or isinstance(num_envs, bool) or num_envs < 1:
         raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
+
+
+_TRUTHS = {"product": "whether the observation has the automaton state's one-hot",
+           "disable_env_checker": "whether gymnasium skips its env checker"}
+
+
+def check_world_values(kwargs: dict, prefix: str = "") -> None:
+    """Raise a ValueError naming a world keyword's value of the wrong kind: ``product`` and
+    ``disable_env_checker`` True or False ("no" or 0 would pass as a truth value),
+    ``max_episode_steps`` a positive integer or None (gymnasium's own message names no flag);
+    for single and vector worlds alike."""
+    for name, what in _TRUTHS.items():
+        if not isinstance(kwargs.get(name, False), bool):
+            raise ValueError(f"{prefix}{name} must be True or False ({what}), got {kwargs[name]!r}")
+    steps = kwargs.get("max_episode_steps")
+    if steps is not None and (isinstance(steps, bool) or not isinstance(steps, int) or steps < 1):
+        raise ValueError(f"{prefix}max_episode_steps must be a positive integer (the decisions before an episode is "
+                         f"cut short), got {steps!r}")
 
 
 def _check_kwargs(world: str, kwargs: dict, accepted: tuple[str, ...]) -> None:

@@ -8,5 +8,5 @@ CraftSuite trains with lives here once; a member is saved as an SB3 agent
 (``craftsuite.agents``), which loads and acts but does not learn.
 """
 
-from .engine import EngineError, Population, check_supported  # noqa: F401
+from .engine import Diverged, EngineError, Population, check_supported  # noqa: F401
 from .train import train_population  # noqa: F401

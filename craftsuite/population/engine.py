@@ -211,15 +211,8 @@ class Population:
                 return random
             greedy = self.learner.act(obs)
             return np.where(self.rng.random((K, n)) < self.exploration_rate(), random, greedy)
-        if warm:
-            actions = self.rng.uniform(-1, 1, size=(K, n, self.act_dim)).astype(np.float32)
-        else:
-            actions = self.learner.act(obs)
-            broken = np.flatnonzero(~np.isfinite(actions).all(axis=(1, 2)))
-            if broken.size:  # named here: the world would refuse NaN thrust, naming neither seed nor cause
-                raise Diverged(f"{self.method} seed {self.seeds[broken[0]]}: its actor's actions are not finite "
-                               f"after {self.num_timesteps:,} transitions, so its learning diverged; run it with a "
-                               "smaller learning_rate (or other settings that shrink its updates)")
+        actions = self.rng.uniform(-1, 1, size=(K, n, self.act_dim)).astype(np.float32) if warm \
+            else self.greedy(obs)
         for k, noise in enumerate(self.noises):
             if noise is not None:
                 actions[k] = np.clip(actions[k] + np.asarray(noise()).reshape(n, self.act_dim), -1, 1)
@@ -283,7 +276,15 @@ class Population:
             self.replay.update_priorities(batch.leaves, td)
 
     def greedy(self, obs: np.ndarray) -> np.ndarray:
-        return self.learner.act(obs)
+        """Greedy actions for observations ``(K, n, obs_dim)``, in training and evaluation alike."""
+        actions = self.learner.act(obs)
+        if not self.discrete:
+            broken = np.flatnonzero(~np.isfinite(actions).all(axis=(1, 2)))
+            if broken.size:  # named here: the world would refuse NaN thrust, naming neither seed nor cause
+                raise Diverged(f"{self.method} seed {self.seeds[broken[0]]}: its actor's actions are not finite "
+                               f"after {self.num_timesteps:,} transitions, so its learning diverged; run it with a "
+                               "smaller learning_rate (or other settings that shrink its updates)")
+        return actions
 
     # -- checkpoints -------------------------------------------------------------------------------
     def member_state(self, k: int) -> dict:

@@ -40,7 +40,8 @@ def test_a_value_of_the_wrong_type_is_named(overrides, message):
     ("td3", {"n_steps": 101}, "n_steps must be between 1 and 100 (e.g. 1), got 101"),
     # JSON's Infinity (or 1e400) passes every lower bound: a run would train to NaN thrust
     ("td3", {"learning_rate": float("inf")}, "learning_rate must be a finite number (default 0.0001), got inf"),
-    ("dqn", {"max_grad_norm": float("inf")}, "max_grad_norm must be a finite number (e.g. 10.0), got inf"),
+    ("dqn", {"max_grad_norm": float("inf")}, "max_grad_norm must be a finite number (e.g. 10.0; a large one, e.g. "
+     "1e9, caps nothing), got inf"),
     ("td3", {"gamma": float("nan")}, "gamma must be a finite number (default 0.99), got nan"),
 ])
 def test_a_number_out_of_its_range_is_named(algorithm, overrides, message):

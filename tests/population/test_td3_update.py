@@ -64,7 +64,7 @@ def test_the_actor_and_the_critics_take_their_own_widths_and_a_malformed_one_is_
 def test_an_actor_that_diverged_is_named_by_its_seed_before_the_world_sees_its_actions():
     import gymnasium as gym
 
-    from craftsuite.population.engine import Diverged, Population
+    from craftsuite.population import Diverged, Population
     from craftsuite.task_registry import resolve_task
 
     spec = resolve_task("Reach")
@@ -76,6 +76,7 @@ def test_an_actor_that_diverged_is_named_by_its_seed_before_the_world_sees_its_a
     with th.no_grad():
         for p in population.learner.actor.parameters():
             p[1:] = float("nan")  # the second member's share of each stacked weight
-    with pytest.raises(Diverged, match=r"^td3 seed 7: its actor's actions are not finite after 0 transitions, so its "
-                                       r"learning diverged; run it with a smaller learning_rate"):
-        population.actions(obs)
+    for act in (population.actions, population.greedy):  # in training and in evaluation
+        with pytest.raises(Diverged, match=r"^td3 seed 7: its actor's actions are not finite after 0 transitions, so "
+                                           r"its learning diverged; run it with a smaller learning_rate"):
+            act(obs)

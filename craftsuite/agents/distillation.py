@@ -77,7 +77,13 @@ class AutomatonQTable:
         return "\n".join(lines)
 
     def save(self, path) -> Path:
+        """Write the table at ``path`` (atomically).
+
+        Raises:
+            DistillationError: values that are not all finite (a teacher that diverged), named.
+        """
         path = Path(path)
+        _refuse_nonfinite(self.q, "the table's")
         meta = {"format": FORMAT_VERSION, "fingerprint": self.fingerprint, "kind": self.kind,
                 "propositions": list(self.propositions)}
         with atomic_path(path) as tmp, open(tmp, "wb") as f:  # a crash never leaves half a table behind
@@ -122,12 +128,7 @@ class AutomatonQTable:
         if q.ndim != 2 or q.shape != counts.shape:
             raise DistillationError(f"{where}: q {q.shape} and counts {counts.shape} must be one matrix shape "
                                     "(automaton states x labels)")
-        broken = np.argwhere(~np.isfinite(q))
-        if len(broken):  # a student would train towards it, and fail only as NaN actions much later
-            w, sigma = broken[0]
-            raise DistillationError(f"{where}: its values are not all finite ({len(broken)} of {q.size}, the first "
-                                    f"{q[w, sigma]} at automaton state {w}, label {sigma}); its teacher diverged or "
-                                    "the file was edited: train and distil the teacher again")
+        _refuse_nonfinite(q, f"{path}'s")
         try:
             table = cls(q=q, counts=counts, fingerprint=meta["fingerprint"],
                         propositions=tuple(meta["propositions"]), kind=meta["kind"])
@@ -139,6 +140,17 @@ class AutomatonQTable:
             except DistillationError as err:
                 raise DistillationError(f"{path} does not fit this task: {err}") from None
         return table
+
+
+def _refuse_nonfinite(q: np.ndarray, whose: str) -> None:
+    """A DistillationError where ``q`` holds NaN or infinity, naming the first edge: a student
+    would train towards it, and fail only much later (NaN actions)."""
+    broken = np.argwhere(~np.isfinite(q))
+    if len(broken):
+        w, sigma = broken[0]
+        raise DistillationError(f"{whose} values are not all finite ({len(broken)} of {q.size}, the first "
+                                f"{q[w, sigma]} on the edge from automaton state {w} under label {sigma}): its teacher "
+                                "diverged, or the file was edited; train and distil the teacher again")
 
 
 def dynamic_distillation(automaton: Automaton, w: np.ndarray, sigma: np.ndarray,

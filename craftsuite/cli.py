@@ -364,6 +364,7 @@ def _unread(args, why: str) -> None:
 
 
 def _write_table(table, automaton, args) -> int:
+    table.check_finite()  # (before the drawing: a refused table leaves no drawing behind)
     if args.draw:  # drawn first: a failed drawing leaves no table behind either
         from .automata import write_image
 

@@ -160,10 +160,14 @@ def recorded_settings(settings) -> dict:
                          f"hold; record it as a string, e.g. {text!r}")
 
     def mapping(value: Mapping, where: str) -> dict:
+        name = f"settings {where}" if where else "settings"
         odd = [k for k in value if isinstance(k, bool) or not isinstance(k, (str, int))]
         if odd:
-            raise ValueError(f"{f'settings {where}' if where else 'settings'}: its keys must be names (strings), "
-                             f"got {odd[0]!r}")
+            raise ValueError(f"{name}: its keys must be strings or integers, got {odd[0]!r}")
+        texts = [str(k) for k in value]
+        if len(set(texts)) < len(texts):  # 1 and "1": one key in JSON, and one would be lost
+            twice = next(t for t in texts if texts.count(t) > 1)
+            raise ValueError(f"{name}: the keys {twice!r} and {int(twice)!r} are one key in a JSON record; keep one")
         return {str(k): plain(v, f"{where}[{k!r}]" if where else repr(k)) for k, v in value.items()}
 
     return mapping(settings, "")

@@ -97,7 +97,8 @@ def test_a_method_named_as_craftsuites_own_is_refused(tmp_path, method, message)
     ({"lr": float("nan")}, "settings 'lr' holds nan, not a finite number, which JSON cannot hold; record it as "
      "a string"),
     ("lr=1", "settings must be a dict of the learner's settings"),
-    ({(1, 2): 3}, r"settings: its keys must be names \(strings\), got \(1, 2\)"),
+    ({(1, 2): 3}, r"settings: its keys must be strings or integers, got \(1, 2\)"),
+    ({"net": {1: "a", "1": "b"}}, r"settings 'net': the keys '1' and 1 are one key in a JSON record; keep one"),
     ({"log": {"dir": Path("runs/x")}}, r"settings 'log'\['dir'\] holds runs/x \(a PosixPath\), which a JSON record "
      r"cannot hold; record it as a string, e.g. 'runs/x'"),
 ])

@@ -83,12 +83,17 @@ class AutomatonQTable:
             DistillationError: values that are not all finite (a teacher that diverged), named.
         """
         path = Path(path)
-        _refuse_nonfinite(self.q, "the table's")
+        self.check_finite()
         meta = {"format": FORMAT_VERSION, "fingerprint": self.fingerprint, "kind": self.kind,
                 "propositions": list(self.propositions)}
         with atomic_path(path) as tmp, open(tmp, "wb") as f:  # a crash never leaves half a table behind
             np.savez(f, q=self.q, counts=self.counts, meta=np.array(json.dumps(meta)))
         return path
+
+    def check_finite(self) -> None:
+        """Raise a DistillationError where the values are not all finite (a teacher that
+        diverged), naming the first edge: before the table is written, or drawn."""
+        _refuse_nonfinite(self.q, "the table's")
 
     @classmethod
     def load(cls, path, automaton: Automaton | None = None) -> AutomatonQTable:

@@ -95,3 +95,15 @@ def test_save_load_and_clear_errors(tmp_path):
 def test_describe_lists_edges():
     text = static_distillation(TOY).describe(TOY)
     assert "100.90" in text and "->" in text
+
+
+def test_distill_writes_neither_drawing_nor_table_of_values_that_are_not_finite(tmp_path):
+    from types import SimpleNamespace
+
+    from craftsuite.cli import _write_table
+
+    diverged = table({(0, SWORD): np.nan})
+    args = SimpleNamespace(draw=str(tmp_path / "values.png"), out=str(tmp_path / "table.npz"))
+    with pytest.raises(DistillationError, match="^the table's values are not all finite"):
+        _write_table(diverged, TOY, args)
+    assert list(tmp_path.iterdir()) == []

@@ -323,7 +323,7 @@ def _distill(args) -> int:
                 raise FileNotFoundError(f"{source} has no checkpoint (model and replay buffer) yet")
             model, replay = saved / "model.zip", saved / "replay.pkl"
         else:
-            import zipfile
+            from .agents.factory import saved_agent_file
 
             if args.env_id is not None and args.task is not None:
                 raise ValueError(f"--task {args.task} --env-id {args.env_id}: the env id names the teacher's task "
@@ -331,9 +331,11 @@ def _distill(args) -> int:
             if source.suffix == ".npz":  # (a zip too)
                 raise ValueError(f"{source} is a distilled table already: give it to a student (--table), or give "
                                  "its teacher's run directory to distil it again")
-            if not zipfile.is_zipfile(source):
+            try:  # before its replay is asked for
+                saved_agent_file(source)
+            except ValueError:
                 raise ValueError(f"{source} is not a teacher: give a teacher run directory or its model .zip "
-                                 "(dynamic), or a task name with --static")
+                                 "(dynamic), or a task name with --static") from None
             env_id, env_kwargs = args.env_id or _registered(args.task or "BlindCraftsman", "Grid7"), {}
             model, replay = source, Path(args.replay) if args.replay else None
         if replay is None or not replay.is_file():

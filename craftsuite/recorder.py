@@ -31,8 +31,8 @@ skipped: a late one plays a policy that trained on more transitions than its ste
 from __future__ import annotations
 
 import operator
-from collections.abc import Mapping
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 

@@ -134,6 +134,22 @@ def recorded_algorithm(path) -> str | None:
     return data["algorithm"] if isinstance(data.get("algorithm"), str) else None
 
 
+def saved_agent_file(path) -> Path:
+    """``path`` as a saved agent's file, before anything is built to load it.
+
+    Raises:
+        FileNotFoundError: no file there.
+        ValueError: a file that is no stable-baselines3 checkpoint (not a zip archive).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no saved agent at {path}")
+    if not zipfile.is_zipfile(path):
+        raise ValueError(f"{path} is not a saved agent: not a stable-baselines3 checkpoint "
+                         "(not a zip archive: corrupt or another file?)")
+    return path
+
+
 def load_agent(path, env=None):
     """Load a saved agent (any CraftSuite method, or a plain stable-baselines3 checkpoint)
     with a clear error for missing or corrupt files. Its class is the one its algorithm
@@ -143,12 +159,7 @@ def load_agent(path, env=None):
     a replay after it with ``load_replay_buffer``."""
     import stable_baselines3 as sb3
 
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"no saved agent at {path}")
-    if not zipfile.is_zipfile(path):
-        raise ValueError(f"{path} is not a saved agent: not a stable-baselines3 checkpoint "
-                         "(not a zip archive: corrupt or another file?)")
+    path = saved_agent_file(path)
     algorithm = recorded_algorithm(path)
     if algorithm is not None:
         if algorithm not in CLASSES:

@@ -87,11 +87,15 @@ class PopulationDQN:
             return dense.scatter_add_(-1, index, value)  # the padding adds zeros at index 0
         return th.as_tensor(observations, device=self.device)
 
-    def act(self, observations: np.ndarray) -> np.ndarray:
-        """Greedy actions ``(K, n)`` for observations ``(K, n, obs_dim)``."""
+    # what ``act``'s second array holds, for the engine's message when it is not finite
+    OUTPUTS = "Q-values"
+
+    def act(self, observations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Greedy actions ``(K, n)`` for observations ``(K, n, obs_dim)``, and each state's sum of
+        Q-values, finite exactly when all its Q-values are (an argmax of NaN is still an action)."""
         with th.no_grad(), self.evaluating():
-            return self.q_values(self.q_net,
-                                 th.as_tensor(observations, device=self.device)).argmax(dim=-1).cpu().numpy()
+            q = self.q_values(self.q_net, th.as_tensor(observations, device=self.device))
+            return q.argmax(dim=-1).cpu().numpy(), q.sum(dim=-1).cpu().numpy()
 
     def evaluating(self):
         """A context in which the online network's batch norms (a CNN's) read their running

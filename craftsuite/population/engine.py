@@ -35,7 +35,7 @@ class EngineError(ValueError):
 
 
 class Diverged(ValueError):
-    """A member whose actor no longer gives finite actions: its updates diverged."""
+    """A member whose actor's actions or Q-values are no longer finite: its updates diverged."""
 
 
 # Settings the engine reads; any other override of a run's algorithm is refused by name
@@ -209,7 +209,7 @@ class Population:
             random = self.rng.integers(0, self.n_actions, size=(K, n))
             if warm:
                 return random
-            greedy = self.learner.act(obs)
+            greedy = self.greedy(obs)
             return np.where(self.rng.random((K, n)) < self.exploration_rate(), random, greedy)
         actions = self.rng.uniform(-1, 1, size=(K, n, self.act_dim)).astype(np.float32) if warm \
             else self.greedy(obs)
@@ -277,11 +277,12 @@ class Population:
 
     def greedy(self, obs: np.ndarray) -> np.ndarray:
         """Greedy actions for observations ``(K, n, obs_dim)``, in training and evaluation alike."""
-        actions = self.learner.act(obs)
-        if not self.discrete and not np.isfinite(actions).all():  # (one reduction a step in the common case)
-            # named here: the world would refuse NaN thrust, naming neither seed nor cause
-            k = int(np.flatnonzero(~np.isfinite(actions).all(axis=(1, 2)))[0])
-            raise Diverged(f"{self.method} seed {self.seeds[k]}: its actor's actions are not finite after "
+        actions, outputs = self.learner.act(obs)
+        if not np.isfinite(outputs).all():  # (one reduction a step in the common case)
+            # named here: the world would refuse NaN thrust, and a DQN would act on an argmax of NaN,
+            # naming neither seed nor cause
+            k = int(np.flatnonzero(~np.isfinite(outputs.reshape(self.K, -1)).all(axis=1))[0])
+            raise Diverged(f"{self.method} seed {self.seeds[k]}: its {self.learner.OUTPUTS} are not finite after "
                            f"{self.num_timesteps:,} transitions, so its learning diverged; run it with a smaller "
                            "learning_rate (or other settings that shrink its updates)")
         return actions

@@ -60,10 +60,15 @@ class PopulationTD3:
         self.n_updates = 0
 
     # -- acting ------------------------------------------------------------------------------------
-    def act(self, observations: np.ndarray) -> np.ndarray:
-        """Greedy actions ``(K, n, act_dim)`` for observations ``(K, n, obs_dim)``."""
+    # what ``act``'s second array holds, for the engine's message when it is not finite
+    OUTPUTS = "actor's actions"
+
+    def act(self, observations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Greedy actions ``(K, n, act_dim)`` for observations ``(K, n, obs_dim)``, twice: as the
+        actions and as the outputs whose finiteness says the actor has not diverged."""
         with th.no_grad():
-            return self.actor(th.as_tensor(observations, device=self.device)).cpu().numpy()
+            actions = self.actor(th.as_tensor(observations, device=self.device)).cpu().numpy()
+        return actions, actions
 
     # -- learning ----------------------------------------------------------------------------------
     def _tensor(self, array, shape=None) -> th.Tensor:

@@ -60,23 +60,3 @@ def test_the_actor_and_the_critics_take_their_own_widths_and_a_malformed_one_is_
             check_supported("td3", settings)
         assert str(built.value) in str(checked.value)
 
-
-def test_an_actor_that_diverged_is_named_by_its_seed_before_the_world_sees_its_actions():
-    import gymnasium as gym
-
-    from craftsuite.population import Diverged, Population
-    from craftsuite.task_registry import resolve_task
-
-    spec = resolve_task("Reach")
-    settings = algorithm_settings("td3", {"learning_starts": 0, "policy_kwargs": {"net_arch": [8, 8]}})
-    population = Population("td3", settings, [4, 7], 1, OBS, gym.spaces.Box(-1, 1, (ACT,)), spec.automaton,
-                            spec.completion_reward, 100)
-    obs = np.zeros((2, 1, OBS), dtype=np.float32)
-    assert np.isfinite(population.actions(obs)).all()
-    with th.no_grad():
-        for p in population.learner.actor.parameters():
-            p[1:] = float("nan")  # the second member's share of each stacked weight
-    for act in (population.actions, population.greedy):  # in training and in evaluation
-        with pytest.raises(Diverged, match=r"^td3 seed 7: its actor's actions are not finite after 0 transitions, so "
-                                           r"its learning diverged; run it with a smaller learning_rate"):
-            act(obs)

@@ -471,7 +471,8 @@ def read_csv(path, fields: tuple[str, ...] = (), required: bool = False) -> list
     """A run's CSV log as rows (none if it is missing); ``<name>.gz`` beside a missing
     ``<name>`` is read instead (the results archive keeps ``episodes.csv`` compressed). Rows
     are read as ``csv.DictReader`` reads them (blank lines skipped, a long row's extra fields
-    a list under None), less any row short of the header: a torn line.
+    a list under None), less any row short of the header and a last line without its line end:
+    torn lines.
 
     Args:
         fields: the columns the caller reads; given, a log that cannot hold them is refused
@@ -535,6 +536,10 @@ def _log_rows(path, fields: tuple[str, ...], required: bool) -> tuple[list[str] 
         reader = csv.reader(io.TextIOWrapper(io.BytesIO(data), newline=""))  # (open()'s own decoding)
         header = next(reader, None)
         rows = [row for row in reader if row]
+        if rows and not data.endswith((b"\n", b"\r")):
+            # every writer ends its lines: a last line without its end was torn by a kill, however
+            # many fields it kept (a value cut from "0.85" to "0.8" would read as the partial one)
+            rows.pop()
     # neither is an OSError or a ValueError, the damage a log's readers name (reading_log)
     except zlib.error as err:
         raise ValueError(f"its compressed bytes are damaged ({err})") from None

@@ -106,6 +106,11 @@ def test_read_csv_ignores_a_torn_last_line(tmp_path):
     path = tmp_path / "e.csv"
     path.write_text("step,return,length,success\n1,0.5,1,0\n2,0.")
     assert [r["step"] for r in read_csv(path)] == ["1"]
+    path.write_text("step,return,length,success\n1,0.5,1,0\n2,0.5,1,1")  # torn inside its last field
+    assert [r["step"] for r in read_csv(path)] == ["1"]
+    assert read_columns(path, ("success",))["success"] == ("0",)
+    path.write_text("step,return,length,success\r\n1,0.5,1,0\r")  # torn between its line end's bytes: whole
+    assert [r["success"] for r in read_csv(path)] == ["0"]
 
 
 def test_read_csv_reads_rows_as_the_standard_dict_reader_does(tmp_path):

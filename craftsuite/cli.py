@@ -7,6 +7,8 @@ import json
 import sys
 from pathlib import Path
 
+from .files import EMPTY_PATH
+
 TIME_LIMIT_STATUS = 3  # the exit status of a transfer its --time-limit stopped: runs are left to resume
 
 
@@ -603,7 +605,7 @@ def _path(text: str) -> str:
     """A path flag's text: never empty (an empty path is the working directory to Python,
     which no one typing ``--out ''``, or ``--out "$UNSET"``, meant)."""
     if not text.strip():
-        raise argparse.ArgumentTypeError("is empty: give a path")
+        raise argparse.ArgumentTypeError(EMPTY_PATH)
     return text
 
 

@@ -97,6 +97,17 @@ def _nearest(path: Path) -> Path:
     return path
 
 
+# where no path was given, in one voice: the command line's path flags and these checks
+EMPTY_PATH = "is empty: give a path"
+
+
+def _refuse_empty(given, flag: str) -> None:
+    """An empty path is the working directory to Python, which no one passing ``""`` (or an
+    unset variable) meant."""
+    if not str(given).strip():
+        raise ValueError(f"{flag} {EMPTY_PATH}")
+
+
 def _check_writable_dir(path: Path, flag: str, given) -> None:
     """Raise naming ``flag`` where ``path`` (a directory to write in, or to make) cannot be one."""
     nearest = _nearest(path)
@@ -117,9 +128,11 @@ def directory_to_write(path, flag: str) -> Path:
         flag: the option or argument that gave it, e.g. ``--out``: every message names it.
 
     Raises:
+        ValueError: ``path`` is empty.
         NotADirectoryError: ``path``, or a folder on its way, is a file.
         PermissionError: it, or the folder it would be made in, cannot be written.
     """
+    _refuse_empty(path, flag)
     given = path
     path = Path(path)
     if path.exists() and not path.is_dir():
@@ -139,10 +152,12 @@ def file_to_write(path, flag: str, example: str) -> Path:
         example: a file name for the fix where a directory was given, e.g. ``results.md``.
 
     Raises:
+        ValueError: ``path`` is empty.
         IsADirectoryError: ``path`` is a directory (or names one, ending in a separator).
         NotADirectoryError: a folder on its way is a file.
         PermissionError: the folder it goes in cannot be written.
     """
+    _refuse_empty(path, flag)
     given = path
     path = Path(path)
     if path.is_dir() or str(given).endswith(("/", os.sep)):

@@ -198,14 +198,17 @@ class Recorder(gym.Wrapper):
             steps: another budget than the suite's for the rung, on the suite's schedule for it.
 
         Raises:
-            ValueError: bad settings (see ``recorded_config``), each named with its fix.
+            ValueError: bad settings (see ``recorded_config``), each named with its fix, or an
+                empty ``out``.
+            OSError: ``out`` cannot be a directory to write in (a file, no permission), named.
             RunError: the run being recorded in this process already, or recorded before.
         """
+        from .files import directory_to_write
         from .reached import Reached
         from .task_registry import resolve_task
 
         self.config = recorded_config(env_id, method, seed, suite, library, settings, commit, steps)
-        self.path = Path(out) / self.config.run_name()
+        self.path = directory_to_write(out, "out") / self.config.run_name()
         if self.path.resolve() in _RECORDING:
             raise RunError(f"{self.path} is being recorded by another Recorder in this process: a Recorder records "
                            "one run from one env (to collect from several envs, record each seed's run apart)")

@@ -346,8 +346,7 @@ def transfer(suite: Suite, out, *, workers: int | None = None, ray: str | None =
         command = f"python: craftsuite.suite_runner.transfer(suite {suite.name!r}, out {str(out)!r})"
     session, clock = start_session(command), time.perf_counter()
     deadline = None if time_limit is None else time.monotonic() + time_limit
-    out = Path(out)
-    configs, teachers, kept = _checked(suite, out, archive, device)
+    out, configs, teachers, kept = _checked(suite, out, archive, device)
     # the pool, and a Ray cluster with it, before anything is written: one out of reach leaves no output behind
     pool = WorkerPool(len(cells(configs, members)) + len(teachers), workers, ray)
     log(f"suite {suite.name}: {suite.description}")  # (its input checked: a refused transfer says only why)
@@ -460,22 +459,22 @@ def _counting_acceptance(runs: list[Path]) -> list[Path]:
     return found
 
 
-def _checked(suite: Suite, out: Path, archive, device: str | None):
+def _checked(suite: Suite, out, archive, device: str | None):
     """``transfer``'s input checked before anything is written (each refusal one line naming
-    the fix): its student configs, its teachers, and the suite's place in the archive (None:
-    no archive)."""
+    the fix): ``out`` as a Path, its student configs, its teachers, and the suite's place in
+    the archive (None: no archive)."""
     from .provenance import read
 
+    out, kept = _check_places(out, archive, suite.name)
     configs = suite.student_configs(out / "teachers")
     teachers = suite.teachers()
     check_budgets(configs, teachers)
-    kept = _check_places(out, archive, suite.name)
     _check_out_suite(out, suite.name)
     _check_students(configs, device, teachers.values())  # fail before any training
     read(out)  # a damaged provenance record, too
     _counting_acceptance([out / "students" / c.run_name() for c in configs])  # none unfinished
     _refuse_sb3_not_kept(out, kept, configs, teachers.values())  # nothing written for a run it would not train
-    return configs, teachers, kept
+    return out, configs, teachers, kept
 
 
 @dataclass(frozen=True)
@@ -544,8 +543,7 @@ def plan(suite: Suite, out, *, archive=None, device: str | None = None) -> Plan:
     from .archive import reuse
     from .population.train import saved_steps
 
-    out = Path(out)
-    configs, teachers, store = _checked(suite, out, archive, device)
+    out, configs, teachers, store = _checked(suite, out, archive, device)
     skipped, busy = [], []
 
     def finished(kind: str, name: str) -> bool:
@@ -684,16 +682,17 @@ def smallest_budget(settings: dict, n_envs: int) -> int:
     return (first - 1) * n_envs + 1
 
 
-def _check_places(out: Path, archive, suite: str) -> Path | None:
+def _check_places(out, archive, suite: str) -> tuple[Path, Path | None]:
     """``out`` and the results archive (None: none) as directories to write in, else one
-    line naming the flag, the path and the fix; returns the suite's place in the archive."""
+    line naming the flag, the path and the fix (an empty one too, before Path makes it the
+    working directory); returns ``out`` and the suite's place in the archive."""
     from .files import directory_to_write
 
-    directory_to_write(out, "--out")
+    out = directory_to_write(out, "--out")
     if archive is None:
-        return None
+        return out, None
     directory_to_write(archive, "--archive")
-    return directory_to_write(Path(archive) / suite, "--archive")  # a file there, too
+    return out, directory_to_write(Path(archive) / suite, "--archive")  # a file there, too
 
 
 def _check_out_suite(out: Path, name: str) -> None:

@@ -193,6 +193,23 @@ def test_an_empty_path_is_refused_by_its_flag(tmp_path, capsys, monkeypatch, com
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("where", [{"out": ""}, {"out": "out", "archive": " "}])
+def test_an_empty_path_from_python_is_refused_before_anything_is_written(tmp_path, monkeypatch, where):
+    """The rule behind the flags holds for a Python caller, whom no parser stands before."""
+    import craftsuite
+    import craftsuite.suite_runner as suite_runner
+    from craftsuite.suites import SUITES
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(suite_runner, "WorkerPool", lambda *a: pytest.fail("transfer went on to train"))
+    name = next(k for k, v in where.items() if not v.strip())
+    with pytest.raises(ValueError, match=f"^--{name} is empty: give a path$"):
+        suite_runner.transfer(dataclasses.replace(SUITES["quick"], tasks=("Reach",), seeds=1), **where)
+    with pytest.raises(ValueError, match="^out is empty: give a path$"):
+        craftsuite.Recorder("CraftSuite/Reach-Grid10-v0", "", method="mine")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_directory_given_for_a_file_names_the_file_in_it(tmp_path, capsys):
     """A teacher's run directory where its table goes, a run directory where a checkpoint
     goes: the message names the file to give."""

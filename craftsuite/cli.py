@@ -612,6 +612,14 @@ def _path(text: str) -> str:
 _path.__name__ = "path"
 
 
+def _source(text: str) -> str:
+    """distill's SOURCE: never empty, and where it is, the message names both of its kinds."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("is empty: give a teacher run directory or its .zip, or with --static a "
+                                         "task name")
+    return text
+
+
 def _positive(text: str) -> int:
     value = int(text)
     if value < 1:
@@ -747,7 +755,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_teacher)
 
     p = command("distill", "distil a teacher (dynamic) or a task's automaton (static) into a table")
-    p.add_argument("source", type=_path,
+    p.add_argument("source", type=_source,
                    help="a teacher run directory or teacher .zip (dynamic), or a task name (--static)")
     p.add_argument("--out", type=_path, required=True, help="the table to write (.npz)")
     p.add_argument("--static", action="store_true", help="value iteration over the automaton alone")

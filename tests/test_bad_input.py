@@ -193,6 +193,15 @@ def test_an_empty_path_is_refused_by_its_flag(tmp_path, capsys, monkeypatch, com
     assert list(tmp_path.iterdir()) == []
 
 
+def test_an_empty_distill_source_names_both_kinds_of_source(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit):
+        main(["distill", "", "--static", "--out", "t.npz"])
+    assert capsys.readouterr().err.endswith("error: argument source: is empty: give a teacher run directory or its "
+                                            ".zip, or with --static a task name\n")
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("where", [{"out": ""}, {"out": "out", "archive": " "}])
 def test_an_empty_path_from_python_is_refused_before_anything_is_written(tmp_path, monkeypatch, where):
     """The rule behind the flags holds for a Python caller, whom no parser stands before."""

@@ -19,11 +19,11 @@ from functools import lru_cache
 from pathlib import Path
 
 from .names import unknown_name
-from .spec import TaskSpec, builtin_specs, load_spec
+from .spec import SpecError, TaskSpec, builtin_specs, load_spec
 
 SPEC_SUFFIX = ".toml"  # a task argument ending so names a spec file, not a task
 _TASKS: dict[str, TaskSpec] = {}
-_BUILTIN: set[str] = set()
+_BUILTIN: dict[str, TaskSpec] = {}
 
 
 def tasks() -> dict[str, TaskSpec]:
@@ -38,7 +38,7 @@ def tasks() -> dict[str, TaskSpec]:
 def builtin_names() -> frozenset[str]:
     """The names of the tasks shipped in ``tasks/``."""
     tasks()
-    return frozenset(_BUILTIN)
+    return frozenset(_BUILTIN)  # (its keys)
 
 
 def ladder(*tags: str) -> list[TaskSpec]:
@@ -57,13 +57,22 @@ def ladder(*tags: str) -> list[TaskSpec]:
 
 
 def add_task(source: str | Path | TaskSpec | Mapping) -> TaskSpec:
-    """Add a task from a spec file, its TOML data or a loaded spec (replacing a known task
+    """Add a task from a spec file, its TOML data or a loaded spec (replacing a user task
     of the same name) and return it. Gymnasium ids come with ``craftsuite.register_task``.
 
     Raises:
-        SpecError: a spec that cannot be used, naming the file, the field and the problem.
+        SpecError: a spec that cannot be used, naming the file, the field and the problem; a
+            built-in task's name on another task (runs and leaderboards know a task by its name, so
+            its runs would pool with the built-in's).
     """
     spec = source if isinstance(source, TaskSpec) else _load(source)
+    tasks()
+    if spec.name in _BUILTIN:
+        if spec.digest() != _BUILTIN[spec.name].digest():
+            raise SpecError(f"{spec.path or f'<task spec {spec.name!r} given as data>'}: name: {spec.name!r} is a "
+                            f"built-in task's, whose runs this task's would pool with: name yours otherwise, e.g. "
+                            f"My{spec.name}")
+        return _BUILTIN[spec.name]  # the same rules: the built-in itself, which travels by name
     _ = spec.automaton  # compiled now: an objective that can never be satisfied is refused before it is known
     tasks()[spec.name] = spec
     return spec

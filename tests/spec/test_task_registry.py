@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import tomllib
 
 import gymnasium as gym
 import numpy as np
@@ -97,3 +98,21 @@ def test_subprocess_vector_env_of_a_user_task(user_task):
         assert reward.shape == (2,)
     finally:
         envs.close()
+
+
+def test_a_user_task_named_as_a_built_in_is_refused_and_the_built_in_kept(tmp_path):
+    """Runs are keyed by the task's name: another task called Reach would pool with Reach's
+    runs on every leaderboard. The built-in's own spec, registered again, is the same task."""
+    from craftsuite.spec import tasks_dir
+
+    reach, ids = task_registry.tasks()["Reach"], craftsuite.registered_ids()
+    text = (tasks_dir() / "first_wood.toml").read_text().replace('name = "FirstWood"', 'name = "Reach"')
+    assert 'name = "Reach"' in text
+    with pytest.raises(SpecError, match=r"my\.toml: name: 'Reach' is a built-in task's, whose runs this task's would "
+                                        r"pool with: name yours otherwise, e.g. MyReach$"):
+        craftsuite.register_task(write(tmp_path, text, "my.toml"))
+    with pytest.raises(SpecError, match=r"^<task spec 'Reach' given as data>: name: 'Reach' is a built-in"):
+        craftsuite.register_task(load_spec(tomllib.loads(text)).to_data())
+    assert task_registry.tasks()["Reach"] is reach and craftsuite.registered_ids() == ids
+    assert craftsuite.register_task(tasks_dir() / "reach.toml")  # the same task: its ids again
+    assert task_registry.tasks()["Reach"] is reach

@@ -16,6 +16,7 @@ hyperparameter of a suite, so a leaderboard row says what ran.
 
 from __future__ import annotations
 
+import numbers
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -30,6 +31,15 @@ DISTILLATIONS = (None, "static", "dynamic")  # where a distilled target's, or a 
 # the DistilledTarget's keywords unless a row or a run says otherwise: the paper's rho,
 # and the teacher's values on every label (self-loops included)
 TARGET_DEFAULTS = MappingProxyType({"rho": 0.999, "self_loops": True})
+
+
+def check_target(rho, self_loops) -> None:
+    """The distilled target's keywords (``DistilledTarget``'s), each refused by name: a row
+    is checked when it is built, not when its first run starts."""
+    if isinstance(rho, bool) or not isinstance(rho, numbers.Real) or not 0.0 <= rho <= 1.0:
+        raise ValueError(f"rho must be a number in [0, 1], got {rho!r}")
+    if not isinstance(self_loops, bool):
+        raise ValueError(f"self_loops must be true or false, got {self_loops!r}")
 
 
 class MethodError(ValueError):
@@ -56,6 +66,9 @@ class Method:
 
     def __post_init__(self):
         where = f"METHODS row {self.name!r}"
+        for flag in ("product", "crm"):  # read as truths: "no" would switch one on
+            if not isinstance(getattr(self, flag), bool):
+                raise MethodError(f"{where}: {flag} must be True or False, got {getattr(self, flag)!r}")
         if self.world not in WORLD_KINDS:
             raise MethodError(f"{where}: world {self.world!r} does not exist; worlds: {', '.join(WORLD_KINDS)}")
         if ALGORITHMS.get(self.algorithm) != self.world:
@@ -79,6 +92,10 @@ class Method:
         if unknown or (self.target and self.distill is None):
             raise MethodError(f"{where}: target takes {', '.join(sorted(TARGET_DEFAULTS))} and only with distill; "
                               f"got {self.target!r}")
+        try:
+            check_target(**{**TARGET_DEFAULTS, **self.target})
+        except ValueError as err:
+            raise MethodError(f"{where}: target {err}") from None
         object.__setattr__(self, "target", MappingProxyType(dict(self.target)))  # a row of a read-only table
 
     @property
@@ -190,7 +207,7 @@ def register_method(row: Method) -> None:
     """
     if not isinstance(row, Method):
         raise MethodError(f"register_method takes a craftsuite.methods.Method row, got {type(row).__name__}")
-    if not _NAME.match(row.name):
+    if not isinstance(row.name, str) or not _NAME.match(row.name):
         raise MethodError(f"method name {row.name!r}: use lowercase letters, digits and dashes (e.g. td3-rho09), "
                           "as run directories and the command line take it")
     if row.name in _ROWS:

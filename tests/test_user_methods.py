@@ -117,10 +117,23 @@ def test_a_ray_worker_gets_the_rows_registered_in_the_driver(monkeypatch):
     (Method("td3", "Cont", "td3", False), "method 'td3' is a row already"),
     (Method("My Method", "Cont", "td3", False), "use lowercase letters, digits and dashes"),
     ("td3-mine", "register_method takes a craftsuite.methods.Method row, got str"),
+    (Method(None, "Cont", "td3", False), "method name None: use lowercase letters"),
 ])
 def test_a_bad_row_is_refused_by_name(row, message):
     with pytest.raises(MethodError, match=message):
         register_method(row)
+
+
+@pytest.mark.parametrize("fields, message", [
+    ({"crm": "no"}, r"crm must be True or False, got 'no'"),  # a truth: it would switch CRM on
+    ({"product": None}, r"product must be True or False, got None"),
+    ({"distill": "dynamic", "target": {"rho": "x"}}, r"target rho must be a number in \[0, 1\], got 'x'"),
+    ({"distill": "dynamic", "target": {"rho": float("nan")}}, r"target rho must be a number in \[0, 1\], got nan"),
+    ({"distill": "dynamic", "target": {"self_loops": 0}}, r"target self_loops must be true or false, got 0"),
+])
+def test_a_rows_settings_are_checked_when_it_is_built_not_when_it_first_runs(fields, message):
+    with pytest.raises(MethodError, match=rf"^METHODS row 'dqn-mine': {message}$"):
+        Method(**{"name": "dqn-mine", "world": "Grid", "algorithm": "dqn", "product": True, **fields})
 
 
 def test_a_module_that_is_not_there_or_registers_no_such_row_is_named(user_module, capsys):

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..automata import Automaton
 from ..files import atomic_path, file_to_read
-from ..methods import TARGET_DEFAULTS
+from ..methods import TARGET_DEFAULTS, check_target
 
 FORMAT_VERSION = 1
 
@@ -223,10 +223,7 @@ class DistilledTarget:
     def __init__(self, table: AutomatonQTable, automaton: Automaton, rho: float = TARGET_DEFAULTS["rho"],
                  self_loops: bool = TARGET_DEFAULTS["self_loops"]):
         table.check(automaton)
-        if not 0.0 <= rho <= 1.0:
-            raise ValueError(f"rho must lie in [0, 1], got {rho}")
-        if not isinstance(self_loops, bool):
-            raise ValueError(f"self_loops must be true or false, got {self_loops!r}")
+        check_target(rho, self_loops)
         self.table, self.rho, self.self_loops = table, rho, self_loops
         self.q_teacher = table.q.astype(np.float32)
         self.seen = table.seen

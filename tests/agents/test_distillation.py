@@ -30,7 +30,7 @@ def test_the_target_takes_a_rho_in_0_1_and_self_loops_as_a_bool():
     values = {(0, 0): 50.0, (0, SWORD): 10.0}
     with pytest.raises(ValueError, match="self_loops must be true or false"):
         DistilledTarget(table(values), TOY, self_loops="no")  # e.g. a string from --hyper
-    with pytest.raises(ValueError, match=r"rho must lie in \[0, 1\], got 1.5"):
+    with pytest.raises(ValueError, match=r"rho must be a number in \[0, 1\], got 1.5"):
         DistilledTarget(table(values), TOY, rho=1.5)
     progress_only = DistilledTarget(table(values), TOY, self_loops=False)
     assert progress_only.seen[0].tolist() == [False, True, False, False]  # the self-loop {} left to the student

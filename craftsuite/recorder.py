@@ -25,7 +25,10 @@ marked ``self_reported``: CraftSuite did not train them, and says so wherever it
 A step past the budget is refused: a library that collects in rollouts (SB3's PPO, say) stops
 at it through a callback that returns ``not env.done``. An evaluation called late is recorded
 at its scheduled step (its seeds are that step's), and ``finish`` warns of any, and of any
-skipped: a late one plays a policy that trained on more transitions than its step says.
+skipped: a late one plays a policy that trained on more transitions than its step says. An
+episode cut short by ``reset`` is recorded as one a time limit ends (not completed). A
+recording closed before ``finish`` stays, unfinished, where it wrote anything: the
+leaderboard leaves it out, and a second recording of that run is refused until it is deleted.
 """
 
 from __future__ import annotations
@@ -76,6 +79,16 @@ class RecordedConfig:
         return f"student-{self.task}-{self.world}-{self.method}-s{self.seed}-{config_key(self)}"
 
 
+def _count(value) -> int | None:
+    """``value`` as an integer where it is one (numpy's and torch's too; not a bool), else None."""
+    if isinstance(value, bool):
+        return None
+    try:
+        return operator.index(value)
+    except TypeError:
+        return None
+
+
 def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "standard", library: str = "",
                     settings: dict | None = None, commit: str | None = None,
                     steps: int | None = None) -> RecordedConfig:
@@ -96,8 +109,15 @@ def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "stand
     if method in METHODS:
         raise ValueError(f"method {method!r} is one of CraftSuite's own methods: name yours (e.g. my-{method}), "
                          "so that its runs never pool with the archive's")
-    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+    count = _count(seed)  # numpy's integers too, as a loop over np.arange gives them
+    if count is None or count < 0:
         raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+    seed = count
+    if not isinstance(library, str):
+        raise ValueError(f"library must be a string naming what trained the run, e.g. 'stable-baselines3 2.4 SAC', "
+                         f"got {library!r}")
+    if commit is not None and not isinstance(commit, str):
+        raise ValueError(f"commit must be the commit of your code as a string (or None), got {commit!r}")
     from .suites import SUITES
 
     suite_config, _ = protocol(env_id, suite)
@@ -229,13 +249,14 @@ class Recorder(gym.Wrapper):
 
     # -- the env ----------------------------------------------------------------------------------
     def reset(self, **kwargs):
+        if self._episode is not None and self._episode[1]:  # one cut short: recorded as a time limit ends one
+            self._end_episode(success=False)
         self._episode = [0.0, 0]
         self._reached.take([0])
         return self.env.reset(**kwargs)
 
     def step(self, action):
-        if self.run is None:
-            raise RuntimeError(f"{self.path}: the recording is finished (or closed): a Recorder records one run")
+        self._check_open()
         if self._episode is None:
             raise RuntimeError("step() before reset(): reset the env first, as gymnasium envs need")
         if self.done:  # a transition past the budget would train the policy the budget's evaluation plays
@@ -249,12 +270,18 @@ class Recorder(gym.Wrapper):
         self._reached.step(np.array([info["label_mask"]], dtype=np.int64),
                            np.array([info["automaton_state"]], dtype=np.int64))
         if terminated or truncated:
-            (seen,), (states,) = self._reached.take([0])
-            self._pending.append({"step": self.transitions, "return": round(self._episode[0], 4),
-                                  "length": self._episode[1], "success": int(bool(info.get("is_success"))),
-                                  "seen": seen, "states": states})
-            self._episode = None
+            self._end_episode(bool(info.get("is_success")))
         return obs, reward, terminated, truncated, info
+
+    def _end_episode(self, success: bool) -> None:
+        (seen,), (states,) = self._reached.take([0])
+        self._pending.append({"step": self.transitions, "return": round(self._episode[0], 4),
+                              "length": self._episode[1], "success": int(success), "seen": seen, "states": states})
+        self._episode = None
+
+    def _check_open(self) -> None:
+        if self.run is None:
+            raise RuntimeError(f"{self.path}: the recording is finished (or closed): a Recorder records one run")
 
     # -- the schedule ---------------------------------------------------------------------------
     @property
@@ -294,6 +321,7 @@ class Recorder(gym.Wrapper):
         ``craftsuite.Evaluation``."""
         from .evaluation import evaluate
 
+        self._check_open()
         if not self.evaluation_due:
             raise RuntimeError(f"no evaluation is due at {self.transitions:,} transitions (the next is at "
                                f"{self.next_evaluation:,}): call it when evaluation_due says so")
@@ -317,17 +345,14 @@ class Recorder(gym.Wrapper):
         Raises:
             ValueError: the budget not collected yet, or a bad count of gradient updates.
         """
-        if self.run is None:
-            raise RuntimeError(f"{self.path}: the recording is finished (or closed) already")
+        self._check_open()
         if not self.done:
             raise ValueError(f"{self.transitions:,} transitions of the budget's {self.budget:,}: a run is finished "
                              "at its budget (step the env until done)")
-        try:
-            updates = operator.index(updates)  # numpy's and torch's integers too
-        except TypeError:
-            updates = -1
-        if isinstance(updates, bool) or updates < 0:
+        count = _count(updates)
+        if count is None or count < 0:
             raise ValueError(f"updates must be the count of gradient updates made (an integer >= 0), got {updates!r}")
+        updates = count
         if self.budget not in self.evaluated:  # the last evaluation, at the budget
             self.evaluate(policy)
         skipped = sorted(set(self.scheduled) - set(self.evaluated))
@@ -351,7 +376,10 @@ class Recorder(gym.Wrapper):
     def close(self):
         if getattr(self, "run", None) is not None:
             self._flush()
-            self.run.__exit__(None, None, None)
+            # closed before finish(): a recording that wrote nothing but its config is removed, as
+            # a run that failed at once is, so that the same script can record it again
+            unfinished = not self.run.result_path.exists()
+            self.run.__exit__(RuntimeError if unfinished else None, None, None)
             self.run = None
             _RECORDING.discard(self.path.resolve())
         super().close()

@@ -125,9 +125,37 @@ def test_finishing_before_the_budget_is_refused_and_a_second_recording_too(tmp_p
     env.step(0)
     with pytest.raises(ValueError, match=r"1 transitions of the budget's 30,000: a run is finished at its budget"):
         env.finish(lambda obs: 0, updates=0)
+    env.reset()  # the episode cut short is recorded: the unfinished recording holds something
     env.close()
     with pytest.raises(RunError, match="holds a recording already \\(unfinished\\)"):
         craftsuite.Recorder(ENV, tmp_path, method="my-short")
+
+
+def test_a_recording_closed_before_it_wrote_anything_leaves_nothing_behind(tmp_path):
+    """A script that failed at its first step runs again as it is, once mended."""
+    env = craftsuite.Recorder(ENV, tmp_path / "runs", method="my-first")
+    env.reset(seed=0)
+    with pytest.raises(ValueError):
+        env.step(7)  # no such action
+    env.close()
+    assert list(tmp_path.iterdir()) == []  # nor the folders it made
+    craftsuite.Recorder(ENV, tmp_path / "runs", method="my-first").close()
+
+
+def test_an_episode_cut_short_by_reset_is_recorded_as_a_time_limit_ends_one(tmp_path):
+    env = craftsuite.Recorder(ENV, tmp_path, method="my-cut", steps=60)
+    while not env.done:
+        env.reset()
+        for _ in range(20):
+            _, _, terminated, truncated, _ = env.step(0)
+            if env.evaluation_due:
+                env.evaluate(lambda obs: 0)
+            if terminated or truncated or env.done:
+                break
+    path = env.finish(lambda obs: 0, updates=0)
+    rows = read_csv(path / "episodes.csv")
+    assert [(r["step"], r["length"], r["success"]) for r in rows] == [("20", "20", "0"), ("40", "20", "0")]
+    assert all(int(r["states"]) & 1 for r in rows)  # what each reached, as an ended episode's
 
 
 def test_a_step_past_the_budget_is_refused_and_the_run_still_finishes_at_it(tmp_path):
@@ -210,7 +238,7 @@ def test_a_budget_off_the_schedule_is_evaluated_at_the_budget_once(tmp_path):
     assert env.evaluated[-1] == 1_234 and not env.evaluation_due and len(set(env.evaluated)) == len(env.evaluated)
     path = env.finish(lambda obs: 0, updates=np.int64(5))  # numpy's integers are counts too
     assert json.loads((path / "result.json").read_text())["updates"] == 5
-    with pytest.raises(RuntimeError, match="finished \\(or closed\\) already"):
+    with pytest.raises(RuntimeError, match="the recording is finished \\(or closed\\)"):
         env.finish(lambda obs: 0, updates=5)
     with pytest.raises(RuntimeError, match="a Recorder records one run"):
         env.step(0)
@@ -234,6 +262,40 @@ def test_two_recorders_of_one_run_are_refused(tmp_path):
     with pytest.raises(RunError, match="being recorded by another Recorder in this process"):
         craftsuite.Recorder(ENV, tmp_path, method="my-vec")
     first.close()
+
+
+def test_after_close_the_recording_refuses_more_by_name_and_counts_may_be_numpys(tmp_path):
+    env = craftsuite.Recorder(ENV, tmp_path, method="my-late-eval", seed=np.int64(1), steps=50)
+    assert env.config.seed == 1 and type(env.config.seed) is int
+    env.reset(seed=0)
+    while not env.done:
+        env.step(0)
+    env.close()
+    for call in (lambda: env.evaluate(lambda obs: 0), lambda: env.step(0), lambda: env.finish(lambda obs: 0, 0)):
+        with pytest.raises(RuntimeError, match="the recording is finished \\(or closed\\): a Recorder records one"):
+            call()
+
+
+@pytest.mark.parametrize("fields, message", [
+    ({"library": None}, "library must be a string naming what trained the run"),
+    ({"commit": 123}, "commit must be the commit of your code as a string \\(or None\\), got 123"),
+    ({"seed": 1.0}, "seed must be a non-negative integer, got 1.0"),
+])
+def test_what_the_record_holds_is_checked_before_anything_is_written(tmp_path, fields, message):
+    with pytest.raises(ValueError, match=message):
+        craftsuite.Recorder(ENV, tmp_path, method="mine", **fields)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_updates_that_are_no_count_are_named_as_given(tmp_path):
+    env = craftsuite.Recorder(ENV, tmp_path, method="my-updates", steps=50)
+    env.reset(seed=0)
+    while not env.done:
+        env.step(0)
+    for bad in ("5", 2.0, None, True, -1):
+        with pytest.raises(ValueError, match=f"gradient updates made \\(an integer >= 0\\), got {bad!r}$"):
+            env.finish(lambda obs: 0, updates=bad)
+    env.close()
 
 
 def test_several_directories_need_an_output_of_their_own(tmp_path, capsys):

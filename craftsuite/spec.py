@@ -380,8 +380,9 @@ class _Reader:
 
     def float(self, data: dict, key: str, where: str, default: float) -> float:
         value = data.get(key, default)
-        if not isinstance(value, (int, float)) or isinstance(value, bool) or value != value:
-            self.fail(f"{where}.{key}", f"must be a number, got {value!r}")
+        # finite: TOML reads inf, which a return, a size or a period cannot be (a spec's data is JSON, too)
+        if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
+            self.fail(f"{where}.{key}", f"must be a finite number, got {value!r}")
         return float(value)
 
     def str(self, data: dict, key: str, where: str, default=None) -> str:

@@ -95,8 +95,11 @@ BAD = [
     (('name = "Treasure"', 'name = "Treasure"\ntags = ["easy", "easy"]'), "tags", "lists a tag twice"),
     (("[grid]", "[continuous]\ncontrol_period = 0\n[grid]"), "continuous.control_period", "must be > 0 seconds"),
     (("[grid]", "[continuous]\ncontrol_period = -0.25\n[grid]"), "continuous.control_period", "must be > 0"),
+    (("[grid]", "[continuous]\ncontrol_period = inf\n[grid]"), "continuous.control_period",
+     "must be a finite number, got inf"),  # TOML reads inf: one step would never end
+    (("[grid]", "[continuous]\narena = inf\n[grid]"), "continuous.arena", "must be a finite number, got inf"),
     (("[places.trap]", "[places.trap]\nkinematic = { reward = \"lots\" }"), "places.trap.kinematic.reward",
-     "must be a number"),
+     "must be a finite number, got 'lots'"),
     (("[places.trap]", "[places.trap]\nkinematic = { label = \"near\" }"), "places.trap.kinematic.label",
      "must be 'acts' or 'cell'"),
     (("count = 2", "count = 2\nkinematic = { label = \"cell\" }"), "items.coin.kinematic.label",

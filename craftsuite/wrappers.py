@@ -20,6 +20,12 @@ class AutomatonObservation(gym.ObservationWrapper, gym.utils.RecordConstructorAr
         base = env.unwrapped
         if not hasattr(base, "automaton") or not hasattr(base, "automaton_state"):
             raise TypeError(f"{base!r} tracks no automaton: AutomatonObservation needs a CraftSuite world")
+        inner = env
+        while isinstance(inner, gym.Wrapper):  # a second one-hot would lengthen the observation unnoticed
+            if isinstance(inner, AutomatonObservation):
+                raise ValueError("the env observes the automaton state already (made with product=True, or wrapped "
+                                 "in AutomatonObservation): wrap it once")
+            inner = inner.env
         space = env.observation_space
         if not isinstance(space, gym.spaces.Box) or len(space.shape) != 1:
             raise TypeError(f"AutomatonObservation needs a flat Box observation, got {space}")

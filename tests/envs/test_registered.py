@@ -141,6 +141,17 @@ def test_make_vec(env_id, mode):
         envs.close()
 
 
+def test_the_automaton_state_is_added_once():
+    from craftsuite import AutomatonObservation
+
+    env = gym.make("CraftSuite/Reach-Grid7-v0", product=True)
+    for wrapped in (env, gym.wrappers.ClipReward(env, -1, 1)):  # under another wrapper, too
+        with pytest.raises(ValueError, match=r"^the env observes the automaton state already \(made with "
+                                             r"product=True, or wrapped in AutomatonObservation\): wrap it once$"):
+            AutomatonObservation(wrapped)
+    assert AutomatonObservation(gym.make("CraftSuite/Reach-Grid7-v0")).observation_space == env.observation_space
+
+
 @pytest.mark.parametrize("env_id", IDS)
 def test_product_observation_tail_is_automaton_one_hot(env_id):
     env = gym.make(env_id, product=True)

@@ -33,6 +33,9 @@ def cache_dir() -> Path:
 
 
 def _check(formula: str, propositions) -> tuple[tuple[str, ...], tuple]:
+    if isinstance(propositions, str):  # tuple("wood") is its letters
+        raise ValueError(f"propositions must be a sequence of names, got the string {propositions!r}: give "
+                         f"[{propositions!r}], or a list of several")
     props = tuple(propositions)
     if len(set(props)) != len(props):
         dup = sorted({p for p in props if props.count(p) > 1})
@@ -88,9 +91,8 @@ def _load(path: Path, formula: str, props: tuple[str, ...]) -> Automaton | None:
             if str(f["formula"]) != formula or tuple(f["propositions"].tolist()) != props:
                 return None  # a hash collision: recompile rather than trust it
             delta, accepting = f["delta"], f["accepting"]
-        if delta.shape != (len(accepting), 1 << len(props)):
-            raise ValueError(f"table of shape {delta.shape}")
-        return Automaton(formula=formula, propositions=props, delta=delta, accepting=accepting)
+        return Automaton(  # (which refuses a damaged table: a ValueError, so recompiled)
+            formula=formula, propositions=props, delta=delta, accepting=accepting)
     except FileNotFoundError:
         return None
     except (OSError, ValueError, KeyError, zipfile.BadZipFile) as err:

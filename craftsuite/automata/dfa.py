@@ -33,10 +33,30 @@ class Automaton:
     _rows: list = field(init=False, repr=False, compare=False, default=None)
 
     def __post_init__(self):
+        self._check()
         self.delta.setflags(write=False)
         self.accepting.setflags(write=False)
         # Python lists index ~5x faster than numpy scalars in a per-step hot path.
         object.__setattr__(self, "_rows", self.delta.tolist())
+
+    def _check(self) -> None:
+        """Refuse a table that is no DFA over these propositions: ``step`` indexes it as it is
+        (a negative or float entry would be read as another state, or fail far from here)."""
+        delta, accepting, columns = self.delta, self.accepting, 2 ** len(self.propositions)
+        if not (isinstance(delta, np.ndarray) and np.issubdtype(delta.dtype, np.integer) and delta.ndim == 2
+                and delta.shape[0] >= 1 and delta.shape[1] == columns):
+            raise ValueError(f"delta must be an integer array of shape (n_states, {columns}) for "
+                             f"{len(self.propositions)} propositions, got {getattr(delta, 'dtype', type(delta))} of "
+                             f"shape {getattr(delta, 'shape', '?')}")
+        n = delta.shape[0]
+        if delta.min() < 0 or delta.max() >= n:
+            raise ValueError(f"delta's entries must be states 0-{n - 1}, got {delta.min()}-{delta.max()}")
+        if not (isinstance(accepting, np.ndarray) and accepting.dtype == bool and accepting.shape == (n,)):
+            raise ValueError(f"accepting must be a bool array of shape ({n},), one per state, got "
+                             f"{getattr(accepting, 'dtype', type(accepting))} of shape "
+                             f"{getattr(accepting, 'shape', '?')}")
+        if type(self.initial) is not int or not 0 <= self.initial < n:
+            raise ValueError(f"initial must be a state 0-{n - 1}, got {self.initial!r}")
 
     # -- structure ---------------------------------------------------------------------------
     @property
@@ -90,6 +110,9 @@ class Automaton:
     # -- running ---------------------------------------------------------------------------
     def mask(self, labels) -> int:
         """Bitmask of a set of proposition names."""
+        if isinstance(labels, str):  # its letters would be read as names
+            raise ValueError(f"labels must be a collection of proposition names, got the string {labels!r}: give "
+                             f"{{{labels!r}}}")
         bits = 0
         for name in labels:
             try:
@@ -99,6 +122,8 @@ class Automaton:
         return bits
 
     def labels(self, mask: int) -> frozenset[str]:
+        if not 0 <= mask < 2 ** len(self.propositions):  # (Python would read a negative one's bits)
+            raise ValueError(f"mask must be a label bitmask 0-{2 ** len(self.propositions) - 1}, got {mask!r}")
         return frozenset(p for i, p in enumerate(self.propositions) if mask >> i & 1)
 
     def step(self, state: int, mask: int) -> int:

@@ -53,6 +53,15 @@ def test_corrupt_cache_is_recompiled_and_rewritten(cache, caplog):
         assert f["delta"].shape == good.delta.shape
 
 
+def test_a_cached_table_that_is_no_dfa_is_recompiled(cache, caplog):
+    good = compile_ltlf(FORMULA, PROPS)
+    (path,) = cache.glob("*.npz")
+    np.savez(path, formula=good.formula, propositions=np.array(good.propositions), delta=good.delta[:, :1],
+             accepting=good.accepting)
+    assert np.array_equal(compile_ltlf(FORMULA, PROPS).delta, good.delta)
+    assert "unreadable automaton cache" in caplog.text and "delta must be an integer array of shape" in caplog.text
+
+
 def test_unwritable_cache_still_compiles(tmp_path, monkeypatch):
     blocker = tmp_path / "file"
     blocker.write_text("a file where the cache directory should be")

@@ -178,6 +178,36 @@ def test_bad_proposition_lists():
         compile_ltlf("F a", ("a",) + tuple(f"p{i}" for i in range(16)), cache=False)
     with pytest.raises(ValueError, match="lower-case identifier"):
         compile_ltlf("F a", ("a", "Tools>=3"), cache=False)
+    for text in ("wood", "ab"):  # tuple() of a string is its letters: 'ab' was read as a and b
+        with pytest.raises(ValueError, match=rf"^propositions must be a sequence of names, got the string '{text}'"):
+            compile_ltlf("F wood", text, cache=False)
+
+
+def test_a_table_that_is_no_dfa_and_labels_out_of_range_are_refused():
+    import dataclasses
+
+    from craftsuite.automata import Automaton
+
+    good = compile_ltlf("F a & F b", ("a", "b"), cache=False)
+    delta, accepting = np.array(good.delta), np.array(good.accepting)
+    for field, value, message in [
+        ("delta", delta[:, :2], r"delta must be an integer array of shape \(n_states, 4\) for 2 propositions"),
+        ("delta", delta.astype(float), "delta must be an integer array"),
+        ("delta", np.where(delta == 0, -1, delta), r"delta's entries must be states 0-3, got -1-3"),
+        ("delta", np.where(delta == 0, 9, delta), r"delta's entries must be states 0-3, got 1-9"),
+        ("accepting", accepting[:2], r"accepting must be a bool array of shape \(4,\)"),
+        ("initial", 4, "initial must be a state 0-3, got 4"),
+    ]:
+        with pytest.raises(ValueError, match=message):
+            Automaton(**{"formula": good.formula, "propositions": good.propositions, "delta": delta,
+                         "accepting": accepting, field: value})
+    assert Automaton(good.formula, good.propositions, delta, accepting).fingerprint == good.fingerprint
+    with pytest.raises(ValueError, match=r"^labels must be a collection of proposition names, got the string 'a'"):
+        good.mask("a")
+    for mask in (-1, 4):
+        with pytest.raises(ValueError, match=rf"^mask must be a label bitmask 0-3, got {mask}$"):
+            good.labels(mask)
+    assert good.labels(3) == {"a", "b"} and dataclasses.is_dataclass(good)
 
 
 def test_parse_roundtrip():

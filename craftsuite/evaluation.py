@@ -108,15 +108,24 @@ def play(policy_for, env_id: str, env_kwargs: dict, product: bool, episodes: int
 
 def sees_automaton(policy, env_id: str, kwargs: dict) -> bool:
     """Whether a policy that declares its observation space (an SB3 model) was trained
-    with the automaton state in its observations."""
+    with the automaton state in its observations.
+
+    Raises:
+        ValueError: a space of neither shape (a policy of another world, say), naming both.
+    """
     space = getattr(policy, "observation_space", None)
     if space is None:
         return False
     plain = gym.make(env_id, product=False, **kwargs)
     try:
-        return tuple(space.shape) != tuple(plain.observation_space.shape)
+        shape, theirs = tuple(plain.observation_space.shape), tuple(space.shape)
+        product = (shape[0] + plain.unwrapped.automaton.n_states,) if len(shape) == 1 else None
     finally:
         plain.close()
+    if theirs in (shape, product):
+        return theirs == product
+    raise ValueError(f"the policy observes shape {theirs}, which {env_id}'s observations are not ({shape}, or "
+                     f"{product} with the automaton state): was it trained in another world?")
 
 
 def _batched(policy, space):
@@ -135,18 +144,26 @@ def _batched(policy, space):
 
     def checked(batch):
         actions = act(batch)
+        if np.ndim(actions) == 0 or len(actions) != len(batch):
+            raise ValueError(f"the policy returned {actions!r} for a batch of {len(batch)} observations: a batch "
+                             "policy (predict, a torch module) returns one action per observation")
         out = []
         for action in actions:
             if hasattr(action, "detach"):  # a torch tensor, maybe still in its graph
                 action = action.detach().cpu().numpy()
             raw = np.asarray(action)
-            a = raw.astype(space.dtype)
-            if isinstance(space, gym.spaces.Discrete):
+            try:
+                a = raw.astype(space.dtype)
+            except (TypeError, ValueError):
+                a = None  # not a number at all: refused below, as one outside the space is
+            if a is None:
+                a = raw
+            elif isinstance(space, gym.spaces.Discrete):
                 a = a.reshape(()) if a.size == 1 else a
                 if raw.size != 1 or raw.reshape(()) != a:  # 2.7 is no move: never cast silently
                     a = raw
-            if not space.contains(a):
-                raise ValueError(f"the policy returned {np.asarray(action).tolist()!r}, outside the action space "
+            if raw.dtype == object or not space.contains(a):
+                raise ValueError(f"the policy returned {raw.tolist()!r}, outside the action space "
                                  f"{space}: return actions in it (clip a continuous output to its bounds)")
             out.append(a)
         return out
@@ -172,7 +189,12 @@ def _module_policy(module, space):
         module.eval()  # evaluated as a policy is: no dropout, no batch statistics updated
         try:
             with torch.no_grad():
-                out = module(torch.as_tensor(np.asarray(batch), dtype=torch.float32, device=device))
+                try:
+                    out = module(torch.as_tensor(np.asarray(batch), dtype=torch.float32, device=device))
+                except RuntimeError as err:  # torch names its tensors' shapes, not the env's observation
+                    raise ValueError(f"the torch module cannot take this env's observations, of shape "
+                                     f"{np.shape(batch)[1:]} ({str(err).splitlines()[0]}): give one built for "
+                                     "them") from None
         finally:
             module.train(training)
         if not isinstance(out, torch.Tensor):

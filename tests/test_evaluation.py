@@ -3,6 +3,7 @@ trained run's model evaluated by it gives the run's own last evaluation, episode
 episode; plain callables and torch modules are taken; bad input is refused in one line."""
 
 import dataclasses
+from types import SimpleNamespace
 
 import gymnasium as gym
 import numpy as np
@@ -62,6 +63,16 @@ def test_a_torch_module_acts_by_its_best_output():
     (lambda obs: 2.7, "CraftSuite/Reach-Grid10-v0", r"the policy returned 2.7, outside the action space"),
     (th.nn.Sequential(), "CraftSuite/Reach-Grid10-v0", "outside the action space"),  # the observation itself
     ("not a policy", "CraftSuite/Reach-Grid10-v0", "policy must be an SB3 model, a torch module or a callable"),
+    (lambda obs: None, "CraftSuite/Reach-Grid10-v0", r"the policy returned None, outside the action space"),
+    (lambda obs: "up", "CraftSuite/Reach-Grid10-v0", r"the policy returned 'up', outside the action space"),
+    (lambda obs: {"move": 1}, "CraftSuite/Reach-Grid10-v0", r"the policy returned \{'move': 1\}, outside the"),
+    (SimpleNamespace(predict=lambda batch, deterministic: (0, None)), "CraftSuite/Reach-Grid10-v0",
+     r"the policy returned 0 for a batch of 1 observations: a batch policy \(predict, a torch module\) returns one"),
+    (th.nn.Linear(3, 4), "CraftSuite/Reach-Grid10-v0",
+     r"^the torch module cannot take this env's observations, of shape \(\d+,\) \(mat1 and mat2 shapes"),
+    (SimpleNamespace(observation_space=gym.spaces.Box(0, 1, (5,)), predict=None), "CraftSuite/Reach-Grid10-v0",
+     r"^the policy observes shape \(5,\), which CraftSuite/Reach-Grid10-v0's observations are not \(\(\d+,\), or "
+     r"\(\d+,\) with the automaton state\): was it trained in another world\?$"),
 ])
 def test_bad_input_is_one_line_naming_the_problem(policy, env, message):
     with pytest.raises(ValueError, match=message):

@@ -103,7 +103,9 @@ EMPTY_PATH = "is empty: give a path"
 
 def _refuse_empty(given, flag: str) -> None:
     """An empty path is the working directory to Python, which no one passing ``""`` (or an
-    unset variable) meant."""
+    unset variable) meant; nor is anything but a path one (pathlib's TypeError names no flag)."""
+    if not isinstance(given, (str, os.PathLike)):
+        raise TypeError(f"{flag} must be a path, got {given!r}")
     if not str(given).strip():
         raise ValueError(f"{flag} {EMPTY_PATH}")
 

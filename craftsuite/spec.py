@@ -58,6 +58,7 @@ Format (see ``tasks/blind_craftsman.toml`` for a full example)::
 from __future__ import annotations
 
 import math
+import os
 import re
 import tomllib
 from dataclasses import dataclass, field, fields, is_dataclass
@@ -447,9 +448,17 @@ def load_spec(source: str | Path | dict, *, name_hint: str = "<dict>") -> TaskSp
     """
     if isinstance(source, dict):
         path, data = name_hint, dict(source)
-    else:
+        if "extends" in data:  # a file's base is found beside it; data has no folder
+            raise SpecError(f"{name_hint}: extends: a spec given as data has no folder to find "
+                            f"{data['extends']!r} in: load it from its file, beside its base")
+    elif isinstance(source, str) and "\n" in source:  # (pathlib would say the file name is too long)
+        raise SpecError("a task spec is given as its file's path or its data, got TOML text: give "
+                        "tomllib.loads(text), or write it to a .toml file")
+    elif isinstance(source, (str, os.PathLike)):
         path = Path(source)
         data = _raw(path)
+    else:
+        raise SpecError(f"a task spec is given as its file's path or its data (a dict), got {type(source).__name__}")
     return _build(_Reader(path), data, path if isinstance(path, Path) else None)
 
 

@@ -287,6 +287,13 @@ def test_what_the_record_holds_is_checked_before_anything_is_written(tmp_path, f
     assert list(tmp_path.iterdir()) == []
 
 
+def test_an_out_that_is_no_path_is_named(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(TypeError, match=r"^out must be a path, got None$"):  # pathlib's own named no argument
+        craftsuite.Recorder(ENV, None, method="mine")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_updates_that_are_no_count_are_named_as_given(tmp_path):
     env = craftsuite.Recorder(ENV, tmp_path, method="my-updates", steps=50)
     env.reset(seed=0)

@@ -182,6 +182,18 @@ def test_a_directory_or_an_empty_file_is_named_as_such(tmp_path):
         load_spec(write(tmp_path, "\n", "empty.toml"))
 
 
+def test_what_is_no_spec_file_nor_spec_data_is_named():
+    with pytest.raises(SpecError, match=r"^a task spec is given as its file's path or its data \(a dict\), got "
+                                        r"NoneType$"):
+        craftsuite.register_task(None)
+    with pytest.raises(SpecError, match=r"^a task spec is given as its file's path or its data, got TOML text: give "
+                                        r"tomllib.loads\(text\)"):
+        load_spec(textwrap.dedent(GOOD))  # pathlib said the file name was too long
+    data = {"extends": "first_wood", "name": "Woods"}  # was ignored: the spec then lacked every object
+    with pytest.raises(SpecError, match=r"^<dict>: extends: a spec given as data has no folder to find 'first_wood'"):
+        load_spec(data)
+
+
 def test_an_objective_that_can_never_be_satisfied_is_refused_when_added(tmp_path):
     from craftsuite import task_registry
 

@@ -102,7 +102,8 @@ def resolve_task(task: str | TaskSpec | Mapping) -> TaskSpec:
     known = tasks()
     if task not in known:
         raise unknown_name("task", task, sorted(known),
-                           f"(or a spec file, path/to/task{SPEC_SUFFIX}; add one with craftsuite.register_task)")
+                           f"(a task of your own: a command takes its spec file, path/to/task{SPEC_SUFFIX}; in Python, "
+                           f"craftsuite.register_task('path/to/task{SPEC_SUFFIX}') adds it)")
     return known[task]
 
 

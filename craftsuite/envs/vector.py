@@ -153,12 +153,14 @@ class CraftVectorEnv(VectorEnv):
         n = self.num_envs
         if seed is None:
             seeds = [None] * n
-        elif isinstance(seed, int):
-            seeds = [seed + i for i in range(n)]
-        else:
+        elif isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+            seeds = [int(seed) + i for i in range(n)]
+        elif isinstance(seed, (list, tuple, np.ndarray)):
             seeds = list(seed)
             if len(seeds) != n:
                 raise ValueError(f"reset(seed=...) got {len(seeds)} seeds for num_envs={n}")
+        else:
+            raise ValueError(f"reset(seed=...) takes None, an integer or one seed per env, got {seed!r}")
         rows = np.ones(n, dtype=bool)
         if options and "reset_mask" in options:
             rows = np.asarray(options["reset_mask"])

@@ -194,7 +194,15 @@ def test_keywords_and_actions_are_checked():
     grid = gym.make_vec(grid_id, num_envs=2, **mode)
     with pytest.raises(RuntimeError, match="reset"):
         grid.step(np.array([0, 1]))
-    grid.reset(seed=0)
+    for seed in (1.5, "7"):  # a float was read as a list of seeds ("'float' object is not iterable")
+        with pytest.raises(ValueError, match=rf"^reset\(seed=...\) takes None, an integer or one seed per env, "
+                                             rf"got {seed!r}$"):
+            grid.reset(seed=seed)
+    with pytest.raises(ValueError, match=r"got 3 seeds for num_envs=2"):
+        grid.reset(seed=[0, 1, 2])
+    first, _ = grid.reset(seed=np.int64(0))  # numpy's integers as Python's
+    again, _ = grid.reset(seed=0)
+    assert np.array_equal(first, again)
     with pytest.raises(ValueError, match=r"integer array of shape \(2,\)"):
         grid.step(np.array([0, 4]))
     board = gym.make_vec(kinematic_id, num_envs=2, **mode)

@@ -165,6 +165,13 @@ def test_syntax_errors_name_the_problem(bad, message):
         compile_ltlf(bad, ("wood", "factory", "home"), cache=False)
 
 
+def test_a_formula_nested_past_pythons_stack_is_a_syntax_error():
+    deep = "(" * 2000 + "a" + ")" * 2000
+    with pytest.raises(LTLfSyntaxError, match=r"^the formula nests too deeply to parse \(2000 parentheses\)"):
+        parse(deep)
+    assert parse("(" * 20 + "a" + ")" * 20) == ("ap", "a")
+
+
 def test_unknown_proposition_is_named():
     with pytest.raises(ValueError,
                        match=r"^unknown proposition 'gold'; propositions: wood \(declared for formula 'F\(gold\)'\)$"):

@@ -613,11 +613,12 @@ _path.__name__ = "path"
 
 
 def _source(text: str) -> str:
-    """distill's SOURCE: never empty, and where it is, the message names both of its kinds."""
-    if not text.strip():
+    """distill's SOURCE: a path flag's text (never empty) whose message names both of its kinds."""
+    try:
+        return _path(text)
+    except argparse.ArgumentTypeError:
         raise argparse.ArgumentTypeError("is empty: give a teacher run directory or its .zip, or with --static a "
-                                         "task name")
-    return text
+                                         "task name") from None
 
 
 def _positive(text: str) -> int:

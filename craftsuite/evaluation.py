@@ -192,6 +192,8 @@ def _module_policy(module, space):
                 try:
                     out = module(torch.as_tensor(np.asarray(batch), dtype=torch.float32, device=device))
                 except RuntimeError as err:  # torch names its tensors' shapes, not the env's observation
+                    if isinstance(err, torch.OutOfMemoryError) or not ("shape" in str(err) or "size" in str(err)):
+                        raise  # not a mismatch with the observations: the module's own fault, as torch says it
                     raise ValueError(f"the torch module cannot take this env's observations, of shape "
                                      f"{np.shape(batch)[1:]} ({str(err).splitlines()[0]}): give one built for "
                                      "them") from None

@@ -78,7 +78,10 @@ EPISODES = (
           "automaton's i-th proposition); empty in rows written before the column"),
     Field("states", "integer >= 0 or empty", False, "the automaton states it visited, as bits (bit q: state q)"),
 )
-NOTES = {"evals.csv": "One row at least: every run evaluates at its end."}  # rules of a file beyond its columns
+# rules of a file beyond its columns
+_LINES = ("Every line ends with a line end: a last line without one is read as torn by a kill, and left out "
+          "(a value cut short can keep every comma).")
+NOTES = {"evals.csv": f"One row at least: every run evaluates at its end. {_LINES}", "episodes.csv": _LINES}
 FILES = {"config.json": CONFIG, "result.json": RESULT, "evals.csv": EVALS, "episodes.csv": EPISODES}
 
 

@@ -220,6 +220,7 @@ class Recorder(gym.Wrapper):
         Raises:
             ValueError: bad settings (see ``recorded_config``), each named with its fix, or an
                 empty ``out``.
+            TypeError: ``out`` is no path.
             OSError: ``out`` cannot be a directory to write in (a file, no permission), named.
             RunError: the run being recorded in this process already, or recorded before.
         """

@@ -113,3 +113,13 @@ def test_a_suite_with_a_fault_of_its_own_is_refused_with_that_fault(monkeypatch)
                                          r"n-step-wide") as refused:
         craftsuite.evaluate(lambda obs: 0, "CraftSuite/Reach-Grid10-v0", suite="broken", episodes=1)
     assert "not a rung" not in str(refused.value)
+
+
+def test_a_modules_own_error_is_left_as_torch_raised_it():
+    """Only a mismatch with the env's observations is worded as one."""
+    class Broken(th.nn.Module):
+        def forward(self, x):
+            raise RuntimeError("my own fault")
+
+    with pytest.raises(RuntimeError, match="^my own fault$"):
+        craftsuite.evaluate(Broken(), "CraftSuite/Reach-Grid10-v0", episodes=1)

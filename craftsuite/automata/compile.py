@@ -70,6 +70,14 @@ def compile_ltlf(formula: str, propositions, *, cache: bool = True) -> Automaton
         LTLfSyntaxError: the formula does not parse.
         ValueError: unknown, duplicate, malformed or too many propositions.
     """
+    try:
+        return _compile(formula, propositions, cache)
+    except RecursionError:  # the parser and the tree's readers recurse: Python's stack ends first
+        raise LTLfSyntaxError("the formula nests too deeply (operators within operators) for Python's stack: "
+                              "write it with fewer levels") from None
+
+
+def _compile(formula: str, propositions, cache: bool) -> Automaton:
     props, ast = _check(formula, propositions)
     path = None
     if cache:

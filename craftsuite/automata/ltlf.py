@@ -154,11 +154,7 @@ def parse(text: str):
     """Parse an LTLf formula into a tuple AST. Raises LTLfSyntaxError on bad input."""
     if not isinstance(text, str):
         raise LTLfSyntaxError(f"an LTLf formula must be a string, got {type(text).__name__}")
-    try:
-        return _Parser(text).parse()
-    except RecursionError:  # a descent of several calls per parenthesis: Python's stack ends first
-        raise LTLfSyntaxError(f"the formula nests too deeply to parse ({text.count('(')} parentheses): write it "
-                              "with fewer levels") from None
+    return _Parser(text).parse()
 
 
 def atoms(node) -> set[str]:

@@ -38,6 +38,7 @@ Contract (what a training engine may rely on):
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import gymnasium as gym
@@ -153,12 +154,15 @@ class CraftVectorEnv(VectorEnv):
         n = self.num_envs
         if seed is None:
             seeds = [None] * n
-        elif isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
-            seeds = [int(seed) + i for i in range(n)]
-        elif isinstance(seed, (list, tuple, np.ndarray)):
-            seeds = list(seed)
+        elif _seed(seed) is not None:
+            seeds = [_seed(seed) + i for i in range(n)]
+        elif isinstance(seed, Sequence | np.ndarray) and not isinstance(seed, str | bytes):
+            seeds = [None if s is None else _seed(s) for s in seed]
             if len(seeds) != n:
                 raise ValueError(f"reset(seed=...) got {len(seeds)} seeds for num_envs={n}")
+            bad = next((i for i, s in enumerate(seeds) if s is None and seed[i] is not None), None)
+            if bad is not None:
+                raise ValueError(f"reset(seed=...)'s seed {bad} is {seed[bad]!r}: each is None or an integer >= 0")
         else:
             raise ValueError(f"reset(seed=...) takes None, an integer or one seed per env, got {seed!r}")
         rows = np.ones(n, dtype=bool)
@@ -279,6 +283,14 @@ class CraftVectorEnv(VectorEnv):
         raise NotImplementedError(
             f"{type(self).__name__} does not render; make the single env to render "
             "(gymnasium.make(id, render_mode='rgb_array'))")
+
+
+def _seed(value) -> int | None:
+    """``value`` as a reset seed (an integer >= 0, numpy's too: gymnasium's seeding takes
+    Python's alone), else None."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 0:
+        return None
+    return int(value)
 
 
 def check_num_envs(num_envs) -> None:

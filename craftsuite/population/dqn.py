@@ -95,7 +95,8 @@ class PopulationDQN:
         Q-values, finite exactly when all its Q-values are (an argmax of NaN is still an action)."""
         with th.no_grad(), self.evaluating():
             q = self.q_values(self.q_net, th.as_tensor(observations, device=self.device))
-            return q.argmax(dim=-1).cpu().numpy(), q.sum(dim=-1).cpu().numpy()
+            both = th.stack((q.argmax(dim=-1).to(q.dtype), q.sum(dim=-1))).cpu().numpy()  # one copy off the device
+            return both[0].astype(np.int64), both[1]
 
     def evaluating(self):
         """A context in which the online network's batch norms (a CNN's) read their running

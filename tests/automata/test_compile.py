@@ -165,10 +165,10 @@ def test_syntax_errors_name_the_problem(bad, message):
         compile_ltlf(bad, ("wood", "factory", "home"), cache=False)
 
 
-def test_a_formula_nested_past_pythons_stack_is_a_syntax_error():
-    deep = "(" * 2000 + "a" + ")" * 2000
-    with pytest.raises(LTLfSyntaxError, match=r"^the formula nests too deeply to parse \(2000 parentheses\)"):
-        parse(deep)
+@pytest.mark.parametrize("deep", ["(" * 2000 + "a" + ")" * 2000, "!" * 3000 + "a", " & ".join(["a"] * 3000)])
+def test_a_formula_nested_past_pythons_stack_is_a_syntax_error(deep):
+    with pytest.raises(LTLfSyntaxError, match=r"^the formula nests too deeply \(operators within operators\)"):
+        compile_ltlf(deep, ("a",), cache=False)
     assert parse("(" * 20 + "a" + ")" * 20) == ("ap", "a")
 
 

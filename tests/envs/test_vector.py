@@ -200,9 +200,13 @@ def test_keywords_and_actions_are_checked():
             grid.reset(seed=seed)
     with pytest.raises(ValueError, match=r"got 3 seeds for num_envs=2"):
         grid.reset(seed=[0, 1, 2])
-    first, _ = grid.reset(seed=np.int64(0))  # numpy's integers as Python's
-    again, _ = grid.reset(seed=0)
-    assert np.array_equal(first, again)
+    for seeds, index, bad in (([0, True], 1, "True"), ([0, 1.5], 1, "1.5"), ([-1, None], 0, "-1")):
+        with pytest.raises(ValueError, match=rf"^reset\(seed=...\)'s seed {index} is {bad}: each is None or an "):
+            grid.reset(seed=seeds)
+    first, _ = grid.reset(seed=0)
+    for same in (np.int64(0), range(2), np.arange(2), [np.int64(0), 1]):  # numpy's integers as Python's
+        again, _ = grid.reset(seed=same)
+        assert np.array_equal(first, again), same
     with pytest.raises(ValueError, match=r"integer array of shape \(2,\)"):
         grid.step(np.array([0, 4]))
     board = gym.make_vec(kinematic_id, num_envs=2, **mode)

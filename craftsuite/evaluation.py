@@ -154,15 +154,14 @@ def _batched(policy, space):
             raw = np.asarray(action)
             try:
                 a = raw.astype(space.dtype)
-            except (TypeError, ValueError):
-                a = None  # not a number at all: refused below, as one outside the space is
-            if a is None:
+            except (TypeError, ValueError):  # not a number at all (None, 'up'): the space refuses it below
                 a = raw
-            elif isinstance(space, gym.spaces.Discrete):
-                a = a.reshape(()) if a.size == 1 else a
-                if raw.size != 1 or raw.reshape(()) != a:  # 2.7 is no move: never cast silently
-                    a = raw
-            if raw.dtype == object or not space.contains(a):
+            else:
+                if isinstance(space, gym.spaces.Discrete):
+                    a = a.reshape(()) if a.size == 1 else a
+                    if raw.size != 1 or raw.reshape(()) != a:  # 2.7 is no move: never cast silently
+                        a = raw
+            if not space.contains(a):
                 raise ValueError(f"the policy returned {raw.tolist()!r}, outside the action space "
                                  f"{space}: return actions in it (clip a continuous output to its bounds)")
             out.append(a)

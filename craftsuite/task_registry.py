@@ -66,8 +66,7 @@ def add_task(source: str | Path | TaskSpec | Mapping) -> TaskSpec:
             its runs would pool with the built-in's).
     """
     spec = source if isinstance(source, TaskSpec) else _load(source)
-    tasks()
-    if spec.name in _BUILTIN:
+    if spec.name in builtin_names():
         if spec.digest() != _BUILTIN[spec.name].digest():
             raise SpecError(f"{spec.path or f'<task spec {spec.name!r} given as data>'}: name: {spec.name!r} is a "
                             f"built-in task's, whose runs this task's would pool with: name yours otherwise, e.g. "

@@ -6,7 +6,8 @@ steps it as it would the env, and calls ``evaluate(policy)`` when ``evaluation_d
 the suite's schedule has come (every 20th of the budget, ``craftsuite.evaluate``'s
 protocol), and ``finish(policy, updates=...)`` at the budget. It writes what the suites'
 runs write, in their record format (``craftsuite.runs``): ``config.json`` (the method's
-name, the library, the budget, the settings as given, provenance and the user's commit),
+name, the library, the budget, the settings as given, whether the agent observed the
+automaton state, the task's rules digest, provenance and the user's commit),
 ``episodes.csv`` (every training episode, with how far along the task it got),
 ``evals.csv`` and, last, ``result.json`` (transitions and gradient updates). Its records are
 marked ``self_reported``: CraftSuite did not train them, and says so wherever it shows them.
@@ -65,6 +66,8 @@ class RecordedConfig:
     commit: str | None = None  # the user's code's commit, where given
     layout_seed: int | None = None
     world_kwargs: dict = field(default_factory=dict)
+    product: bool = False  # whether the agent observed the automaton state
+    rules: str | None = None  # the digest of the task's rules (a task edited since records under another key)
     self_reported: bool = True
 
     @property
@@ -91,10 +94,12 @@ def _count(value) -> int | None:
 
 def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "standard", library: str = "",
                     settings: dict | None = None, commit: str | None = None,
-                    steps: int | None = None) -> RecordedConfig:
+                    steps: int | None = None, product: bool = False) -> RecordedConfig:
     """The record of a run of ``method`` on ``env_id`` under ``suite``'s protocol
     (``steps``: another budget than the suite's for the rung, evaluated on the suite's
-    schedule for it; the leaderboard never compares it with runs of another budget).
+    schedule for it; the leaderboard never compares it with runs of another budget;
+    ``product``: whether the agent observes the automaton state). Its task's rules digest
+    is recorded: runs of a task edited between them are never pooled.
 
     Raises:
         ValueError: a method named as one of CraftSuite's (its runs would pool with the
@@ -118,7 +123,10 @@ def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "stand
                          f"got {library!r}")
     if commit is not None and not isinstance(commit, str):
         raise ValueError(f"commit must be the commit of your code as a string (or None), got {commit!r}")
+    if not isinstance(product, (bool, np.bool_)):
+        raise ValueError(f"product must be True (the observation carries the automaton state) or False, got {product!r}")
     from .suites import SUITES
+    from .task_registry import resolve_task
 
     suite_config, _ = protocol(env_id, suite)
     if suite_config.world not in SUITES[suite].worlds:  # its runs would sit beside none of the suite's
@@ -139,7 +147,8 @@ def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "stand
                           steps=steps, eval_every=eval_every,
                           eval_episodes=suite_config.eval_episodes, suite=suite, library=library,
                           settings=recorded_settings(settings), commit=commit, layout_seed=suite_config.layout_seed,
-                          world_kwargs=dict(suite_config.world_kwargs))
+                          world_kwargs=dict(suite_config.world_kwargs), product=bool(product),
+                          rules=resolve_task(suite_config.task).digest())
 
 
 def recorded_settings(settings) -> dict:
@@ -228,7 +237,7 @@ class Recorder(gym.Wrapper):
         from .reached import Reached
         from .task_registry import resolve_task
 
-        self.config = recorded_config(env_id, method, seed, suite, library, settings, commit, steps)
+        self.config = recorded_config(env_id, method, seed, suite, library, settings, commit, steps, product)
         self.path = directory_to_write(out, "out") / self.config.run_name()
         if self.path.resolve() in _RECORDING:
             raise RunError(f"{self.path} is being recorded by another Recorder in this process: a Recorder records "
@@ -237,8 +246,8 @@ class Recorder(gym.Wrapper):
             state = "finished" if (self.path / "result.json").exists() else "unfinished"
             raise RunError(f"{self.path} holds a recording already ({state}): choose another seed or output "
                            "directory, or delete it to record again")
-        super().__init__(gym.make(self.config.env_id, product=product, **self.config.env_kwargs))
-        self.product = product
+        super().__init__(gym.make(self.config.env_id, product=self.config.product, **self.config.env_kwargs))
+        self.product = self.config.product
         self.run = RunDir(self.path, self.config).__enter__()  # held until finish() or close()
         _RECORDING.add(self.path.resolve())
         self.transitions = 0

@@ -148,6 +148,13 @@ def record_key(record: dict) -> str:
     return hashlib.sha256(json.dumps(run_settings(record), sort_keys=True).encode()).hexdigest()[:10]
 
 
+def recorded_rules(record: dict) -> str | None:
+    """The digest of the task's rules a ``config.json`` record says its run ran under
+    (CraftSuite's runs in their effective settings, a self-reported run beside its task), or
+    None where the record predates it."""
+    return record.get("rules") or (record.get("effective") or {}).get("world", {}).get("rules")
+
+
 def read_config(run) -> dict:
     """A run directory's ``config.json``, of any layout this version reads.
 

@@ -316,3 +316,46 @@ def test_several_directories_need_an_output_of_their_own(tmp_path, capsys):
     assert main(["leaderboard", str(tmp_path / "a"), str(tmp_path / "b")]) == 2
     assert "give --out DIR" in capsys.readouterr().err
     assert not (tmp_path / "a" / "leaderboard.md").exists()
+
+
+def _record_standing_still(out, env_id, **kwargs):
+    env = craftsuite.Recorder(env_id, out, method="my-still", suite="paper", steps=100, **kwargs)
+    env.reset(seed=0)
+    while not env.done:
+        _, _, terminated, truncated, _ = env.step(0)
+        if terminated or truncated:
+            env.reset()
+        if env.evaluation_due:
+            env.evaluate(lambda obs: 0)
+    return env.finish(lambda obs: 0, updates=0)
+
+
+def test_runs_of_a_user_task_edited_between_them_are_never_pooled(tmp_path, treasure_spec):
+    from craftsuite.reporting.obstacles import episode_progress
+
+    path = treasure_spec("EditedTreasure", size=10, max_steps=20)
+    craftsuite.register_task(path)
+    first = _record_standing_still(tmp_path / "runs", "CraftSuite/EditedTreasure-Grid10-v0")
+    path.write_text(path.read_text().replace("count = 1", "count = 2"))  # the same name, other rules
+    craftsuite.register_task(path)
+    second = _record_standing_still(tmp_path / "runs", "CraftSuite/EditedTreasure-Grid10-v0")
+    digests = [json.loads((run / "config.json").read_text())["rules"] for run in (first, second)]
+    assert first != second and digests[1] == craftsuite.resolve_task("EditedTreasure").digest() != digests[0]
+    entries = build(tmp_path / "runs")
+    assert sorted((e.variant, e.seeds) for e in entries) == [("a", [0]), ("b", [0])]
+    assert {e.differs["rules"] for e in entries} == set(digests)
+    assert episode_progress(second) is not None
+    with pytest.raises(RunError, match="task 'EditedTreasure' ran under other rules"):
+        episode_progress(first)  # its episodes' bits would be read against the edited automaton
+
+
+def test_a_product_run_is_recorded_as_one_and_keyed_apart(tmp_path):
+    plain = recorded_config(ENV, "my-dqn")
+    product = recorded_config(ENV, "my-dqn", product=True)
+    assert (plain.product, product.product) == (False, True) and plain.run_name() != product.run_name()
+    with craftsuite.Recorder(ENV, tmp_path, method="my-dqn", product=True) as env, \
+            craftsuite.Recorder(ENV, tmp_path, method="my-dqn") as other:  # the same method and seed: two runs
+        assert json.loads((env.path / "config.json").read_text())["product"] is True
+        assert env.observation_space.shape != other.observation_space.shape
+    with pytest.raises(ValueError, match="product must be True .* or False, got 'yes'"):
+        recorded_config(ENV, "my-dqn", product="yes")

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..record_format import RecordError, breaks_format, check_config, completions, required
-from ..runs import RunError, read_columns, read_config, reading_log
+from ..runs import RunError, read_columns, read_config, reading_log, recorded_rules
 
 
 @dataclass(frozen=True)
@@ -279,7 +279,7 @@ def _spec(run: Path, config: dict):
     except (KeyError, ValueError) as err:
         raise RunError(f"{run / 'config.json'}: task {config['task']!r} is unknown here ({err}): register it to "
                        "read what its episodes reached") from None
-    recorded = config.get("effective", {}).get("world", {}).get("rules")
+    recorded = recorded_rules(config)
     if recorded is not None and recorded != spec.digest():
         raise RunError(f"{run / 'config.json'}: task {spec.name!r} ran under other rules (digest {recorded}) than "
                        f"this version's ({spec.digest()}): its episodes' bits may name another automaton's "

@@ -245,3 +245,44 @@ def test_a_campaign_part_resumes_a_transfer_whose_part_sh_was_interrupted_and_le
     # while its transfer ran, the status named the part.sh that ran it, as the next call reads it
     assert re.search(rf"^status=started [0-9]+ [0-9]+ {this_boot}$",
                      (out / "killed.log").read_text(), re.M)
+
+
+LAND = PART.with_name("land.sh")
+
+
+def test_the_watcher_archives_each_ended_line_in_order_then_rebuilds_the_pages(tmp_path):
+    # the project root it runs from: results/ and a Makefile whose docs target leaves a mark
+    (tmp_path / "results").mkdir()
+    (tmp_path / "Makefile").write_text("docs:\n\techo rebuilt > pages.txt\n")
+    out = tmp_path / "C"
+    out.mkdir()
+    for name, status in (("a", "exit 0"), ("b", "skipped"), ("c", "exit 3")):  # c: stopped by the cut-off
+        (out / f"{name}.status").write_text(status + "\n")
+    stub = tmp_path / "python"
+    stub.write_text(f'#!/bin/sh\necho "$*" >> {tmp_path / "calls"}\necho kept\n')
+    stub.chmod(0o755)
+    done = subprocess.run(["bash", str(LAND), str(out), "hard", "a", "b", "c"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=60, env={**os.environ, "PYTHON": str(stub)})
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "calls").read_text().splitlines() == [f"-m craftsuite archive {out / n} --suite hard"
+                                                             for n in "ac"]
+    said = [re.sub(r"^\d\d:\d\d:\d\d ", "", line) for line in done.stdout.splitlines()]  # less its time
+    assert said[:5] == ["a: exit 0", "kept", "a: archived", "b: skipped", "c: exit 3"]
+    assert said[-1].startswith("pages rebuilt (make docs exit 0") and (tmp_path / "pages.txt").exists()
+    again = subprocess.run(["bash", str(LAND), str(out), "hard", "a"], cwd=tmp_path, capture_output=True, text=True,
+                           timeout=60, env={**os.environ, "PYTHON": str(stub), "LAND_DOCS": "0"})
+    assert again.returncode == 0 and "pages rebuilt" not in again.stdout  # one of several watchers
+
+
+@pytest.mark.parametrize("args, where, message", [
+    ([], "root", "usage: land.sh OUT SUITE NAME"),
+    (["nowhere", "hard", "a"], "root", "no OUT directory"),
+    (["C", "hard", "a"], "elsewhere", "run it from the project root"),
+])
+def test_the_watcher_refuses_a_call_it_cannot_serve_in_one_line(tmp_path, args, where, message):
+    (tmp_path / "root" / "results").mkdir(parents=True)
+    (tmp_path / "root" / "Makefile").write_text("")
+    (tmp_path / "root" / "C").mkdir()
+    (tmp_path / "elsewhere").mkdir()
+    done = subprocess.run(["bash", str(LAND), *args], cwd=tmp_path / where, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2 and message in done.stderr and len(done.stderr.splitlines()) == 1

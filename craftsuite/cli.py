@@ -216,7 +216,7 @@ def _video(args) -> int:
         env_id = _registered(_task(args.target), args.world or "Cont")
     env = _world_kwargs(args.env, parse_id(env_id)[1])
     # a video is for people: show the inventory and automaton state unless --env says otherwise
-    rec = record_video(env_id, args.policy, args.episodes, args.out, args.seed, args.fps, args.product,
+    rec = record_video(env_id, args.policy, args.episodes, args.out, args.seed, args.fps, args.product or None,
                        env_kwargs={"status_panel": True, **env})
     print(f"wrote {rec.path}: {rec.frames} frames at {rec.fps} fps ({rec.codec}); "
           f"{rec.successes}/{rec.episodes} episodes completed the objective")
@@ -890,7 +890,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--fps", type=_positive_float, help="frames per second (default: the world's pace, the env's "
                    "render_fps decisions a second; continuous worlds' motion is drawn between decisions)")
     p.add_argument("--product", action="store_true",
-                   help="make the env with product=True (for checkpoints trained on the product MDP)")
+                   help="make the env with product=True, its observations carrying the automaton state "
+                        "(default: as the checkpoint was trained; not for random and scripted)")
     p.add_argument("--env", help="JSON gymnasium.make keywords, e.g. '{\"frame_skip\": 2}' "
                    "(the world the checkpoint was trained in)")
     p.set_defaults(run=_video)

@@ -22,19 +22,32 @@ def load_policy(name: str, env, seed: int = 0):
         return lambda obs: space.sample()
     if name == "scripted":
         return scripted_policy(env)
-    return _load_checkpoint(Path(name), env)
+    return checkpoint_policy(load_checkpoint(name), env, name)
 
 
-def _load_checkpoint(path: Path, env):
+def is_checkpoint(name: str) -> bool:
+    """Whether a policy's name is a checkpoint's path (not ``"random"`` or ``"scripted"``)."""
+    return name not in ("random", "scripted")
+
+
+def load_checkpoint(path):
+    """The stable-baselines3 model saved at ``path``, with a clear error for a missing,
+    corrupt or misnamed file."""
     from .agents.factory import load_agent
     from .files import file_to_read
 
+    path = Path(path)
     file_to_read(path, "checkpoint", ("model.zip", "teacher.zip"))  # a student's run directory, or a teacher's
     if not path.is_file():
         raise FileNotFoundError(
             f"no such checkpoint {str(path)!r}; a policy is 'random', 'scripted' or a checkpoint file")
-    model = load_agent(path)
-    _check_observations(path, model.observation_space.shape, env)
+    return load_agent(path)
+
+
+def checkpoint_policy(model, env, path):
+    """A callable ``obs -> action`` of a loaded ``model`` (saved at ``path``) for ``env``,
+    whose observations it must have been trained on."""
+    _check_observations(Path(path), model.observation_space.shape, env)
     return lambda obs: model.predict(np.asarray(obs), deterministic=True)[0]
 
 
@@ -48,10 +61,10 @@ def _check_observations(path: Path, shape: tuple, env) -> None:
     product = (plain[0] + automaton.n_states,) if automaton is not None and len(plain) == 1 else None
     if shape == plain:
         raise ValueError(f"{path}: the policy's observation size {shape[0]} matches the plain observation "
-                         "(trained without the automaton state); drop --product")
+                         "(trained without the automaton state); drop --product (product=False)")
     if shape == product:
         raise ValueError(f"{path}: the policy's observation size {shape[0]} matches the observation with the "
-                         "automaton state (trained with it); add --product")
+                         "automaton state (trained with it); make the env with product=True")
     name = env.spec.id if env.spec is not None else "the env"
     sizes = f"{plain}" + (f" ({product} with the automaton state)" if product else "")
     raise ValueError(f"{path}: the policy's observation shape {shape} is not {name}'s, {sizes}; "

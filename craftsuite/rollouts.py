@@ -27,20 +27,31 @@ class Recording:
 
 
 def record_video(env_id: str, policy: str = "scripted", episodes: int = 1, out: str = "rollout.mp4",
-                 seed: int = 0, fps: float | None = None, product: bool = False,
+                 seed: int = 0, fps: float | None = None, product: bool | None = None,
                  progress: bool = True, env_kwargs: dict | None = None) -> Recording:
     """Roll out ``policy`` (see ``load_policy``) for ``episodes`` and write every frame to
-    ``out``. ``env_kwargs`` go to ``gymnasium.make`` (the world a student was trained in).
+    ``out``. ``env_kwargs`` go to ``gymnasium.make`` (the world a student was trained in);
+    ``product``: whether the env's observations carry the automaton state (default: as the
+    checkpoint's observation space says, as ``craftsuite.evaluate`` reads it; not for
+    ``"random"`` and ``"scripted"``).
 
     A grid video shows one frame per decision at the env's ``render_fps``; a continuous
     world's draws each decision's motion too (``set_frames_per_decision``), so that it plays
     at ``SMOOTH_FPS`` or more at the world's pace. ``fps``, if given, sets the playback rate."""
-    from .policies import load_policy  # here: the loop's other users (training's evaluation) need no policies
+    # here: the loop's other users (training's evaluation) need no policies
+    from .evaluation import sees_automaton
+    from .policies import checkpoint_policy, is_checkpoint, load_checkpoint, load_policy
 
+    model = load_checkpoint(policy) if is_checkpoint(policy) else None
+    if product is None:
+        try:
+            product = model is not None and sees_automaton(model, env_id, env_kwargs or {})
+        except ValueError:  # of neither shape: checkpoint_policy names it, with the checkpoint's path
+            product = False
     env = gym.make(env_id, render_mode="rgb_array", product=product, **(env_kwargs or {}))
     world = env.unwrapped
     try:
-        act = load_policy(policy, env, seed=seed)
+        act = load_policy(policy, env, seed=seed) if model is None else checkpoint_policy(model, env, policy)
         decisions_per_second = env.metadata.get("render_fps", 20)
         per_decision = 1
         if hasattr(world, "set_frames_per_decision"):

@@ -101,14 +101,18 @@ def test_a_plain_checkpoint_with_product_says_drop_product(tmp_path, capsys, che
     error = _refused(capsys, ["video", GRID7, "--policy", str(checkpoints[False]), "--product", "--out", str(out)],
                      out)
     assert error == (f"{checkpoints[False]}: the policy's observation size 247 matches the plain observation "
-                     "(trained without the automaton state); drop --product")
+                     "(trained without the automaton state); drop --product (product=False)")
 
 
-def test_a_product_checkpoint_without_product_says_add_product(tmp_path, capsys, checkpoints):
+def test_a_product_checkpoint_is_played_with_the_automaton_state_unasked(tmp_path, checkpoints):
+    from craftsuite.policies import load_policy
+
     out = tmp_path / "v.mp4"
-    error = _refused(capsys, ["video", GRID7, "--policy", str(checkpoints[True]), "--out", str(out)], out)
-    assert error == (f"{checkpoints[True]}: the policy's observation size 251 matches the observation with the "
-                     "automaton state (trained with it); add --product")
+    assert main(["video", GRID7, "--policy", str(checkpoints[True]), "--out", str(out)]) == 0  # as evaluate reads it
+    assert out.stat().st_size > 0
+    with pytest.raises(ValueError, match=r"size 251 matches the observation with the automaton state \(trained "
+                                         r"with it\); make the env with product=True"):
+        load_policy(str(checkpoints[True]), gym.make(GRID7))  # an env made by hand says how to mend it
 
 
 def test_a_checkpoint_of_another_task_names_both_sizes(tmp_path, capsys, checkpoints):

@@ -124,7 +124,8 @@ def recorded_config(env_id: str, method: str, seed: int = 0, suite: str = "stand
     if commit is not None and not isinstance(commit, str):
         raise ValueError(f"commit must be the commit of your code as a string (or None), got {commit!r}")
     if not isinstance(product, (bool, np.bool_)):
-        raise ValueError(f"product must be True (the observation carries the automaton state) or False, got {product!r}")
+        raise ValueError(f"product must be True (the observation carries the automaton state) or False, "
+                         f"got {product!r}")
     from .suites import SUITES
     from .task_registry import resolve_task
 

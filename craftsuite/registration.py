@@ -32,7 +32,8 @@ _WHY_NOT = {"Grid": {side: "the grid world draws every cell {tile} pixels a side
                            "frames); it has no frame size to set" for side in ("width", "height")}}
 # keywords of a world's entry point that a run sets itself, refused in a run's flags (--env)
 # with who sets them; the others' listings leave them out
-_PRODUCT = "whether the automaton state is observed is the run's to say (its method; a video's checkpoint, or --product)"
+_PRODUCT = ("whether the automaton state is observed is the run's to say (its method; a video's checkpoint, "
+            "or --product)")
 # the command renders where it shows something: a run trains unrendered, a video asks for frames
 _RENDER = "the command sets it (runs train unrendered; craftsuite video renders its frames itself)"
 _RUN_OWNS = {"Grid": {"product": _PRODUCT, "size": "the world (Grid7, Grid10) fixes the grid's size",

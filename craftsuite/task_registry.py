@@ -14,6 +14,7 @@ user task (a vector env's worker, ``EnvSpec.from_json``) still builds its world.
 from __future__ import annotations
 
 import json
+import warnings
 from collections.abc import Mapping
 from functools import lru_cache
 from pathlib import Path
@@ -58,7 +59,7 @@ def ladder(*tags: str) -> list[TaskSpec]:
 
 def add_task(source: str | Path | TaskSpec | Mapping) -> TaskSpec:
     """Add a task from a spec file, its TOML data or a loaded spec (replacing a user task
-    of the same name) and return it. Gymnasium ids come with ``craftsuite.register_task``.
+    of the same name, with a warning where its rules differ) and return it. Gymnasium ids come with ``craftsuite.register_task``.
 
     Raises:
         SpecError: a spec that cannot be used, naming the file, the field and the problem; a
@@ -73,6 +74,10 @@ def add_task(source: str | Path | TaskSpec | Mapping) -> TaskSpec:
                             f"My{spec.name}")
         return _BUILTIN[spec.name]  # the same rules: the built-in itself, which travels by name
     _ = spec.automaton  # compiled now: an objective that can never be satisfied is refused before it is known
+    held = tasks().get(spec.name)
+    if held is not None and held.digest() != spec.digest():  # said as gymnasium says an id registered again
+        warnings.warn(f"task {spec.name!r} was registered already, with other rules: this spec replaces it (runs "
+                      "record their task's rules, so runs under the two never pool)", stacklevel=3)
     tasks()[spec.name] = spec
     return spec
 

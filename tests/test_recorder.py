@@ -337,7 +337,9 @@ def test_runs_of_a_user_task_edited_between_them_are_never_pooled(tmp_path, trea
     craftsuite.register_task(path)
     first = _record_standing_still(tmp_path / "runs", "CraftSuite/EditedTreasure-Grid10-v0")
     path.write_text(path.read_text().replace("count = 1", "count = 2"))  # the same name, other rules
-    craftsuite.register_task(path)
+    with pytest.warns(UserWarning, match="task 'EditedTreasure' was registered already, with other rules: this "
+                                         "spec replaces it"):
+        craftsuite.register_task(path)
     second = _record_standing_still(tmp_path / "runs", "CraftSuite/EditedTreasure-Grid10-v0")
     digests = [json.loads((run / "config.json").read_text())["rules"] for run in (first, second)]
     assert first != second and digests[1] == craftsuite.resolve_task("EditedTreasure").digest() != digests[0]

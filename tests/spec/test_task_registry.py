@@ -116,3 +116,16 @@ def test_a_user_task_named_as_a_built_in_is_refused_and_the_built_in_kept(tmp_pa
     assert task_registry.tasks()["Reach"] is reach and craftsuite.registered_ids() == ids
     assert craftsuite.register_task(tasks_dir() / "reach.toml")  # the same task: its ids again
     assert task_registry.tasks()["Reach"] is reach
+
+
+def test_a_user_task_registered_again_warns_only_where_its_rules_changed(tmp_path, user_task):
+    import warnings
+
+    text = GOOD.replace('name = "Treasure"', 'name = "TreasureAsData"')
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        craftsuite.register_task(write(tmp_path, text))  # the same rules: its ids again, silently
+    edited = text.replace("max_steps = ", "max_steps = 1").replace("count = 1", "count = 2")
+    assert edited != text
+    with pytest.warns(UserWarning, match="'TreasureAsData' was registered already, with other rules"):
+        craftsuite.register_task(write(tmp_path, edited, "edited.toml"))

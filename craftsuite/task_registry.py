@@ -59,7 +59,8 @@ def ladder(*tags: str) -> list[TaskSpec]:
 
 def add_task(source: str | Path | TaskSpec | Mapping) -> TaskSpec:
     """Add a task from a spec file, its TOML data or a loaded spec (replacing a user task
-    of the same name, with a warning where its rules differ) and return it. Gymnasium ids come with ``craftsuite.register_task``.
+    of the same name, with a warning where its rules differ) and return it. Gymnasium ids
+    come with ``craftsuite.register_task``.
 
     Raises:
         SpecError: a spec that cannot be used, naming the file, the field and the problem; a

@@ -13,7 +13,12 @@ sqrt(0.05 * 0.95 / N)). The page's rule: the two t-intervals apart, or the proba
 improvement's bootstrap interval excluding one half **and** Welch's interval of the
 difference excluding 0. Beside it: each route alone, and the rule the page had before
 (either route alone decides). Then power: how often each rule says *ahead* when the
-distilled side learns with q 0.2 higher.
+distilled side learns with q 0.2 higher. Then *all-or-nothing* outcomes (a seed that learned
+succeeds in every episode, else in none, as the archive's learned seeds mostly do), where a
+side's seeds often all read 1.00 or 0.00, on equal and unequal sides (experiments/
+bounded-intervals): false *ahead*/*behind* where both sides share q, and false *no difference
+of 0.2 or more* where their q differ by exactly 0.2 (reference 2.5%: a 95% interval within
++-0.2 is two one-sided tests at 2.5%).
 """
 
 from __future__ import annotations
@@ -32,11 +37,15 @@ LEARNED, UNLEARNED = 0.95, 0.02  # an episode's success probability on a seed th
 SEEDS = (5, 10, 20, 100)
 NULLS = (("bimodal, q = 0.2", 0.2), ("bimodal, q = 0.5", 0.5), ("bimodal, q = 0.8", 0.8), ("unimodal, p = 0.5", None))
 GAPS = ((0.3, 0.5), (0.5, 0.7))  # (scratch's q, the distilled side's q)
+EXACT_NULLS = (0.1, 0.9)  # all-or-nothing outcomes, both sides at this q
+SIDES = ((5, 5), (10, 10), (20, 20), (100, 100), (5, 50), (10, 30))  # (distilled seeds, scratch seeds)
+EXACT_GAPS = ((1.0, 0.8), (0.2, 0.0), (0.6, 0.4))  # (the distilled side's q, scratch's q): a gap of 0.2
 
 
-def draw(rng, n: int, q: float | None) -> list[float]:
-    """n seeds' final greedy success: bimodal with learning probability q, or unimodal (q None)."""
-    p = np.full(n, 0.5) if q is None else np.where(rng.random(n) < q, LEARNED, UNLEARNED)
+def draw(rng, n: int, q: float | None, exact: bool = False) -> list[float]:
+    """n seeds' final greedy success: bimodal with learning probability q, or unimodal (q
+    None); ``exact``: a seed that learned succeeds in every episode, else in none."""
+    p = np.full(n, 0.5) if q is None else np.where(rng.random(n) < q, *((1.0, 0.0) if exact else (LEARNED, UNLEARNED)))
     return list(rng.binomial(EPISODES, p) / EPISODES)
 
 
@@ -67,6 +76,18 @@ def rates(rng, n: int, q_mine, q_theirs, trials: int, side: str | None) -> dict[
         for rule in RULES:
             hits[rule] += said[rule] is not None and (side is None or said[rule] == side)
     return {rule: hits[rule] / trials for rule in RULES}
+
+
+def exact_rates(rng, sides: tuple[int, int], q_mine: float, q_theirs: float, trials: int) -> tuple[float, float]:
+    """All-or-nothing outcomes: the shares of trials in which the page's rule says *ahead* or
+    *behind*, and *no difference of 0.2 or more*."""
+    sided = same = 0
+    for _ in range(trials):
+        comparison = board.compare(entry(draw(rng, sides[0], q_mine, exact=True)),
+                                   entry(draw(rng, sides[1], q_theirs, exact=True)))
+        sided += comparison.side is not None
+        same += comparison.verdict.startswith("no difference")
+    return sided / trials, same / trials
 
 
 def main() -> None:
@@ -108,6 +129,31 @@ def main() -> None:
         for n in SEEDS:
             r = rates(rng, n, q_mine, q_theirs, trials(n), "ahead")
             report(f"| {q_theirs} → {q_mine} | {n} | {r['page']:.3f} | {r['either']:.3f} |")
+    report()
+    report("All-or-nothing outcomes (a learned seed succeeds in all 20 episodes, else in none): false *ahead*/"
+           "*behind* where both sides learn with q (reference 0.05), false *no difference of 0.2 or more* where "
+           "the distilled side's q is 0.2 away from scratch's (reference 0.025), share of trials under the page's "
+           "rule:")
+    report()
+    report("| q | seeds (distilled, scratch) | false *ahead*/*behind* |")
+    report("|---|---|---|")
+    worst_sided = worst_same = 0.0
+    for q in EXACT_NULLS:
+        for sides in SIDES:
+            sided, _ = exact_rates(rng, sides, q, q, trials(min(sides)))
+            worst_sided = max(worst_sided, sided)
+            report(f"| {q} | {sides[0]}, {sides[1]} | {sided:.3f} |")
+    report()
+    report("| distilled's q, scratch's q | seeds (distilled, scratch) | false *no difference* |")
+    report("|---|---|---|")
+    for q_mine, q_theirs in EXACT_GAPS:
+        for sides in SIDES:
+            _, same = exact_rates(rng, sides, q_mine, q_theirs, trials(min(sides)))
+            worst_same = max(worst_same, same)
+            report(f"| {q_mine}, {q_theirs} | {sides[0]}, {sides[1]} | {same:.3f} |")
+    report()
+    report(f"All-or-nothing: false *ahead*/*behind* at most {worst_sided:.3f} (reference 0.05), false *no "
+           f"difference* at most {worst_same:.3f} (reference 0.025).")
     report.save(__file__, __doc__, args)
 
 

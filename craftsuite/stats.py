@@ -62,10 +62,15 @@ def shared_level(looks: int) -> float:
     return 1 - (1 - LEVEL) / looks
 
 
-def t_interval(values, level: float = LEVEL, bounds: tuple[float, float] = (-math.inf, math.inf)) -> Estimate:
+UNBOUNDED = (-math.inf, math.inf)
+
+
+def t_interval(values, level: float = LEVEL, bounds: tuple[float, float] = UNBOUNDED) -> Estimate:
     """The mean of ``values`` (one per seed) and its Student t-interval, clipped to
     ``bounds`` (a success rate's [0, 1]: the true mean lies inside them, so clipping loses
-    no coverage). Fewer than ``MIN_SEEDS_FOR_INTERVAL`` values: the mean alone."""
+    no coverage). Fewer than ``MIN_SEEDS_FOR_INTERVAL`` values: the mean alone. Every value
+    at one of ``bounds`` (every seed at 1.0 of a rate): no spread to read a t-interval from,
+    so the exact interval for values within the bounds (``_at_bound_interval``)."""
     from scipy import stats
 
     x = np.asarray(values, dtype=float)
@@ -74,15 +79,40 @@ def t_interval(values, level: float = LEVEL, bounds: tuple[float, float] = (-mat
     mean = float(x.mean())
     if len(x) < MIN_SEEDS_FOR_INTERVAL:
         return Estimate(mean)
+    if _at_bound(x, bounds):
+        return _at_bound_interval(mean, len(x), level, bounds)
     half = float(stats.t.ppf(0.5 + level / 2, len(x) - 1) * x.std(ddof=1) / math.sqrt(len(x)))
     return Estimate(mean, max(bounds[0], mean - half), min(bounds[1], mean + half))
 
 
-def difference(x, y, level: float = LEVEL) -> Estimate:
+def _at_bound(x: np.ndarray, bounds: tuple[float, float]) -> bool:
+    """Whether every value sits at one finite bound (all seeds at 1.0 of a rate, or all at 0.0)."""
+    return any(math.isfinite(b) and bool((x == b).all()) for b in bounds)
+
+
+def _at_bound_interval(bound: float, n: int, level: float, bounds: tuple[float, float]) -> Estimate:
+    """The interval of the mean of ``n`` independent values within ``bounds`` that all sat at
+    ``bound``, one of them: on a [0, 1] scale, n values all at 1 leave [(alpha/2)^(1/n), 1]
+    (Clopper and Pearson's interval for n successes of n). It holds for any values within
+    the bounds, not only 0 and 1: a value reaches the top no more often than its mean says
+    (Markov's inequality), so n of them all there have probability at most mean^n. A
+    t-interval would read no width from no spread: 5 seeds all at 1 are as likely as not
+    from a mean of 0.87, and their t-interval says [1, 1]."""
+    low, high = bounds
+    reach = (high - low) * ((1 - level) / 2) ** (1 / n)
+    return Estimate(bound, low + reach, high) if bound == high else Estimate(bound, low, high - reach)
+
+
+def difference(x, y, level: float = LEVEL, bounds: tuple[float, float] = UNBOUNDED) -> Estimate:
     """mean(x) - mean(y) of two independent samples (one value per seed each) with Welch's
     t-interval (no equal variances assumed). Fewer than ``MIN_SEEDS_FOR_INTERVAL`` values
-    on a side: the difference alone. Both samples constant (every seed at 1.0, say): the
-    interval is the difference itself, all the seeds say."""
+    on a side: the difference alone. A side whose values all sit at one of ``bounds``
+    (every seed at 1.0 of a rate) has no spread for Welch's interval to carry: the interval
+    is then built from the two sides' own intervals (``t_interval``, the exact one for that
+    side) by Newcombe's square-and-add (MOVER, Zou and Donner 2008): from d, down by
+    hypot(mean_x - low_x, high_y - mean_y) and up by hypot(high_x - mean_x, mean_y - low_y),
+    the standard interval of a difference of proportions where one reads 0 or n of n. Both
+    samples constant elsewhere: the interval is the difference itself, all the seeds say."""
     from scipy import stats
 
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
@@ -91,6 +121,10 @@ def difference(x, y, level: float = LEVEL) -> Estimate:
     d = float(x.mean() - y.mean())
     if min(len(x), len(y)) < MIN_SEEDS_FOR_INTERVAL:
         return Estimate(d)
+    if _at_bound(x, bounds) or _at_bound(y, bounds):
+        ix, iy = t_interval(x, level, bounds), t_interval(y, level, bounds)
+        return Estimate(d, d - math.hypot(ix.value - ix.low, iy.high - iy.value),
+                        d + math.hypot(ix.high - ix.value, iy.value - iy.low))
     vx, vy = x.var(ddof=1) / len(x), y.var(ddof=1) / len(y)
     if vx + vy == 0:
         return Estimate(d, d, d)
@@ -99,58 +133,72 @@ def difference(x, y, level: float = LEVEL) -> Estimate:
     return Estimate(d, d - half, d + half)
 
 
-def seeds_to_resolve(x, y, smallest: float, level: float = LEVEL) -> int | None:
+def seeds_to_resolve(x, y, smallest: float, level: float = LEVEL, bounds: tuple[float, float] = UNBOUNDED) -> int | None:
     """The seeds a side at which a comparison of x against y would be decided by the results
     page's interval rules (``reporting.board.compare``), if the difference and the spreads
-    measured held: the two t-intervals of the means apart (ahead or behind), or Welch's
-    interval of the difference within +-``smallest`` (no difference), whichever comes
-    first. A planning figure for an undecided comparison, not a promise: a spread read from a
-    handful of seeds is itself uncertain, and the page's other route to *ahead* or *behind*
-    (the probability of improvement's interval excluding one half while Welch's interval
-    excludes 0 on the same side) is not modelled (it can decide sooner). None where it
-    cannot be said: fewer than ``MIN_SEEDS_FOR_INTERVAL`` values on a side, no spread at
-    all, or no number of seeds that would decide it."""
-    from scipy import stats
-
+    measured held: the two means' intervals apart (ahead or behind), or the interval of the
+    difference within +-``smallest`` (no difference), read by the very functions the page
+    reads (``t_interval``, ``difference``, within ``bounds``) on n seeds a side with the
+    measured means and spreads (a side whose seeds all sat at a bound staying there). A
+    planning figure for an undecided comparison, not a promise: a spread read from a handful
+    of seeds is itself uncertain, the figure is where the expected interval just decides (so
+    about half the time more seeds are needed), and the page's other route to *ahead* or
+    *behind* (the probability of improvement's interval excluding one half while the
+    difference's excludes 0 on the same side) is not modelled (it can decide sooner). None
+    where it cannot be said: fewer than ``MIN_SEEDS_FOR_INTERVAL`` values on a side, no
+    spread on either (unless at a bound, where the exact interval narrows with the seeds), or
+    no number of seeds up to a million that would decide it."""
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     if min(len(x), len(y)) < MIN_SEEDS_FOR_INTERVAL or not (np.isfinite(x).all() and np.isfinite(y).all()):
         return None
-    d = abs(float(x.mean() - y.mean()))
-    vx, vy = float(x.var(ddof=1)), float(y.var(ddof=1))
-    if vx + vy == 0:
+    if x.var() + y.var() == 0 and not (_at_bound(x, bounds) or _at_bound(y, bounds)):
         return None
-    q = 0.5 + level / 2
 
-    def apart(n: int) -> bool:  # each mean's t-interval, n - 1 degrees of freedom
-        return stats.t.ppf(q, n - 1) * (math.sqrt(vx) + math.sqrt(vy)) / math.sqrt(n) < d
+    def like(values: np.ndarray, n: int) -> np.ndarray:  # n seeds with exactly these seeds' mean and spread
+        if values.var() == 0:
+            return np.full(n, values[0])
+        pattern = np.linspace(-1.0, 1.0, n)
+        return values.mean() + values.std(ddof=1) * (pattern - pattern.mean()) / pattern.std(ddof=1)
 
-    def within(n: int) -> bool:  # Welch's interval of the difference at n a side, its own degrees of freedom
-        dof = (n - 1) * (vx + vy) ** 2 / (vx**2 + vy**2)
-        return stats.t.ppf(q, dof) * math.sqrt((vx + vy) / n) < smallest - d
+    def decides(n: int) -> bool:  # each rule's intervals narrow as n grows: the first n at which either decides
+        a, b = like(x, n), like(y, n)
+        ia, ib = t_interval(a, level, bounds), t_interval(b, level, bounds)
+        if ia.low > ib.high or ib.low > ia.high:
+            return True
+        d = difference(a, b, level, bounds)
+        return -smallest < d.low and d.high < smallest
 
-    def first(decides) -> int | None:  # each rule's half-width shrinks with n: double, then halve
-        low, high = MIN_SEEDS_FOR_INTERVAL - 1, MIN_SEEDS_FOR_INTERVAL
-        while not decides(high):
-            if high > 1_000_000:
-                return None
-            low, high = high, high * 2
-        while high - low > 1:
-            mid = (low + high) // 2
-            low, high = (low, mid) if decides(mid) else (mid, high)
-        return high
-
-    found = [n for n in (first(apart) if d > 0 else None, first(within) if smallest > d else None)
-             if n is not None]
-    return min(found) if found else None
+    low, high = MIN_SEEDS_FOR_INTERVAL - 1, MIN_SEEDS_FOR_INTERVAL  # double, then halve
+    while not decides(high):
+        if high > 1_000_000:
+            return None
+        low, high = high, high * 2
+    while high - low > 1:
+        mid = (low + high) // 2
+        low, high = (low, mid) if decides(mid) else (mid, high)
+    return high
 
 
-def iqm(values) -> float:
-    """The interquartile mean: the mean of the middle 50% of ``values`` (all runs of all
-    tasks, flattened), as rliable defines it (``scipy.stats.trim_mean`` cutting 25% from
-    each end)."""
-    from scipy import stats
+def iqm(per_task) -> float:
+    """The interquartile mean of runs over tasks (one array of runs per task; a 2-D array's
+    rows are its tasks), each task weighing the same whatever its count of runs: each of a
+    task's n runs weighs 1 / (tasks x n), and the IQM is the weighted mean of the middle
+    half of that weight, a run on its edge counted for its share. rliable's runs x tasks
+    matrices give every task as many runs, and there this is its IQM (``scipy.stats.trim_mean``
+    cutting 25% from each end) wherever a quarter of the runs is a whole number; pooling
+    unequal counts as they stand would let a task with many seeds outweigh the others."""
+    return float(_task_weighted_iqm(*[np.asarray(s, dtype=float) for s in per_task]))
 
-    return float(stats.trim_mean(np.asarray(values, dtype=float).ravel(), 0.25))
+
+def _task_weighted_iqm(*xs, axis=-1):
+    """``iqm`` of per-task samples along ``axis``, per batch row (a bootstrap's resamples)."""
+    values = np.concatenate([np.moveaxis(x, axis, -1) for x in xs], axis=-1)
+    weights = np.concatenate([np.full(x.shape[axis], 1.0 / (len(xs) * x.shape[axis])) for x in xs])
+    order = np.argsort(values, axis=-1, kind="stable")
+    ordered, w = np.take_along_axis(values, order, axis=-1), weights[order]
+    above = np.cumsum(w, axis=-1)
+    inside = np.clip(above, 0.25, 0.75) - np.clip(above - w, 0.25, 0.75)  # each run's weight in the middle half
+    return (ordered * inside).sum(axis=-1) / inside.sum(axis=-1)
 
 
 def resamples(level: float = LEVEL) -> int:
@@ -178,17 +226,11 @@ def _bootstrap(samples: list[np.ndarray], statistic, level: float = LEVEL):
 
 
 def aggregate_iqm(per_task: list) -> Estimate:
-    """IQM over every run of every task (one array of runs per task), with a
-    stratified-bootstrap interval."""
+    """``iqm`` over every run of every task (one array of runs per task, each task weighing
+    the same), with a stratified-bootstrap interval."""
     samples = [np.asarray(s, dtype=float) for s in per_task]
-
-    def statistic(*xs, axis=-1):
-        from scipy import stats
-
-        return stats.trim_mean(np.concatenate(xs, axis=axis), 0.25, axis=axis)
-
-    low, high = _bootstrap(samples, statistic)
-    return Estimate(iqm(np.concatenate(samples)), float(low), float(high))
+    low, high = _bootstrap(samples, _task_weighted_iqm)
+    return Estimate(iqm(samples), float(low), float(high))
 
 
 def probability_of_improvement(x_per_task: list, y_per_task: list, level: float = LEVEL) -> Estimate:

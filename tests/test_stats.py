@@ -11,10 +11,15 @@ from craftsuite import stats
 
 
 def test_iqm_by_hand():
-    # 8 values: the middle half is the 3rd to the 6th in order
-    assert stats.iqm([10, 0, 1, 2, 3, 4, 5, -10]) == pytest.approx((1 + 2 + 3 + 4) / 4)
-    # across tasks the runs are pooled before trimming (rows: runs, columns: tasks)
-    assert stats.iqm(np.array([[0.0, 1.0], [0.5, 0.5], [1.0, 0.0], [0.25, 0.75]])) == pytest.approx(0.5)
+    # one task of 8 runs: the middle half is the 3rd to the 6th in order
+    assert stats.iqm([[10, 0, 1, 2, 3, 4, 5, -10]]) == pytest.approx((1 + 2 + 3 + 4) / 4)
+    # across tasks (a 2-D array's rows) the runs are pooled before trimming
+    assert stats.iqm(np.array([[0.0, 0.5, 1.0, 0.25], [1.0, 0.5, 0.0, 0.75]])) == pytest.approx(0.5)
+    # each task weighs the same whatever its runs: pooled as they stand, 45 runs at 1 would make it 1.0
+    assert stats.iqm([[1.0] * 45, [0.0] * 5]) == pytest.approx(0.5)
+    assert stats.aggregate_iqm([np.array([1.0] * 45), np.array([0.0] * 5)]).value == pytest.approx(0.5)
+    # a run on the edge of the middle half counts for its share: of 3 runs, a twelfth of each end's
+    assert stats.iqm([[0.0, 1.0, 5.0]]) == pytest.approx((1.0 / 3 + 5.0 / 12) / 0.5)
 
 
 def test_t_interval_by_hand_and_its_edges():
@@ -22,6 +27,11 @@ def test_t_interval_by_hand_and_its_edges():
     half = 4.302652729749464 * 1.0 / np.sqrt(3)  # t(0.975, df 2), sample sd 1
     assert (e.value, e.low, e.high) == pytest.approx((2.0, 2.0 - half, 2.0 + half))
     assert stats.t_interval([0.9, 1.0, 1.0], bounds=(0.0, 1.0)).high == 1.0
+    # every seed at a bound of [0, 1]: no spread, so the exact interval, Clopper and Pearson's for n of n
+    assert stats.t_interval([1.0] * 10, bounds=(0.0, 1.0)) == stats.Estimate(1.0, 0.025 ** 0.1, 1.0)
+    assert stats.t_interval([0.0] * 5, 0.9, bounds=(0.0, 1.0)) == stats.Estimate(0.0, 0.0, 1 - 0.05 ** 0.2)
+    assert stats.t_interval([2.0] * 5, bounds=(0.0, 2.0)).low == pytest.approx(2 * 0.025 ** 0.2)
+    assert stats.t_interval([1.0] * 10) == stats.Estimate(1.0, 1.0, 1.0)  # unbounded: nothing to say it could be less
     two = stats.t_interval([0.2, 0.4])
     assert two.value == pytest.approx(0.3) and not two.has_interval  # below 3 seeds: no interval
     assert np.isnan(stats.t_interval([]).value)
@@ -37,6 +47,32 @@ def test_t_interval_covers_the_true_mean_at_its_level_with_five_seeds():
         e = stats.t_interval(sample)
         covered += e.low <= 0.3 <= e.high
     assert abs(covered / trials - 0.95) <= 0.03
+
+
+def test_the_interval_of_seeds_all_at_one_still_covers_the_true_mean():
+    # a seed learns (success 1.0) with probability 0.87, else not (0.0): 5 such seeds all read 1.0 about half
+    # the time, where a t-interval reads no spread and says [1, 1]
+    rng = np.random.default_rng(0)
+    draws = [(rng.random(5) < 0.87).astype(float) for _ in range(2_000)]
+    covered = np.mean([stats.t_interval(d, bounds=(0.0, 1.0)).low <= 0.87 for d in draws])
+    unbounded = np.mean([stats.t_interval(d).low <= 0.87 for d in draws])
+    assert covered >= 0.95 and unbounded < 0.6
+
+
+def test_a_difference_with_a_side_all_at_a_bound_squares_and_adds_the_two_intervals():
+    ones, mixed = [1.0] * 5, [0.5, 0.7, 0.9, 0.6, 0.8]
+    d = stats.difference(ones, mixed, bounds=(0.0, 1.0))
+    mine, theirs = (stats.t_interval(v, bounds=(0.0, 1.0)) for v in (ones, mixed))
+    assert (d.value, d.low, d.high) == pytest.approx((0.3, 0.3 - math.hypot(1 - mine.low, theirs.high - 0.7),
+                                                      0.3 + math.hypot(0.0, 0.7 - theirs.low)))
+    welch = stats.difference(ones, mixed)  # unbounded: Welch's, which carries the mixed side's spread alone
+    assert welch.low > 0 > d.low
+    # a complete separation of 5 seeds against 5 is decided (an exact permutation test: p = 0.008)
+    assert stats.difference([1.0] * 5, [0.0] * 5, bounds=(0.0, 1.0)).low > 0
+    # nobody learned on either side: a gap of 0.2 is ruled out only from 17 seeds a side
+    assert stats.difference([0.0] * 16, [0.0] * 16, bounds=(0.0, 1.0)).high > 0.2
+    assert stats.difference([0.0] * 17, [0.0] * 17, bounds=(0.0, 1.0)).high < 0.2
+    assert stats.difference([0.0] * 3, [0.0] * 3) == stats.Estimate(0.0, 0.0, 0.0)  # unbounded and constant
 
 
 def test_steps_to_a_threshold_never_average_the_runs_that_did_not_get_there():
@@ -106,6 +142,17 @@ def test_seeds_to_resolve_is_where_the_pages_interval_rules_start_to_decide():
         assert n is not None and decides(like(x, n), like(y, n)) and not decides(like(x, n - 1), like(y, n - 1))
     # the first case is decided by Welch's interval at 10 seeds, but not by the page's rules: more seeds it says
     assert stats.difference(*cases[0]).low > 0 and stats.seeds_to_resolve(*cases[0], 0.2) > 10
+    # a side all at 1 of [0, 1] stays there, its exact interval narrowing with its seeds
+    bounded = ([1.0] * 5, [1.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, 0.0])
+    n = stats.seeds_to_resolve(*bounded, 0.2, bounds=(0.0, 1.0))
+
+    def decides_within(x, y) -> bool:
+        a, b = stats.t_interval(x, bounds=(0.0, 1.0)), stats.t_interval(y, bounds=(0.0, 1.0))
+        d = stats.difference(x, y, bounds=(0.0, 1.0))
+        return a.low > b.high or b.low > a.high or (-0.2 < d.low and d.high < 0.2)
+
+    assert n is not None and decides_within([1.0] * n, like(bounded[1], n))
+    assert not decides_within([1.0] * (n - 1), like(bounded[1], n - 1))
     assert stats.seeds_to_resolve([1.0] * 5, [1.0] * 5, 0.2) is None  # no spread: nothing to extrapolate
     assert stats.seeds_to_resolve([0.0, 1.0], [1.0, 0.0], 0.2) is None  # too few seeds to read a spread
     assert stats.seeds_to_resolve([0.0, 1.0, 1.0], [0.0, 1.0, 1.0], 0.0) is None  # no gap, no margin: never

@@ -548,13 +548,14 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
         raise ValueError(f"no comparison in {metric!r}: compare in one of {', '.join(sorted(COMPARED))}")
     mine, theirs = entry.values[metric], baseline.values[metric]
     level = stats.shared_level(looks)
-    diff = stats.difference(mine, theirs, level)
+    bounds = METRICS[metric]
+    diff = stats.difference(mine, theirs, level, bounds)
     note = ""
     try:
         better = stats.probability_of_improvement([mine], [theirs], level)
     except ValueError:  # fewer than 2 runs on a side
         better = stats.Estimate(math.nan)
-    apart = _apart(*(stats.t_interval(values, level, bounds=METRICS[metric]) for values in (mine, theirs)))
+    apart = _apart(*(stats.t_interval(values, level, bounds) for values in (mine, theirs)))
     # the probability's route alone errs up to twice its nominal 5% at 5-10 seeds a side
     # (benchmarks/verdict_error.py): it decides only where Welch's interval agrees
     side = probability_side(better, len(mine), len(theirs))
@@ -577,7 +578,7 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
                               note=f"every seed of both at {mine[0]:g}{ALL_SAME[metric]}")
     else:
         return Comparison(diff, better, "undecided", looks=looks, seeds_to_decide=stats.seeds_to_resolve(
-            mine, theirs, SMALLEST_DIFFERENCE, stats.shared_level(looks + 1)))
+            mine, theirs, SMALLEST_DIFFERENCE, stats.shared_level(looks + 1), bounds))
     if said in ("ahead", "behind") and -SMALLEST_DIFFERENCE < diff.low and diff.high < SMALLEST_DIFFERENCE:
         said += f", by less than {SMALLEST_DIFFERENCE:g}"
     return Comparison(diff, better, said, looks=looks, note=note)

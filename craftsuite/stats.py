@@ -133,7 +133,8 @@ def difference(x, y, level: float = LEVEL, bounds: tuple[float, float] = UNBOUND
     return Estimate(d, d - half, d + half)
 
 
-def seeds_to_resolve(x, y, smallest: float, level: float = LEVEL, bounds: tuple[float, float] = UNBOUNDED) -> int | None:
+def seeds_to_resolve(x, y, smallest: float, level: float = LEVEL,
+                     bounds: tuple[float, float] = UNBOUNDED) -> int | None:
     """The seeds a side at which a comparison of x against y would be decided by the results
     page's interval rules (``reporting.board.compare``), if the difference and the spreads
     measured held: the two means' intervals apart (ahead or behind), or the interval of the

@@ -57,7 +57,9 @@ PAPER_REFERENCE = {
 
 SEEDS_LISTED = 20  # beyond this, a row's seeds are counted at 0, at 1 and between instead of listed
 LEGEND = (
-    "Per task: the mean over seeds with its 95% Student t-interval (none below 3 seeds), and every seed's "
+    "Per task: the mean over seeds with its 95% Student t-interval (none below 3 seeds; where every seed sat at 0, "
+    "or every seed at 1, the exact interval for values in [0, 1], as no spread gives a t-interval no width), and "
+    "every seed's "
     f"final greedy success (beyond {SEEDS_LISTED} seeds, how many sat at 0, at 1 and between). success: "
     "greedy, at the last evaluation; AUC: mean greedy success over the evaluations during training; return "
     "and training success: training episodes (exploration noise on) in the last 10% of the budget; reached "
@@ -70,7 +72,8 @@ SELF_REPORTED_LEGEND = (
     "not train it. Its learner is its own, so it stands beside every learner regime's runs.")
 
 AGGREGATE_LEGEND = (
-    "Across the tasks every method of a world ran: the interquartile mean (IQM) over all runs of all tasks, with "
+    "Across the tasks every method of a world ran: the interquartile mean (IQM) over all runs of all tasks, each "
+    "task weighing the same whatever its seeds (a rung run at 200 seeds counts as one at 10), with "
     "95% stratified-bootstrap intervals (each task's runs resampled on their own, 2,000 resamples), and the "
     "probability that a run of the method beats a run of {baseline} on the same task (ties count half; 0.5: no "
     "difference), averaged over tasks. With few seeds these intervals run narrow (an IQM interval over 4 tasks x "
@@ -192,8 +195,9 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
                                                  for e, base in same) + "."]
         if pairs:
             lines += ["", f"Against scratch, {COMPARED['success']} (the difference of the means with Welch's "
-                      "t-interval, 95% unless said; the probability that a run beats a scratch run, with its bootstrap "
-                      "interval): "
+                      "t-interval, or, where a side's seeds all sat at 0 or at 1, the two sides' intervals squared "
+                      "and added; 95% unless said; the probability that a run beats a scratch run, with its "
+                      "bootstrap interval): "
                       + "; ".join(_comparison_text(*pair) for pair in in_metric(pairs, "success")) + ".", "",
                       f"Against scratch, {COMPARED['auc']} (how soon a run learned; the same rules): "
                       + "; ".join(_comparison_text(*pair) for pair in in_metric(pairs, "auc")) + "."]
@@ -414,7 +418,7 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
             "| verdict | difference in AUC [Welch t] | P(distilled > scratch) in AUC [bootstrap] | verdict in AUC |",
             "|---|---|---|---|---|---|---|---|---|---|---|", *rows, "",
             f"Decided in final greedy success (ahead, behind, or no difference of {SMALLEST_DIFFERENCE:g} or more) "
-            f"{_tally_text(pairs)}: *ahead*/*behind* where the two means' t-intervals are apart (a row its own "
+            f"{_tally_text(pairs)}: *ahead*/*behind* where the two means' intervals are apart (a row its own "
             "cells would not decide says so), or where the "
             "probability's interval (counted from 5 seeds a side) excludes one half and the difference's excludes 0 "
             "on the same side (the "
@@ -423,7 +427,12 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
             f"±{SMALLEST_DIFFERENCE:g} as well); "
             f"*no difference* where the difference's interval lies within ±{SMALLEST_DIFFERENCE:g} (a probability "
             "away from one half beside it says only that one side's runs won more of the pairings, a lead the "
-            "rules did not confirm: the difference of the means may even lean the other way). A comparison "
+            "rules did not confirm: the difference of the means may even lean the other way). A side whose "
+            "seeds all sat at 0 (or all at 1) has no spread to read a t-interval from: its interval is the exact "
+            "one for values in [0, 1] (Clopper and Pearson's for n of n: 10 seeds all at 1 leave any mean above "
+            "0.69 at 95%), and the difference's interval squares and adds the two sides' (Newcombe's MOVER) in "
+            "place of Welch's, so such a row is decided only where its seeds can say so "
+            "(experiments/bounded-intervals). A comparison "
             "read at fewer seeds (of either side) before they grew had more than one chance to be decided. Its "
             "readings k are counted from the records: one after the runs of each commit that added seeds to "
             "either side (as the runs' config.json records; two such commits count as two readings even where "

@@ -440,7 +440,8 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
             f"interval of a comparison read k times is at 1 − {1 - stats.LEVEL:g}/k (Bonferroni), and its row "
             "says so (\"read 3 times: every interval at 98.3%\"). An undecided row says how many "
             "seeds a side the interval rules would need to decide it at its next reading if its means and "
-            "spreads held (a planning figure: a spread read from a handful of seeds is itself uncertain)."
+            "spreads held (a planning figure: a spread read from a handful of seeds is itself uncertain, and at "
+            "that count the expected interval only just decides, so about half the time more seeds are needed)."
             + _by_regime_text(pairs), "",
             "Decided in AUC (the mean greedy success over the evaluations during training: how soon and how steadily "
             "a run learned, where final success says only where it ended), by the same rules and the same smallest "

@@ -116,10 +116,11 @@ def sees_automaton(policy, env_id: str, kwargs: dict) -> bool:
     space = getattr(policy, "observation_space", None)
     if space is None:
         return False
+    from .wrappers import observation_shapes
+
     plain = gym.make(env_id, product=False, **kwargs)
     try:
-        shape, theirs = tuple(plain.observation_space.shape), tuple(space.shape)
-        product = (shape[0] + plain.unwrapped.automaton.n_states,) if len(shape) == 1 else None
+        (shape, product), theirs = observation_shapes(plain), tuple(space.shape)
     finally:
         plain.close()
     if theirs in (shape, product):

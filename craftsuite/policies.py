@@ -16,13 +16,13 @@ def load_policy(name: str, env, seed: int = 0):
         name: ``"random"``, ``"scripted"``, or the path of a stable-baselines3 checkpoint
             (``.zip``) trained on this env's observation and action spaces.
     """
+    if is_checkpoint(name):
+        return checkpoint_policy(load_checkpoint(name), env, name)
     if name == "random":
         space = env.action_space
         space.seed(seed)
         return lambda obs: space.sample()
-    if name == "scripted":
-        return scripted_policy(env)
-    return checkpoint_policy(load_checkpoint(name), env, name)
+    return scripted_policy(env)
 
 
 def is_checkpoint(name: str) -> bool:
@@ -54,11 +54,11 @@ def checkpoint_policy(model, env, path):
 def _check_observations(path: Path, shape: tuple, env) -> None:
     """Raise a ValueError when a checkpoint's observation ``shape`` is not ``env``'s, saying
     whether the checkpoint was trained with the automaton state (product=True) or without it."""
+    from .wrappers import observation_shapes
+
     if shape == env.observation_space.shape:
         return
-    plain = env.unwrapped.observation_space.shape  # the world's own, under AutomatonObservation
-    automaton = getattr(env.unwrapped, "automaton", None)
-    product = (plain[0] + automaton.n_states,) if automaton is not None and len(plain) == 1 else None
+    plain, product = observation_shapes(env)  # the world's own, under AutomatonObservation, and with it
     if shape == plain:
         raise ValueError(f"{path}: the policy's observation size {shape[0]} matches the plain observation "
                          "(trained without the automaton state); drop --product (product=False)")

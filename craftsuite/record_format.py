@@ -45,9 +45,11 @@ CONFIG = (
     Field("library", "string", False, "self-reported: what trained it"),
     Field("settings", "object", False, "self-reported: the learner's settings, as given"),
     Field("commit", "string or null", False, "self-reported: the commit of the code that trained it"),
-    Field("product", "boolean", False, "self-reported: whether the agent observed the automaton state"),
+    Field("product", "boolean", False, "self-reported: true where the agent observed the automaton state (absent: "
+          "it did not)"),
     Field("rules", "string", False, "self-reported: the digest of its task's rules (CraftSuite's runs record it in "
-          "`effective`); runs of a task whose rules differ are never pooled"),
+          "`effective`); runs of a task whose rules differ are never pooled, nor are runs recorded before it was "
+          "(they stand as a variant of their own)"),
     Field("format", "integer", False, "the record format (absent: 1)"),
     Field("provenance", "list", False, "per session that wrote it: time, versions, commit, machine"),
 )

@@ -66,7 +66,8 @@ class RecordedConfig:
     commit: str | None = None  # the user's code's commit, where given
     layout_seed: int | None = None
     world_kwargs: dict = field(default_factory=dict)
-    product: bool = False  # whether the agent observed the automaton state
+    # whether the agent observed the automaton state (recorded where it did: a plain run keeps the key it had)
+    product: bool = field(default=False, metadata={"omit_if_default": True})
     rules: str | None = None  # the digest of the task's rules (a task edited since records under another key)
     self_reported: bool = True
 

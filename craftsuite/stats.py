@@ -88,8 +88,9 @@ def t_interval(values, level: float = LEVEL, bounds: tuple[float, float] = UNBOU
 
 
 def _at_bound(x: np.ndarray, bounds: tuple[float, float]) -> bool:
-    """Whether every value sits at one finite bound (all seeds at 1.0 of a rate, or all at 0.0)."""
-    return any(math.isfinite(b) and bool((x == b).all()) for b in bounds)
+    """Whether every value sits at one bound of a bounded scale (all seeds at 1.0 of a rate,
+    or all at 0.0); a scale open on either side has no exact interval to give."""
+    return all(map(math.isfinite, bounds)) and any(bool((x == b).all()) for b in bounds)
 
 
 def _at_bound_interval(bound: float, n: int, level: float, bounds: tuple[float, float]) -> Estimate:
@@ -111,10 +112,10 @@ def difference(x, y, level: float = LEVEL, bounds: tuple[float, float] = UNBOUND
     on a side: the difference alone. A side whose values all sit at one of ``bounds``
     (every seed at 1.0 of a rate) has no spread for Welch's interval to carry: the interval
     is then built from the two sides' own intervals (``t_interval``, the exact one for that
-    side) by Newcombe's square-and-add (MOVER, Zou and Donner 2008): from d, down by
-    hypot(mean_x - low_x, high_y - mean_y) and up by hypot(high_x - mean_x, mean_y - low_y),
-    the standard interval of a difference of proportions where one reads 0 or n of n. Both
-    samples constant elsewhere: the interval is the difference itself, all the seeds say."""
+    side) by square-and-add (MOVER, Zou and Donner 2008; Newcombe's method 10 does the same
+    with two Wilson intervals, for a difference of proportions): from d, down by
+    hypot(mean_x - low_x, high_y - mean_y) and up by hypot(high_x - mean_x, mean_y - low_y).
+    Both samples constant elsewhere: the interval is the difference itself, all the seeds say."""
     from scipy import stats
 
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
@@ -150,7 +151,7 @@ def seeds_to_resolve(x, y, smallest: float, level: float = LEVEL,
     difference's excludes 0 on the same side) is not modelled (it can decide sooner). None
     where it cannot be said: fewer than ``MIN_SEEDS_FOR_INTERVAL`` values on a side, no
     spread on either (unless at a bound, where the exact interval narrows with the seeds), or
-    no number of seeds up to a million that would decide it."""
+    no number of seeds up to 100,000 that would decide it."""
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     if min(len(x), len(y)) < MIN_SEEDS_FOR_INTERVAL or not (np.isfinite(x).all() and np.isfinite(y).all()):
         return None
@@ -173,7 +174,7 @@ def seeds_to_resolve(x, y, smallest: float, level: float = LEVEL,
 
     low, high = MIN_SEEDS_FOR_INTERVAL - 1, MIN_SEEDS_FOR_INTERVAL  # double, then halve
     while not decides(high):
-        if high > 1_000_000:
+        if high > 100_000:
             return None
         low, high = high, high * 2
     while high - low > 1:
@@ -188,9 +189,16 @@ def iqm(per_task) -> float:
     task's n runs weighs 1 / (tasks x n), and the IQM is the weighted mean of the middle
     half of that weight, a run on its edge counted for its share. rliable's runs x tasks
     matrices give every task as many runs, and there this is its IQM (``scipy.stats.trim_mean``
-    cutting 25% from each end) wherever a quarter of the runs is a whole number; pooling
-    unequal counts as they stand would let a task with many seeds outweigh the others."""
-    return float(_task_weighted_iqm(*[np.asarray(s, dtype=float) for s in per_task]))
+    cutting 25% from each end), up to floating-point rounding, wherever a quarter of the runs
+    is a whole number; pooling unequal counts as they stand would let a task with many seeds
+    outweigh the others.
+
+    Raises:
+        ValueError: not one non-empty array of runs per task."""
+    samples = [np.asarray(s, dtype=float) for s in per_task]
+    if not samples or any(s.ndim != 1 or len(s) == 0 for s in samples):
+        raise ValueError("iqm: give one non-empty list of runs per task, e.g. [[0.2, 0.9, 1.0], [0.0, 0.5]]")
+    return float(_task_weighted_iqm(*samples))
 
 
 def _task_weighted_iqm(*xs, axis=-1):

@@ -6,6 +6,16 @@ import gymnasium as gym
 import numpy as np
 
 
+def observation_shapes(env) -> tuple[tuple, tuple | None]:
+    """A world's own observation shape, and its shape with the automaton state's one-hot
+    (``AutomatonObservation``'s: None where the world's is not flat or tracks no automaton),
+    whatever wraps it: how a policy's observation space tells which it was trained on."""
+    base = env.unwrapped
+    plain = tuple(base.observation_space.shape)
+    automaton = getattr(base, "automaton", None)
+    return plain, ((plain[0] + automaton.n_states,) if automaton is not None and len(plain) == 1 else None)
+
+
 class AutomatonObservation(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     """The product MDP's observation: the world's vector with the automaton state's one-hot.
 

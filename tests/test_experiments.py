@@ -250,28 +250,56 @@ def test_a_campaign_part_resumes_a_transfer_whose_part_sh_was_interrupted_and_le
 LAND = PART.with_name("land.sh")
 
 
-def test_the_watcher_archives_each_ended_line_in_order_then_rebuilds_the_pages(tmp_path):
-    # the project root it runs from: results/ and a Makefile whose docs target leaves a mark
+def _watcher_root(tmp_path, docs: str = "echo rebuilt > pages.txt"):
+    """A project root for land.sh (results/, a Makefile whose docs target runs ``docs``), its
+    OUT folder, and a stand-in python that logs its command line and fails for a line named bad."""
     (tmp_path / "results").mkdir()
-    (tmp_path / "Makefile").write_text("docs:\n\techo rebuilt > pages.txt\n")
+    (tmp_path / "Makefile").write_text(f"docs:\n\t{docs}\n")
     out = tmp_path / "C"
     out.mkdir()
-    for name, status in (("a", "exit 0"), ("b", "skipped"), ("c", "exit 3")):  # c: stopped by the cut-off
-        (out / f"{name}.status").write_text(status + "\n")
     stub = tmp_path / "python"
-    stub.write_text(f'#!/bin/sh\necho "$*" >> {tmp_path / "calls"}\necho kept\n')
+    stub.write_text(f'#!/bin/sh\necho "$*" >> {tmp_path / "calls"}\necho kept\n'
+                    'case "$*" in */bad\\ *) exit 1;; esac\n')
     stub.chmod(0o755)
-    done = subprocess.run(["bash", str(LAND), str(out), "hard", "a", "b", "c"], cwd=tmp_path, capture_output=True,
-                          text=True, timeout=60, env={**os.environ, "PYTHON": str(stub)})
-    assert done.returncode == 0, done.stderr
+    return out, {**os.environ, "PYTHON": str(stub), "LAND_POLL": "0.05"}
+
+
+def _said(stdout: str) -> list[str]:
+    return [re.sub(r"^\d\d:\d\d:\d\d ", "", line) for line in stdout.splitlines()]  # less its time
+
+
+def test_the_watcher_archives_each_ended_line_in_order_then_rebuilds_the_pages(tmp_path):
+    out, env = _watcher_root(tmp_path)
+    for name, status in (("a", "exit 0"), ("b", "skipped"), ("bad", "exit 1")):
+        (out / f"{name}.status").write_text(status + "\n")
+    watcher = subprocess.Popen(["bash", str(LAND), str(out), "hard", "a", "b", "bad", "c"], cwd=tmp_path,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    time.sleep(0.5)  # c: stopped by the cut-off while the watcher waits for it
+    (out / "c.status").write_text("exit 3\n")
+    stdout, stderr = watcher.communicate(timeout=60)
+    assert watcher.returncode == 0, stderr
     assert (tmp_path / "calls").read_text().splitlines() == [f"-m craftsuite archive {out / n} --suite hard"
-                                                             for n in "ac"]
-    said = [re.sub(r"^\d\d:\d\d:\d\d ", "", line) for line in done.stdout.splitlines()]  # less its time
-    assert said[:5] == ["a: exit 0", "kept", "a: archived", "b: skipped", "c: exit 3"]
+                                                             for n in ("a", "bad", "c")]
+    said = _said(stdout)
+    assert said[:6] == ["a: exit 0", "kept", "a: archived", "b: skipped", "bad: exit 1", "kept"]
+    assert said[6] == "bad: NOT archived (craftsuite archive failed: its lines above)" and said[7] == "c: exit 3"
     assert said[-1].startswith("pages rebuilt (make docs exit 0") and (tmp_path / "pages.txt").exists()
     again = subprocess.run(["bash", str(LAND), str(out), "hard", "a"], cwd=tmp_path, capture_output=True, text=True,
-                           timeout=60, env={**os.environ, "PYTHON": str(stub), "LAND_DOCS": "0"})
+                           timeout=60, env={**env, "LAND_DOCS": "0"})
     assert again.returncode == 0 and "pages rebuilt" not in again.stdout  # one of several watchers
+
+
+def test_the_watcher_waits_for_a_resumed_line_and_says_a_failed_rebuild(tmp_path):
+    out, env = _watcher_root(tmp_path, docs="false")
+    (out / "a.status").write_text("exit 3\n")  # an earlier part's cut-off: part.sh resumes it
+    watcher = subprocess.Popen(["bash", str(LAND), str(out), "hard", "a"], cwd=tmp_path, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, env=env)
+    time.sleep(0.5)
+    assert watcher.poll() is None and not (tmp_path / "calls").exists()  # still waiting: not archived half-done
+    (out / "a.status").write_text("exit 0\n")  # the resume finished it
+    stdout, _ = watcher.communicate(timeout=60)
+    said = _said(stdout)
+    assert said[0] == "a: exit 0" and said[-1].startswith("pages rebuilt (make docs exit 2")
 
 
 @pytest.mark.parametrize("args, where, message", [

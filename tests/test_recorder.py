@@ -206,9 +206,13 @@ def test_the_leaderboard_sets_self_reported_runs_beside_every_regimes_own(tmp_pa
     for part in (one_step, n_step):
         assert "| my-sac *(self-reported)* | 3 | 1.00" in part
         assert "`my-long` not compared: 2,000 transitions against 1,000" in part
-    assert "`my-sac` +1.00 [+1.00, +1.00], P(> `td3`) 1.00" in one_step
+    from craftsuite.stats import difference
+
+    # 3 seeds all at 1 against 3 at 0 (or at 0.5): the exact interval of the side at a bound, squared and added
+    apart, half = difference([1.0] * 3, [0.0] * 3, bounds=(0, 1)), difference([1.0] * 3, [0.5] * 3, bounds=(0, 1))
+    assert f"`my-sac` +1.00 [{apart.low:+.2f}, +1.00], P(> `td3`) 1.00" in one_step
     assert "self-reported runs: compared with these per rung, not aggregated with them" in one_step
-    assert "`my-sac` +0.50 [+0.50, +0.50], P(> `td3`) 1.00" in n_step
+    assert f"`my-sac` +0.50 [{half.low:+.2f}, +0.50], P(> `td3`) 1.00" in n_step
     rows = read_csv(out / "seeds.csv")
     assert {(r["method"], r["regime"], r["self_reported"]) for r in rows} == {
         ("my-sac", "self-reported", "1"), ("my-long", "self-reported", "1"), ("td3", "one-step", "0"),

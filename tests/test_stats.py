@@ -20,6 +20,9 @@ def test_iqm_by_hand():
     assert stats.aggregate_iqm([np.array([1.0] * 45), np.array([0.0] * 5)]).value == pytest.approx(0.5)
     # a run on the edge of the middle half counts for its share: of 3 runs, a twelfth of each end's
     assert stats.iqm([[0.0, 1.0, 5.0]]) == pytest.approx((1.0 / 3 + 5.0 / 12) / 0.5)
+    for flat in ([0.1, 0.9], [[0.1, 0.9], []]):  # runs not given per task, or a task without runs
+        with pytest.raises(ValueError, match="iqm: give one non-empty list of runs per task"):
+            stats.iqm(flat)
 
 
 def test_t_interval_by_hand_and_its_edges():
@@ -32,6 +35,7 @@ def test_t_interval_by_hand_and_its_edges():
     assert stats.t_interval([0.0] * 5, 0.9, bounds=(0.0, 1.0)) == stats.Estimate(0.0, 0.0, 1 - 0.05 ** 0.2)
     assert stats.t_interval([2.0] * 5, bounds=(0.0, 2.0)).low == pytest.approx(2 * 0.025 ** 0.2)
     assert stats.t_interval([1.0] * 10) == stats.Estimate(1.0, 1.0, 1.0)  # unbounded: nothing to say it could be less
+    assert stats.t_interval([0.0] * 10, bounds=(0.0, math.inf)) == stats.Estimate(0.0, 0.0, 0.0)  # open above too
     two = stats.t_interval([0.2, 0.4])
     assert two.value == pytest.approx(0.3) and not two.has_interval  # below 3 seeds: no interval
     assert np.isnan(stats.t_interval([]).value)

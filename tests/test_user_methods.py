@@ -83,7 +83,11 @@ def test_the_leaderboard_reads_a_users_row_given_by_its_module(tmp_path, capsys)
     md = (out / "leaderboard.md").read_text()
     assert "- `hand-made`: trained outside CraftSuite's trainers (its records hold no CraftSuite learner's " \
         "settings)" in md
-    assert "- `mine-static`: my static" in md and "`mine-static` +1.00 [+1.00, +1.00], P(> `dqn`) 1.00" in md
+    from craftsuite.stats import difference
+
+    apart = difference([1.0] * 3, [0.0] * 3, bounds=(0, 1))  # 3 seeds all at 1 against 3 all at 0
+    assert "- `mine-static`: my static" in md
+    assert f"`mine-static` +1.00 [{apart.low:+.2f}, +1.00], P(> `dqn`) 1.00" in md
     capsys.readouterr()
     assert main(["leaderboard", str(runs), "--out", str(out), "--methods", "mine-static"]) == 2
     assert capsys.readouterr().err == ("craftsuite leaderboard: error: --methods mine-static: name a row of your "

@@ -482,14 +482,14 @@ ALL_SAME = {"success": "", "auc": " at every evaluation"}
 class Comparison:
     """A method against a baseline on one task and world, in one of ``COMPARED``."""
 
-    difference: stats.Estimate  # its mean minus the baseline's, with Welch's t-interval
+    difference: stats.Estimate  # its mean minus the baseline's, with its interval (``stats.difference``)
     improvement: stats.Estimate  # P(a run of it beats a run of the baseline), stratified bootstrap
     # "ahead" or "behind" (", by less than 0.2" where that too), "no difference of 0.2 or more",
     # "undecided", "too few seeds"
     verdict: str
     trivial: bool = False  # decided only because every seed of both sat at 0 (or at 1)
     # what the verdict rests on where the row's cells do not show it, said beside it: "every
-    # seed of both at 1" (trivial), "the two means' t-intervals apart"
+    # seed of both at 1" (trivial), "the two means' intervals apart"
     note: str = ""
     # undecided: the seeds a side that would decide it at its next look (one more reading) if
     # the difference and spreads held (``stats.seeds_to_resolve``); None where decided or not to be said
@@ -534,9 +534,11 @@ def probability_side(improvement: stats.Estimate, n: int, m: int) -> str | None:
 
 def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int = 1) -> Comparison:
     """``entry`` against ``baseline`` (same task and world) in ``metric`` (one of
-    ``COMPARED``; both lie in [0, 1]): *ahead* or *behind* where their t-intervals are apart,
-    or where the probability of improvement's interval excludes one half and Welch's interval
-    of the difference excludes 0 on the same side (*, by less than 0.2* added where the
+    ``COMPARED``; both lie in [0, 1]): *ahead* or *behind* where the two means' intervals
+    (``stats.t_interval``: a t-interval, or the exact one where every seed sat at 0 or at 1)
+    are apart, or where the probability of improvement's interval excludes one half and the
+    difference's interval (``stats.difference``: Welch's, or square-and-add beside a side all
+    at 0 or 1) excludes 0 on the same side (*, by less than 0.2* added where the
     difference's interval also lies within +-``SMALLEST_DIFFERENCE``: a real but small gap);
     else *no difference of 0.2 or more* where the interval of the difference lies within
     +-``SMALLEST_DIFFERENCE``; else *undecided*. One rule and one smallest difference for
@@ -557,7 +559,7 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
         better = stats.Estimate(math.nan)
     apart = _apart(*(stats.t_interval(values, level, bounds) for values in (mine, theirs)))
     # the probability's route alone errs up to twice its nominal 5% at 5-10 seeds a side
-    # (benchmarks/verdict_error.py): it decides only where Welch's interval agrees
+    # (benchmarks/verdict_error.py): it decides only where the difference's interval agrees
     side = probability_side(better, len(mine), len(theirs))
     by_probability = side if (side == "ahead" and diff.low > 0) or (side == "behind" and diff.high < 0) else None
     if math.isnan(diff.value):
@@ -568,7 +570,7 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
         said = apart
         # the row's cells show the difference and the probability, not the two t-intervals:
         # where those two would not have decided it, the row says what did
-        note = "" if by_probability == apart else "the two means' t-intervals apart"
+        note = "" if by_probability == apart else "the two means' intervals apart"
     elif by_probability:
         said = by_probability
     elif -SMALLEST_DIFFERENCE < diff.low and diff.high < SMALLEST_DIFFERENCE:

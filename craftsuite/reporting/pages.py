@@ -414,8 +414,8 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
                             if c is None else f"| {entry.budget:,} | {_cells(c, entry, base)} | "
                             f"{_cells(in_auc, entry, base)} |"))
     return ["| rung | world | learner regime | distilled − scratch | transitions per run "
-            "| difference in success [Welch t] | P(distilled > scratch) [bootstrap] "
-            "| verdict | difference in AUC [Welch t] | P(distilled > scratch) in AUC [bootstrap] | verdict in AUC |",
+            "| difference in success [interval] | P(distilled > scratch) [bootstrap] "
+            "| verdict | difference in AUC [interval] | P(distilled > scratch) in AUC [bootstrap] | verdict in AUC |",
             "|---|---|---|---|---|---|---|---|---|---|---|", *rows, "",
             f"Decided in final greedy success (ahead, behind, or no difference of {SMALLEST_DIFFERENCE:g} or more) "
             f"{_tally_text(pairs)}: *ahead*/*behind* where the two means' intervals are apart (a row its own "

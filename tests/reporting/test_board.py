@@ -551,7 +551,7 @@ def test_a_verdict_its_row_cannot_show_says_what_decided_it(tmp_path):
         fake_run(tmp_path, "td3-dynamic", seed, [(1000, 0.1 + seed / 100)], [(950, 1.0)], task="Reach", world="Cont")
     e = {x.method: x for x in build(tmp_path)}
     behind = compare(e["td3-dynamic"], e["td3"])
-    assert behind.said == "behind (the two means' t-intervals apart)" and behind.improvement.high == 0.0
+    assert behind.said == "behind (the two means' intervals apart)" and behind.improvement.high == 0.0
     for seed in range(3, 5):  # at 5 a side the probability and the difference, as the row shows them, agree
         fake_run(tmp_path, "td3", seed, [(1000, 0.9 + seed / 100)], [(950, 1.0)], task="Reach", world="Cont")
         fake_run(tmp_path, "td3-dynamic", seed, [(1000, 0.1 + seed / 100)], [(950, 1.0)], task="Reach", world="Cont")

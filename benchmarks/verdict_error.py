@@ -38,9 +38,10 @@ LEARNED, UNLEARNED = 0.95, 0.02  # an episode's success probability on a seed th
 SEEDS = (5, 10, 20, 100)
 NULLS = (("bimodal, q = 0.2", 0.2), ("bimodal, q = 0.5", 0.5), ("bimodal, q = 0.8", 0.8), ("unimodal, p = 0.5", None))
 GAPS = ((0.3, 0.5), (0.5, 0.7))  # (scratch's q, the distilled side's q)
-EXACT_NULLS = (0.1, 0.9)  # all-or-nothing outcomes, both sides at this q
+EXACT_NULLS = (0.1, 0.9, 0.97)  # all-or-nothing outcomes, both sides at this q (0.97: nearly every seed at 1)
 SIDES = ((5, 5), (10, 10), (20, 20), (100, 100), (5, 50), (10, 30))  # (distilled seeds, scratch seeds)
-EXACT_GAPS = ((1.0, 0.8), (0.2, 0.0), (0.6, 0.4))  # (the distilled side's q, scratch's q): a gap of 0.2
+EXACT_GAPS = ((1.0, 0.8), (0.2, 0.0), (0.6, 0.4), (0.95, 0.75), (0.05, 0.25))  # (the distilled side's q, scratch's q):
+# a gap of 0.2, one side at a bound, neither, or both near one (experiments/near-bound-intervals)
 
 
 def draw(rng, n: int, q: float | None, exact: bool = False) -> list[float]:

@@ -4,11 +4,12 @@ Following Agarwal et al. (2021), "Deep reinforcement learning at the edge of the
 statistical precipice" (the ``rliable`` library):
 
 * per task and method, the seeds' values and a Student t-interval of their mean
-  (``t_interval``). Below ``MIN_SEEDS_FOR_INTERVAL`` there is no interval, only the
+  (``mean_interval``). Below ``MIN_SEEDS_FOR_INTERVAL`` there is no interval, only the
   seeds. A percentile bootstrap over 5 seeds covers the true mean in about 85% of normal
   cases, not the 95% it is labelled with; the t-interval keeps its level
-  (``benchmarks/interval_coverage.py``), except where every seed sits at a bound of a
-  rate (all at 1): no spread, no width, so there the exact interval for bounded values;
+  (``benchmarks/interval_coverage.py``), except at and near a bound of a rate: where
+  every seed sits at 1 there is no spread, no width, so there the exact interval for
+  bounded values, and near it the t-interval widened by a score interval;
 * across tasks, each method's interquartile mean (``aggregate_iqm``, each task weighing
   the same), the probability that it improves on a baseline (``probability_of_improvement``)
   and its performance profile (``performance_profile``), with stratified-bootstrap intervals.
@@ -67,12 +68,10 @@ def shared_level(looks: int) -> float:
 UNBOUNDED = (-math.inf, math.inf)
 
 
-def t_interval(values, level: float = LEVEL, bounds: tuple[float, float] = UNBOUNDED) -> Estimate:
-    """The mean of ``values`` (one per seed) and its Student t-interval, clipped to
-    ``bounds`` (a success rate's [0, 1]: the true mean lies inside them, so clipping loses
-    no coverage). Fewer than ``MIN_SEEDS_FOR_INTERVAL`` values: the mean alone. Every value
-    at one of ``bounds`` (every seed at 1.0 of a rate): no spread to read a t-interval from,
-    so the exact interval for values within the bounds (``_at_bound_interval``)."""
+def t_interval(values, level: float = LEVEL) -> Estimate:
+    """The mean of ``values`` (one per seed) and its Student t-interval. Fewer than
+    ``MIN_SEEDS_FOR_INTERVAL`` values: the mean alone. On a bounded scale the page reads
+    ``mean_interval``, which starts from this one."""
     from scipy import stats
 
     x = np.asarray(values, dtype=float)
@@ -81,10 +80,51 @@ def t_interval(values, level: float = LEVEL, bounds: tuple[float, float] = UNBOU
     mean = float(x.mean())
     if len(x) < MIN_SEEDS_FOR_INTERVAL:
         return Estimate(mean)
-    if _at_bound(x, bounds):
-        return _at_bound_interval(mean, len(x), level, bounds)
     half = float(stats.t.ppf(0.5 + level / 2, len(x) - 1) * x.std(ddof=1) / math.sqrt(len(x)))
-    return Estimate(mean, max(bounds[0], mean - half), min(bounds[1], mean + half))
+    return Estimate(mean, mean - half, mean + half)
+
+
+def mean_interval(values, level: float = LEVEL, bounds: tuple[float, float] = UNBOUNDED) -> Estimate:
+    """The interval of the mean of ``values`` (one per seed) the results page reads: on an
+    open scale the t-interval (``t_interval``). On a bounded one (a rate's [0, 1]), where a
+    t-interval reads its width from the seeds' spread alone and so misses near a bound (19
+    seeds at 1 and one at 0 give a t-interval of [0.85, 1.00], excluding a true 0.8):
+    - every value at one bound (every seed at 1.0): no spread at all, so the exact interval
+      for values within the bounds (``_at_bound_interval``);
+    - otherwise the union of the t-interval and the quasi-binomial score interval
+      (``_score_interval``), clipped to the bounds: never narrower than the t-interval, and
+      wider where the seeds' spread understates the spread a mean farther from the bound
+      would have (experiments/near-bound-intervals)."""
+    x = np.asarray(values, dtype=float)
+    t = t_interval(x, level)
+    if not t.has_interval:
+        return t
+    if _at_bound(x, bounds):
+        return _at_bound_interval(t.value, len(x), level, bounds)
+    low, high = t.low, t.high
+    if all(map(math.isfinite, bounds)) and bounds[0] < t.value < bounds[1]:  # else no scale to read a score on
+        score = _score_interval(x, level, bounds)
+        low, high = min(low, score.low), max(high, score.high)
+    return Estimate(t.value, max(bounds[0], low), min(bounds[1], high))
+
+
+def _score_interval(x: np.ndarray, level: float, bounds: tuple[float, float]) -> Estimate:
+    """The quasi-binomial score interval of the mean of values within ``bounds``, not all at
+    one bound: on the [0, 1] scale, the means p with (mean - p)^2 <= t^2 phi p (1 - p) / n,
+    t Student's quantile at n - 1 degrees of freedom and phi = s^2 / (mean (1 - mean)) the
+    dispersion the seeds show. It models a value's variance as phi p (1 - p), a proportion's
+    variance function (as fractional-response GLMs do): at p = mean it is the seeds' own
+    spread, and it grows as p moves from a bound toward the middle, where a t-interval holds
+    it fixed. For values all at 0 or 1 it is Wilson's score interval (with a t quantile)."""
+    from scipy import stats
+
+    low, high = bounds
+    u = (x - low) / (high - low)
+    n, mean = len(u), float(u.mean())
+    k = float(stats.t.ppf(0.5 + level / 2, n - 1)) ** 2 * float(u.var(ddof=1)) / (mean * (1 - mean)) / n
+    # (mean - p)^2 = k p (1 - p), a quadratic in p: (1 + k) p^2 - (2 mean + k) p + mean^2 = 0
+    centre, half = (2 * mean + k) / (2 * (1 + k)), math.sqrt(k * k + 4 * k * mean * (1 - mean)) / (2 * (1 + k))
+    return Estimate(x.mean(), low + (high - low) * (centre - half), low + (high - low) * (centre + half))
 
 
 def _at_bound(x: np.ndarray, bounds: tuple[float, float]) -> bool:
@@ -109,13 +149,14 @@ def _at_bound_interval(bound: float, n: int, level: float, bounds: tuple[float, 
 def difference(x, y, level: float = LEVEL, bounds: tuple[float, float] = UNBOUNDED) -> Estimate:
     """mean(x) - mean(y) of two independent samples (one value per seed each) with Welch's
     t-interval (no equal variances assumed). Fewer than ``MIN_SEEDS_FOR_INTERVAL`` values
-    on a side: the difference alone. A side whose values all sit at one of ``bounds``
-    (every seed at 1.0 of a rate) has no spread for Welch's interval to carry: the interval
-    is then built from the two sides' own intervals (``t_interval``, the exact one for that
-    side) by square-and-add (MOVER, Zou and Donner 2008; Newcombe's method 10 does the same
-    with two Wilson intervals, for a difference of proportions): from d, down by
-    hypot(mean_x - low_x, high_y - mean_y) and up by hypot(high_x - mean_x, mean_y - low_y).
-    Both samples constant elsewhere: the interval is the difference itself, all the seeds say."""
+    on a side: the difference alone. Where a side's interval on a bounded scale
+    (``mean_interval``) is wider than its t-interval (every seed at a bound, or near one),
+    Welch's interval would carry the spread that side's seeds show, which understates it:
+    the interval is then built from the two sides' own intervals by square-and-add (MOVER,
+    Zou and Donner 2008; Newcombe's method 10 does the same with two Wilson intervals, for a
+    difference of proportions): from d, down by hypot(mean_x - low_x, high_y - mean_y) and
+    up by hypot(high_x - mean_x, mean_y - low_y). Both samples constant elsewhere: the
+    interval is the difference itself, all the seeds say."""
     from scipy import stats
 
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
@@ -124,8 +165,8 @@ def difference(x, y, level: float = LEVEL, bounds: tuple[float, float] = UNBOUND
     d = float(x.mean() - y.mean())
     if min(len(x), len(y)) < MIN_SEEDS_FOR_INTERVAL:
         return Estimate(d)
-    if _at_bound(x, bounds) or _at_bound(y, bounds):
-        ix, iy = t_interval(x, level, bounds), t_interval(y, level, bounds)
+    ix, iy = mean_interval(x, level, bounds), mean_interval(y, level, bounds)
+    if _widened(ix, x, level, bounds) or _widened(iy, y, level, bounds):
         return Estimate(d, d - math.hypot(ix.value - ix.low, iy.high - iy.value),
                         d + math.hypot(ix.high - ix.value, iy.value - iy.low))
     vx, vy = x.var(ddof=1) / len(x), y.var(ddof=1) / len(y)
@@ -136,13 +177,19 @@ def difference(x, y, level: float = LEVEL, bounds: tuple[float, float] = UNBOUND
     return Estimate(d, d - half, d + half)
 
 
+def _widened(interval: Estimate, x: np.ndarray, level: float, bounds: tuple[float, float]) -> bool:
+    """Whether a side's ``mean_interval`` reaches beyond its t-interval clipped to the bounds."""
+    t = t_interval(x, level)
+    return interval.low < max(bounds[0], t.low) or interval.high > min(bounds[1], t.high)
+
+
 def seeds_to_resolve(x, y, smallest: float, level: float = LEVEL,
                      bounds: tuple[float, float] = UNBOUNDED) -> int | None:
     """The seeds a side at which a comparison of x against y would be decided by the results
     page's interval rules (``reporting.board.compare``), if the difference and the spreads
     measured held: the two means' intervals apart (ahead or behind), or the interval of the
     difference within +-``smallest`` (no difference), read by the very functions the page
-    reads (``t_interval``, ``difference``, within ``bounds``) on n seeds a side with the
+    reads (``mean_interval``, ``difference``, within ``bounds``) on n seeds a side with the
     measured means and spreads (a side whose seeds all sat at a bound staying there). A
     planning figure for an undecided comparison, not a promise: a spread read from a handful
     of seeds is itself uncertain, the figure is where the expected interval just decides (so
@@ -166,7 +213,7 @@ def seeds_to_resolve(x, y, smallest: float, level: float = LEVEL,
 
     def decides(n: int) -> bool:  # each rule's intervals narrow as n grows: the first n at which either decides
         a, b = like(x, n), like(y, n)
-        ia, ib = t_interval(a, level, bounds), t_interval(b, level, bounds)
+        ia, ib = mean_interval(a, level, bounds), mean_interval(b, level, bounds)
         if ia.low > ib.high or ib.low > ia.high:
             return True
         d = difference(a, b, level, bounds)

@@ -29,13 +29,13 @@ def test_t_interval_by_hand_and_its_edges():
     e = stats.t_interval([1.0, 2.0, 3.0])
     half = 4.302652729749464 * 1.0 / np.sqrt(3)  # t(0.975, df 2), sample sd 1
     assert (e.value, e.low, e.high) == pytest.approx((2.0, 2.0 - half, 2.0 + half))
-    assert stats.t_interval([0.9, 1.0, 1.0], bounds=(0.0, 1.0)).high == 1.0
+    assert stats.mean_interval([0.9, 1.0, 1.0], bounds=(0.0, 1.0)).high == 1.0
     # every seed at a bound of [0, 1]: no spread, so the exact interval, Clopper and Pearson's for n of n
-    assert stats.t_interval([1.0] * 10, bounds=(0.0, 1.0)) == stats.Estimate(1.0, 0.025 ** 0.1, 1.0)
-    assert stats.t_interval([0.0] * 5, 0.9, bounds=(0.0, 1.0)) == stats.Estimate(0.0, 0.0, 1 - 0.05 ** 0.2)
-    assert stats.t_interval([2.0] * 5, bounds=(0.0, 2.0)).low == pytest.approx(2 * 0.025 ** 0.2)
-    assert stats.t_interval([1.0] * 10) == stats.Estimate(1.0, 1.0, 1.0)  # unbounded: nothing to say it could be less
-    assert stats.t_interval([0.0] * 10, bounds=(0.0, math.inf)) == stats.Estimate(0.0, 0.0, 0.0)  # open above too
+    assert stats.mean_interval([1.0] * 10, bounds=(0.0, 1.0)) == stats.Estimate(1.0, 0.025 ** 0.1, 1.0)
+    assert stats.mean_interval([0.0] * 5, 0.9, bounds=(0.0, 1.0)) == stats.Estimate(0.0, 0.0, 1 - 0.05 ** 0.2)
+    assert stats.mean_interval([2.0] * 5, bounds=(0.0, 2.0)).low == pytest.approx(2 * 0.025 ** 0.2)
+    assert stats.mean_interval([1.0] * 10) == stats.Estimate(1.0, 1.0, 1.0)  # unbounded: nothing to say it could be less
+    assert stats.mean_interval([0.0] * 10, bounds=(0.0, math.inf)) == stats.Estimate(0.0, 0.0, 0.0)  # open above too
     two = stats.t_interval([0.2, 0.4])
     assert two.value == pytest.approx(0.3) and not two.has_interval  # below 3 seeds: no interval
     assert np.isnan(stats.t_interval([]).value)
@@ -58,15 +58,60 @@ def test_the_interval_of_seeds_all_at_one_still_covers_the_true_mean():
     # the time, where a t-interval reads no spread and says [1, 1]
     rng = np.random.default_rng(0)
     draws = [(rng.random(5) < 0.87).astype(float) for _ in range(2_000)]
-    covered = np.mean([stats.t_interval(d, bounds=(0.0, 1.0)).low <= 0.87 for d in draws])
+    covered = np.mean([stats.mean_interval(d, bounds=(0.0, 1.0)).low <= 0.87 for d in draws])
     unbounded = np.mean([stats.t_interval(d).low <= 0.87 for d in draws])
     assert covered >= 0.95 and unbounded < 0.6
+
+
+def test_near_a_bound_the_interval_is_widened_by_the_score_interval_and_never_narrowed():
+    t = stats.t_interval([1.0] * 19 + [0.0])
+    e = stats.mean_interval([1.0] * 19 + [0.0], bounds=(0.0, 1.0))
+    assert t.low > 0.8 > e.low and e.high == 1.0  # the t-interval misses a true 0.8; the widened one does not
+    # its low end: 19 of 20 at 1 read as a proportion, Wilson's score interval (with a t quantile) solved by hand
+    k = 2.093024054408263 ** 2 / 19  # phi = s^2 / (mean (1 - mean)) = 20 / 19 for seeds at 0 or 1
+    centre, half = (1.9 + k) / (2 + 2 * k), math.sqrt(k * k + 4 * k * 0.95 * 0.05) / (2 + 2 * k)
+    assert e.low == pytest.approx(centre - half) and centre + half < 1.0
+    # seeds of small spread away from the bounds: the t-interval, to a few thousandths
+    tight = [0.5, 0.55, 0.45, 0.5, 0.52, 0.48, 0.5, 0.51, 0.49, 0.5]
+    assert stats.mean_interval(tight, bounds=(0.0, 1.0)) == stats.t_interval(tight)
+    near = [0.93, 0.95, 0.91, 0.92, 0.96, 0.94, 0.9, 0.93, 0.95, 0.94]
+    e, t = stats.mean_interval(near, bounds=(0.0, 1.0)), stats.t_interval(near)
+    assert e.low <= t.low and e.high >= t.high and e.low == pytest.approx(t.low, abs=0.003)
+    # wide spread in the middle: the score interval is the narrower, so the t-interval stands
+    wide = [0.2, 0.8, 0.5, 0.1, 0.9]
+    assert stats.mean_interval(wide, bounds=(0.0, 1.0)) == stats.t_interval(wide)
+    # on another bounded scale the same interval, rescaled
+    scaled = stats.mean_interval([2.0 * v for v in [1.0] * 19 + [0.0]], bounds=(0.0, 2.0))
+    assert (scaled.low, scaled.high) == pytest.approx((2 * (centre - half), 2.0))
+
+
+def test_the_widened_interval_covers_a_mean_near_one_where_the_t_interval_does_not():
+    # seeds that learn (1.0) with probability 0.8, else not (0.0), 20 a side: a t-interval near the bound
+    # reads 19 of 20 at 1 as [0.85, 1.00], missing 0.8 above its 5%
+    rng = np.random.default_rng(3)
+    draws = [(rng.random(20) < 0.8).astype(float) for _ in range(4_000)]
+    draws = [d for d in draws if 0 < d.mean() < 1]  # all at 1 take the exact interval under both readings
+    missed = np.mean([not stats.mean_interval(d, bounds=(0.0, 1.0)).low <= 0.8 <= stats.mean_interval(
+        d, bounds=(0.0, 1.0)).high for d in draws])
+    missed_t = np.mean([not stats.t_interval(d).low <= 0.8 <= stats.t_interval(d).high for d in draws])
+    assert missed < 0.05 < 0.06 < missed_t
+
+
+def test_beside_a_widened_side_the_difference_squares_and_adds_and_elsewhere_is_welchs():
+    near, far = [1.0] * 19 + [0.0], [1.0] * 15 + [0.0] * 5
+    d = stats.difference(near, far, bounds=(0.0, 1.0))
+    mine, theirs = (stats.mean_interval(v, bounds=(0.0, 1.0)) for v in (near, far))
+    assert (d.low, d.high) == pytest.approx((0.2 - math.hypot(0.95 - mine.low, theirs.high - 0.75),
+                                            0.2 + math.hypot(mine.high - 0.95, 0.75 - theirs.low)))
+    # neither side widened (at a mean of one half the score interval is the narrower): Welch's, as unbounded
+    wide, middle = [0.2, 0.8, 0.5, 0.1, 0.9], [0.3, 0.7, 0.4, 0.6, 0.5]
+    assert stats.difference(wide, middle, bounds=(0.0, 1.0)) == stats.difference(wide, middle)
 
 
 def test_a_difference_with_a_side_all_at_a_bound_squares_and_adds_the_two_intervals():
     ones, mixed = [1.0] * 5, [0.5, 0.7, 0.9, 0.6, 0.8]
     d = stats.difference(ones, mixed, bounds=(0.0, 1.0))
-    mine, theirs = (stats.t_interval(v, bounds=(0.0, 1.0)) for v in (ones, mixed))
+    mine, theirs = (stats.mean_interval(v, bounds=(0.0, 1.0)) for v in (ones, mixed))
     assert (d.value, d.low, d.high) == pytest.approx((0.3, 0.3 - math.hypot(1 - mine.low, theirs.high - 0.7),
                                                       0.3 + math.hypot(0.0, 0.7 - theirs.low)))
     welch = stats.difference(ones, mixed)  # unbounded: Welch's, which carries the mixed side's spread alone
@@ -151,7 +196,7 @@ def test_seeds_to_resolve_is_where_the_pages_interval_rules_start_to_decide():
     n = stats.seeds_to_resolve(*bounded, 0.2, bounds=(0.0, 1.0))
 
     def decides_within(x, y) -> bool:
-        a, b = stats.t_interval(x, bounds=(0.0, 1.0)), stats.t_interval(y, bounds=(0.0, 1.0))
+        a, b = stats.mean_interval(x, bounds=(0.0, 1.0)), stats.mean_interval(y, bounds=(0.0, 1.0))
         d = stats.difference(x, y, bounds=(0.0, 1.0))
         return a.low > b.high or b.low > a.high or (-0.2 < d.low and d.high < 0.2)
 

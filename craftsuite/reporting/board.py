@@ -225,7 +225,7 @@ class Entry:
 
     @property
     def stats(self) -> dict[str, stats.Estimate]:
-        return {m: stats.t_interval(self.values[m], bounds=METRICS[m]) for m in METRICS}
+        return {m: stats.mean_interval(self.values[m], bounds=METRICS[m]) for m in METRICS}
 
     @property
     def budget_text(self) -> str:
@@ -535,10 +535,11 @@ def probability_side(improvement: stats.Estimate, n: int, m: int) -> str | None:
 def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int = 1) -> Comparison:
     """``entry`` against ``baseline`` (same task and world) in ``metric`` (one of
     ``COMPARED``; both lie in [0, 1]): *ahead* or *behind* where the two means' intervals
-    (``stats.t_interval``: a t-interval, or the exact one where every seed sat at 0 or at 1)
-    are apart, or where the probability of improvement's interval excludes one half and the
-    difference's interval (``stats.difference``: Welch's, or square-and-add beside a side all
-    at 0 or 1) excludes 0 on the same side (*, by less than 0.2* added where the
+    (``stats.mean_interval``: a t-interval, the exact one where every seed sat at 0 or at 1,
+    widened by a score interval near those bounds) are apart, or where the probability of
+    improvement's interval excludes one half and the difference's interval
+    (``stats.difference``: Welch's, or square-and-add beside a side at or near 0 or 1)
+    excludes 0 on the same side (*, by less than 0.2* added where the
     difference's interval also lies within +-``SMALLEST_DIFFERENCE``: a real but small gap);
     else *no difference of 0.2 or more* where the interval of the difference lies within
     +-``SMALLEST_DIFFERENCE``; else *undecided*. One rule and one smallest difference for
@@ -557,7 +558,7 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
         better = stats.probability_of_improvement([mine], [theirs], level)
     except ValueError:  # fewer than 2 runs on a side
         better = stats.Estimate(math.nan)
-    apart = _apart(*(stats.t_interval(values, level, bounds) for values in (mine, theirs)))
+    apart = _apart(*(stats.mean_interval(values, level, bounds) for values in (mine, theirs)))
     # the probability's route alone errs up to twice its nominal 5% at 5-10 seeds a side
     # (benchmarks/verdict_error.py): it decides only where the difference's interval agrees
     side = probability_side(better, len(mine), len(theirs))

@@ -98,7 +98,7 @@ def draw_curves(board: Board) -> list[Drawn]:
                 color = line.get_color()  # one colour per method across panels and styles
                 if style == "-":  # the dashed training success goes without a band, for legibility
                     bounds = (0.0, 1.0) if ax is axes[1] else (-math.inf, math.inf)
-                    band = [stats.t_interval(col[~np.isnan(col)], bounds=bounds) for col in data.T]
+                    band = [stats.mean_interval(col[~np.isnan(col)], bounds=bounds) for col in data.T]
                     lo, hi = np.array([(b.low, b.high) for b in band]).T  # NaN below 3 seeds: no band
                     ax.fill_between(grid, lo, hi, color=color, alpha=0.2)
             # the share of seeds that have reached 80% greedy success by each point: censored runs

@@ -34,7 +34,7 @@ def test_t_interval_by_hand_and_its_edges():
     assert stats.mean_interval([1.0] * 10, bounds=(0.0, 1.0)) == stats.Estimate(1.0, 0.025 ** 0.1, 1.0)
     assert stats.mean_interval([0.0] * 5, 0.9, bounds=(0.0, 1.0)) == stats.Estimate(0.0, 0.0, 1 - 0.05 ** 0.2)
     assert stats.mean_interval([2.0] * 5, bounds=(0.0, 2.0)).low == pytest.approx(2 * 0.025 ** 0.2)
-    assert stats.mean_interval([1.0] * 10) == stats.Estimate(1.0, 1.0, 1.0)  # unbounded: nothing to say it could be less
+    assert stats.mean_interval([1.0] * 10) == stats.Estimate(1.0, 1.0, 1.0)  # unbounded: nothing says it could be less
     assert stats.mean_interval([0.0] * 10, bounds=(0.0, math.inf)) == stats.Estimate(0.0, 0.0, 0.0)  # open above too
     two = stats.t_interval([0.2, 0.4])
     assert two.value == pytest.approx(0.3) and not two.has_interval  # below 3 seeds: no interval

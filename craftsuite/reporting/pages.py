@@ -197,8 +197,8 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
         if pairs:
             lines += ["", f"Against scratch, {COMPARED['success']} (the difference of the means with Welch's "
                       "t-interval, or, where a side's interval is wider than its t-interval (at or near 0 or 1), "
-                      "the two sides' intervals squared and added; 95% unless said; the probability that a run beats a scratch run, with its "
-                      "bootstrap interval): "
+                      "the two sides' intervals squared and added; 95% unless said; the probability that a run "
+                      "beats a scratch run, with its bootstrap interval): "
                       + "; ".join(_comparison_text(*pair) for pair in in_metric(pairs, "success")) + ".", "",
                       f"Against scratch, {COMPARED['auc']} (how soon a run learned; the same rules): "
                       + "; ".join(_comparison_text(*pair) for pair in in_metric(pairs, "auc")) + "."]

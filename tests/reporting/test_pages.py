@@ -127,7 +127,8 @@ def test_the_tasks_page_reads_scratch_success_from_the_archive(tmp_path):
         fake_run(tmp_path / "results" / "standard" / "students", "td3", seed, [(250_000, 1.0)], [(1, 0.0)],
                  task="ToolHome", budget=250_000, hyperparameters=check_regime("n-step-wide").settings("td3"))
     assert sorted(scratch_success(tmp_path / "results")["ToolHome"]) == [
-        f"0.20 [0.00, {e.high:.2f}] at 0.8M (3 seeds, standard, one-step)", "1.00 at 0.25M (2 seeds, standard, n-step-wide)"]
+        f"0.20 [0.00, {e.high:.2f}] at 0.8M (3 seeds, standard, one-step)",
+        "1.00 at 0.25M (2 seeds, standard, n-step-wide)"]
     assert scratch_success(tmp_path / "nowhere") == {} and scratch_success(None) == {}
 
 

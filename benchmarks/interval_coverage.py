@@ -3,7 +3,8 @@
 Usage: python benchmarks/interval_coverage.py [--trials N] [--page PATH | --no-page]
 
 Coverage, on simulated normal seeds (mean 0.3, sd 0.2), of a 95% interval of the mean:
-the Student t-interval the leaderboard uses (``craftsuite.stats.t_interval``) beside the
+the Student t-interval the leaderboard starts from (``craftsuite.stats.t_interval``; on a
+rate's [0, 1] it widens it near the bounds: ``mean_interval``) beside the
 percentile bootstrap of the mean it used before (``scipy.stats.bootstrap``, 2,000
 resamples). Then the stratified-bootstrap interval of the IQM across 4 tasks x 5 seeds
 (``craftsuite.stats.aggregate_iqm``), on symmetric data, whose population IQM is its mean.

@@ -11,9 +11,10 @@ probability 0.95, else 0.02; in the unimodal case each episode succeeds with pro
 the rule's error, against a reference of 5% for a 95% rule (standard error
 sqrt(0.05 * 0.95 / N)). The page's rule: the two means' intervals apart, or the probability
 of improvement's bootstrap interval excluding one half **and** the difference's interval
-excluding 0 (t-intervals and Welch's; a side whose seeds all sat at 0 or at 1 takes its exact
-interval, one near those bounds its t-interval widened by a score interval, and beside either
-the difference squares and adds the two sides' intervals). Beside it: each route alone, and the rule the page had before
+excluding 0 (a side whose seeds all sat at 0 or at 1 takes its exact interval, any other its
+t-interval widened by a score interval where that reaches further, which matters near 0 and 1;
+the difference squares and adds the two sides' intervals wherever a side was widened, which is
+most comparisons, else Welch's). Beside it: each route alone, and the rule the page had before
 (either route alone decides). Then power: how often each rule says *ahead* when the
 distilled side learns with q 0.2 higher. Then *all-or-nothing* outcomes (a seed that learned
 succeeds in every episode, else in none, as the archive's learned seeds mostly do), where a

@@ -100,10 +100,10 @@ def mean_interval(values, level: float = LEVEL, bounds: tuple[float, float] = UN
     if not t.has_interval:
         return t
     if _at_bound(x, bounds):
-        return _at_bound_interval(t.value, len(x), level, bounds)
+        return _at_bound_interval(float(x[0]), len(x), level, bounds)  # x[0] is the bound itself, not a rounded mean
     low, high = t.low, t.high
-    if all(map(math.isfinite, bounds)) and bounds[0] < t.value < bounds[1]:  # else no scale to read a score on
-        score = _score_interval(x, level, bounds)
+    score = _score_interval(x, level, bounds)
+    if score.has_interval:
         low, high = min(low, score.low), max(high, score.high)
     return Estimate(t.value, max(bounds[0], low), min(bounds[1], high))
 
@@ -115,12 +115,18 @@ def _score_interval(x: np.ndarray, level: float, bounds: tuple[float, float]) ->
     dispersion the seeds show. It models a value's variance as phi p (1 - p), a proportion's
     variance function (as fractional-response GLMs do): at p = mean it is the seeds' own
     spread, and it grows as p moves from a bound toward the middle, where a t-interval holds
-    it fixed. For values all at 0 or 1 it is Wilson's score interval (with a t quantile)."""
+    it fixed. For values all at 0 or 1 it is Wilson's score interval with t^2 n / (n - 1) in
+    place of z^2. No interval on a scale open on either side, or where the mean is not
+    strictly inside the bounds (values outside them, or a mean that rounds onto one)."""
     from scipy import stats
 
     low, high = bounds
+    if not (math.isfinite(low) and math.isfinite(high)):
+        return Estimate(float(x.mean()))
     u = (x - low) / (high - low)
     n, mean = len(u), float(u.mean())
+    if not 0 < mean < 1:
+        return Estimate(float(x.mean()))
     k = float(stats.t.ppf(0.5 + level / 2, n - 1)) ** 2 * float(u.var(ddof=1)) / (mean * (1 - mean)) / n
     # (mean - p)^2 = k p (1 - p), a quadratic in p: (1 + k) p^2 - (2 mean + k) p + mean^2 = 0
     centre, half = (2 * mean + k) / (2 * (1 + k)), math.sqrt(k * k + 4 * k * mean * (1 - mean)) / (2 * (1 + k))
@@ -150,13 +156,15 @@ def difference(x, y, level: float = LEVEL, bounds: tuple[float, float] = UNBOUND
     """mean(x) - mean(y) of two independent samples (one value per seed each) with Welch's
     t-interval (no equal variances assumed). Fewer than ``MIN_SEEDS_FOR_INTERVAL`` values
     on a side: the difference alone. Where a side's interval on a bounded scale
-    (``mean_interval``) is wider than its t-interval (every seed at a bound, or near one),
-    Welch's interval would carry the spread that side's seeds show, which understates it:
-    the interval is then built from the two sides' own intervals by square-and-add (MOVER,
+    (``mean_interval``) reaches beyond its t-interval (every seed at a bound; near one, where
+    the seeds' spread understates a mean's farther in; and, by a little, most sides whose mean
+    is not one half, as the score interval leans toward the middle), the interval is built
+    from the two sides' own intervals, clipped to the scale, by square-and-add (MOVER,
     Zou and Donner 2008; Newcombe's method 10 does the same with two Wilson intervals, for a
     difference of proportions): from d, down by hypot(mean_x - low_x, high_y - mean_y) and
-    up by hypot(high_x - mean_x, mean_y - low_y). Both samples constant elsewhere: the
-    interval is the difference itself, all the seeds say."""
+    up by hypot(high_x - mean_x, mean_y - low_y). A clipped end can be shorter than Welch's
+    half-width, so on a side toward a bound this interval may be the narrower of the two.
+    Both samples constant elsewhere: the interval is the difference itself, all the seeds say."""
     from scipy import stats
 
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)

@@ -64,25 +64,36 @@ def test_the_interval_of_seeds_all_at_one_still_covers_the_true_mean():
 
 
 def test_near_a_bound_the_interval_is_widened_by_the_score_interval_and_never_narrowed():
-    t = stats.t_interval([1.0] * 19 + [0.0])
-    e = stats.mean_interval([1.0] * 19 + [0.0], bounds=(0.0, 1.0))
+    from scipy import optimize, stats as sp
+
+    seeds = [1.0] * 19 + [0.0]
+    t, e = stats.t_interval(seeds), stats.mean_interval(seeds, bounds=(0.0, 1.0))
     assert t.low > 0.8 > e.low and e.high == 1.0  # the t-interval misses a true 0.8; the widened one does not
-    # its low end: 19 of 20 at 1 read as a proportion, Wilson's score interval (with a t quantile) solved by hand
-    k = 2.093024054408263 ** 2 / 19  # phi = s^2 / (mean (1 - mean)) = 20 / 19 for seeds at 0 or 1
-    centre, half = (1.9 + k) / (2 + 2 * k), math.sqrt(k * k + 4 * k * 0.95 * 0.05) / (2 + 2 * k)
-    assert e.low == pytest.approx(centre - half) and centre + half < 1.0
-    # seeds of small spread away from the bounds: the t-interval, to a few thousandths
-    tight = [0.5, 0.55, 0.45, 0.5, 0.52, 0.48, 0.5, 0.51, 0.49, 0.5]
-    assert stats.mean_interval(tight, bounds=(0.0, 1.0)) == stats.t_interval(tight)
-    near = [0.93, 0.95, 0.91, 0.92, 0.96, 0.94, 0.9, 0.93, 0.95, 0.94]
+
+    def score_ends(values):  # the means p whose score statistic sits on the t quantile, found by a root search
+        x = np.asarray(values)
+        m, n = x.mean(), len(x)
+        phi, q = x.var(ddof=1) / (m * (1 - m)), sp.t.ppf(0.975, n - 1)
+        gap = lambda p: (m - p) ** 2 - q**2 * phi * p * (1 - p) / n  # noqa: E731
+        return optimize.brentq(gap, 1e-12, m), optimize.brentq(gap, m, 1 - 1e-12)
+
+    assert e.low == pytest.approx(score_ends(seeds)[0], abs=1e-9)  # 0.74: Wilson's, up to the quantile
+    near = [0.93, 0.95, 0.91, 0.92, 0.96, 0.94, 0.9, 0.93, 0.95, 0.94]  # small spread away from the bounds
     e, t = stats.mean_interval(near, bounds=(0.0, 1.0)), stats.t_interval(near)
-    assert e.low <= t.low and e.high >= t.high and e.low == pytest.approx(t.low, abs=0.003)
-    # wide spread in the middle: the score interval is the narrower, so the t-interval stands
+    low, high = score_ends(near)
+    assert (e.low, e.high) == pytest.approx((min(t.low, low), max(t.high, high)), abs=1e-9)
+    assert e.low == pytest.approx(t.low, abs=0.003) and e.low <= t.low and e.high >= t.high  # nearly the t-interval
+    # wide spread at a mean of one half: the score interval is the narrower, so the t-interval stands
     wide = [0.2, 0.8, 0.5, 0.1, 0.9]
     assert stats.mean_interval(wide, bounds=(0.0, 1.0)) == stats.t_interval(wide)
     # on another bounded scale the same interval, rescaled
-    scaled = stats.mean_interval([2.0 * v for v in [1.0] * 19 + [0.0]], bounds=(0.0, 2.0))
-    assert (scaled.low, scaled.high) == pytest.approx((2 * (centre - half), 2.0))
+    scaled = stats.mean_interval([2.0 * v for v in seeds], bounds=(0.0, 2.0))
+    assert (scaled.low, scaled.high) == pytest.approx((2 * score_ends(seeds)[0], 2.0))
+    # every value at a bound takes that bound's exact interval, even where the float mean rounds off it
+    assert stats.mean_interval([0.3] * 10, bounds=(0.1, 0.3)).low == pytest.approx(0.1 + 0.2 * 0.025 ** 0.1)
+    # a mean that rounds onto a bound leaves the t-interval (no score to read), not a division by zero
+    one_off = [0.3] * 9 + [np.nextafter(0.3, 0.0)]
+    assert stats.mean_interval(one_off, bounds=(0.1, 0.3)).high == 0.3
 
 
 def test_the_widened_interval_covers_a_mean_near_one_where_the_t_interval_does_not():
@@ -94,7 +105,7 @@ def test_the_widened_interval_covers_a_mean_near_one_where_the_t_interval_does_n
     missed = np.mean([not stats.mean_interval(d, bounds=(0.0, 1.0)).low <= 0.8 <= stats.mean_interval(
         d, bounds=(0.0, 1.0)).high for d in draws])
     missed_t = np.mean([not stats.t_interval(d).low <= 0.8 <= stats.t_interval(d).high for d in draws])
-    assert missed < 0.05 < 0.06 < missed_t
+    assert missed < 0.05 and missed_t > 0.06
 
 
 def test_beside_a_widened_side_the_difference_squares_and_adds_and_elsewhere_is_welchs():

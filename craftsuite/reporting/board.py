@@ -536,9 +536,10 @@ def compare(entry: Entry, baseline: Entry, metric: str = "success", looks: int =
     """``entry`` against ``baseline`` (same task and world) in ``metric`` (one of
     ``COMPARED``; both lie in [0, 1]): *ahead* or *behind* where the two means' intervals
     (``stats.mean_interval``: a t-interval, the exact one where every seed sat at 0 or at 1,
-    widened by a score interval near those bounds) are apart, or where the probability of
-    improvement's interval excludes one half and the difference's interval
-    (``stats.difference``: Welch's, or square-and-add beside a side at or near 0 or 1)
+    elsewhere widened by a score interval where it reaches further, which matters near those
+    bounds) are apart, or where the probability of improvement's interval excludes one half
+    and the difference's interval (``stats.difference``: square-and-add of the two sides'
+    intervals wherever a side's was widened, which is most comparisons; else Welch's)
     excludes 0 on the same side (*, by less than 0.2* added where the
     difference's interval also lies within +-``SMALLEST_DIFFERENCE``: a real but small gap);
     else *no difference of 0.2 or more* where the interval of the difference lies within

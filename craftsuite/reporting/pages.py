@@ -58,8 +58,9 @@ PAPER_REFERENCE = {
 SEEDS_LISTED = 20  # beyond this, a row's seeds are counted at 0, at 1 and between instead of listed
 LEGEND = (
     "Per task: the mean over seeds with its 95% Student t-interval (none below 3 seeds; where every seed sat at 0, "
-    "or every seed at 1, the exact interval for values in [0, 1], as no spread gives a t-interval no width; near "
-    "those bounds, widened by the quasi-binomial score interval), and "
+    "or every seed at 1, the exact interval for values in [0, 1], as no spread gives a t-interval no width; "
+    "elsewhere widened by the quasi-binomial score interval where that reaches further, which matters near 0 "
+    "and 1), and "
     "every seed's "
     f"final greedy success (beyond {SEEDS_LISTED} seeds, how many sat at 0, at 1 and between). success: "
     "greedy, at the last evaluation; AUC: mean greedy success over the evaluations during training; return "
@@ -195,9 +196,9 @@ def leaderboard_markdown(board: Board, title: str | None = "# Leaderboard", prof
                       "as never): " + "; ".join(f"`{e.label}` {verdict(e, base, 'steps_to_80')}"
                                                  for e, base in same) + "."]
         if pairs:
-            lines += ["", f"Against scratch, {COMPARED['success']} (the difference of the means with Welch's "
-                      "t-interval, or, where a side's interval is wider than its t-interval (at or near 0 or 1), "
-                      "the two sides' intervals squared and added; 95% unless said; the probability that a run "
+            lines += ["", f"Against scratch, {COMPARED['success']} (the difference of the means with the two "
+                      "sides' intervals squared and added where a side's interval reaches beyond its t-interval "
+                      "(most comparisons), else Welch's t-interval; 95% unless said; the probability that a run "
                       "beats a scratch run, with its bootstrap interval): "
                       + "; ".join(_comparison_text(*pair) for pair in in_metric(pairs, "success")) + ".", "",
                       f"Against scratch, {COMPARED['auc']} (how soon a run learned; the same rules): "
@@ -434,10 +435,11 @@ def comparisons_markdown(pairs, auc=None) -> list[str]:
             "0.69 at 95%). A side nearly there (19 seeds at 1 and one at 0) has a t-interval too narrow on its "
             "inner side ([0.85, 1.00], missing a true 0.8 more often than 5%): its interval is the t-interval "
             "widened by the quasi-binomial score interval, which lets the spread grow as a mean moves from the "
-            "bound as a proportion's does ([0.74, 1.00]). Beside a side whose interval is wider than its "
-            "t-interval, the difference's interval squares and adds the two sides' (MOVER, as Newcombe's method "
-            "10 does with Wilson intervals) in place of Welch's, so such a row is decided only where its seeds "
-            "can say so (experiments/bounded-intervals, experiments/near-bound-intervals). A comparison "
+            "bound as a proportion's does ([0.74, 1.00]). Beside a side whose interval reaches beyond its "
+            "t-interval (the score interval leans toward the middle, so by a little most sides' do), the "
+            "difference's interval squares and adds the two sides' (MOVER, as Newcombe's method 10 does with "
+            "Wilson intervals) in place of Welch's, so a row near a bound is decided only where its seeds can "
+            "say so (experiments/bounded-intervals, experiments/near-bound-intervals). A comparison "
             "read at fewer seeds (of either side) before they grew had more than one chance to be decided. Its "
             "readings k are counted from the records: one after the runs of each commit that added seeds to "
             "either side (as the runs' config.json records; two such commits count as two readings even where "

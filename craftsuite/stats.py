@@ -95,17 +95,23 @@ def mean_interval(values, level: float = LEVEL, bounds: tuple[float, float] = UN
       (``_score_interval``), clipped to the bounds: never narrower than the t-interval, and
       wider where the seeds' spread understates the spread a mean farther from the bound
       would have (experiments/near-bound-intervals)."""
-    x = np.asarray(values, dtype=float)
+    return _side_interval(np.asarray(values, dtype=float), level, bounds)[0]
+
+
+def _side_interval(x: np.ndarray, level: float, bounds: tuple[float, float]) -> tuple[Estimate, bool]:
+    """``mean_interval`` of ``x``, and whether it reaches beyond the t-interval clipped to the
+    bounds (where ``difference`` squares and adds instead of reading Welch's)."""
     t = t_interval(x, level)
     if not t.has_interval:
-        return t
+        return t, False
     if _at_bound(x, bounds):
-        return _at_bound_interval(float(x[0]), len(x), level, bounds)  # x[0] is the bound itself, not a rounded mean
-    low, high = t.low, t.high
+        return _at_bound_interval(float(x[0]), len(x), level, bounds), True  # x[0]: the bound, not a rounded mean
+    low, high = max(bounds[0], t.low), min(bounds[1], t.high)
     score = _score_interval(x, level, bounds)
-    if score.has_interval:
-        low, high = min(low, score.low), max(high, score.high)
-    return Estimate(t.value, max(bounds[0], low), min(bounds[1], high))
+    if not score.has_interval:
+        return Estimate(t.value, low, high), False
+    wide = Estimate(t.value, max(bounds[0], min(low, score.low)), min(bounds[1], max(high, score.high)))
+    return wide, (wide.low, wide.high) != (low, high)
 
 
 def _score_interval(x: np.ndarray, level: float, bounds: tuple[float, float]) -> Estimate:
@@ -130,7 +136,7 @@ def _score_interval(x: np.ndarray, level: float, bounds: tuple[float, float]) ->
     k = float(stats.t.ppf(0.5 + level / 2, n - 1)) ** 2 * float(u.var(ddof=1)) / (mean * (1 - mean)) / n
     # (mean - p)^2 = k p (1 - p), a quadratic in p: (1 + k) p^2 - (2 mean + k) p + mean^2 = 0
     centre, half = (2 * mean + k) / (2 * (1 + k)), math.sqrt(k * k + 4 * k * mean * (1 - mean)) / (2 * (1 + k))
-    return Estimate(x.mean(), low + (high - low) * (centre - half), low + (high - low) * (centre + half))
+    return Estimate(float(x.mean()), low + (high - low) * (centre - half), low + (high - low) * (centre + half))
 
 
 def _at_bound(x: np.ndarray, bounds: tuple[float, float]) -> bool:
@@ -173,8 +179,8 @@ def difference(x, y, level: float = LEVEL, bounds: tuple[float, float] = UNBOUND
     d = float(x.mean() - y.mean())
     if min(len(x), len(y)) < MIN_SEEDS_FOR_INTERVAL:
         return Estimate(d)
-    ix, iy = mean_interval(x, level, bounds), mean_interval(y, level, bounds)
-    if _widened(ix, x, level, bounds) or _widened(iy, y, level, bounds):
+    (ix, x_widened), (iy, y_widened) = _side_interval(x, level, bounds), _side_interval(y, level, bounds)
+    if x_widened or y_widened:
         return Estimate(d, d - math.hypot(ix.value - ix.low, iy.high - iy.value),
                         d + math.hypot(ix.high - ix.value, iy.value - iy.low))
     vx, vy = x.var(ddof=1) / len(x), y.var(ddof=1) / len(y)
@@ -183,12 +189,6 @@ def difference(x, y, level: float = LEVEL, bounds: tuple[float, float] = UNBOUND
     dof = (vx + vy) ** 2 / (vx**2 / (len(x) - 1) + vy**2 / (len(y) - 1))  # Welch-Satterthwaite
     half = float(stats.t.ppf(0.5 + level / 2, dof) * math.sqrt(vx + vy))
     return Estimate(d, d - half, d + half)
-
-
-def _widened(interval: Estimate, x: np.ndarray, level: float, bounds: tuple[float, float]) -> bool:
-    """Whether a side's ``mean_interval`` reaches beyond its t-interval clipped to the bounds."""
-    t = t_interval(x, level)
-    return interval.low < max(bounds[0], t.low) or interval.high > min(bounds[1], t.high)
 
 
 def seeds_to_resolve(x, y, smallest: float, level: float = LEVEL,

@@ -25,7 +25,7 @@ def test_iqm_by_hand():
             stats.iqm(flat)
 
 
-def test_t_interval_by_hand_and_its_edges():
+def test_t_interval_by_hand_and_the_pages_interval_at_its_edges():
     e = stats.t_interval([1.0, 2.0, 3.0])
     half = 4.302652729749464 * 1.0 / np.sqrt(3)  # t(0.975, df 2), sample sd 1
     assert (e.value, e.low, e.high) == pytest.approx((2.0, 2.0 - half, 2.0 + half))
